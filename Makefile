@@ -1,0 +1,39 @@
+# SPDX-License-Identifier: MIT
+# Thin wrapper over CMake. `make` builds ./build/verdant.
+BUILD ?= build
+PREFIX ?= /usr/local
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+SANITIZE ?= 0
+
+ifeq ($(SANITIZE),1)
+  BUILD := build-sanitize
+  CMAKE_FLAGS += -DVD_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+endif
+
+.PHONY: all deps configure test bench demo install clean
+
+all: configure
+	cmake --build $(BUILD) -j $(JOBS)
+
+deps:
+	@bash scripts/deps.sh
+
+configure: deps
+	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null
+
+test: all
+	cd $(BUILD) && ctest -j $(JOBS) --output-on-failure
+
+bench: all
+	./$(BUILD)/verdant_bench $(BENCH_ARGS)
+
+demo: all
+	@bash scripts/demo.sh ./$(BUILD)/verdant
+
+install: configure
+	cmake -S . -B $(BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) >/dev/null
+	cmake --build $(BUILD) -j $(JOBS)
+	cmake --install $(BUILD)
+
+clean:
+	rm -rf build build-sanitize

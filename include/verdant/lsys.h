@@ -1,0 +1,231 @@
+// SPDX-License-Identifier: MIT
+// verdant lsys: L-systems in the L-Py file syntax, their derivation, and the turtle that turns
+// an L-string into a labelled plant spec.
+//
+// A vd_lsystem is a parsed grammar (rules, globals, symbol table); it owns its interpreter
+// state (globals, random generator), so one lsystem derives one plant at a time. A vd_lstring
+// is a flat array of modules: symbol ids, and parameters as doubles stored contiguously.
+//
+// Usage:
+//   vd_lsystem* ls; vd_error err = {0};
+//   if (vd_lsys_load("data/tomato.lpy", &ls, &err)) { /* report err */ }
+//   vd_lsys_def def = vd_lsys_def_default(); def.seed = 7;
+//   vd_plant_spec* plant = vd_plant_spec_create();
+//   vd_lsys_grow(ls, &def, NULL, plant, &err);    // derive, interpret, turtle
+//   vd_lsys_destroy(ls);
+#ifndef VERDANT_LSYS_H
+#define VERDANT_LSYS_H
+
+#include "verdant/core.h"
+#include "verdant/plant.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// Predefined modules (L-Py's names, then verdant's): X(enum, name as written in L-strings).
+// Symbols with ids below VD_SYM_PREDEFINED_COUNT are these; declared and one-character modules
+// get later ids.
+#define VD_SYM_LIST(X)                                                                             \
+  X(VD_SYM_SB, "[")                                                                                \
+  X(VD_SYM_EB, "]")                                                                                \
+  X(VD_SYM_F, "F")                                                                                 \
+  X(VD_SYM_f, "f")                                                                                 \
+  X(VD_SYM_nF, "nF")                                                                               \
+  X(VD_SYM_LEFT, "+")                                                                              \
+  X(VD_SYM_RIGHT, "-")                                                                             \
+  X(VD_SYM_UP, "^")                                                                                \
+  X(VD_SYM_DOWN, "&")                                                                              \
+  X(VD_SYM_ROLLL, "/")                                                                             \
+  X(VD_SYM_ROLLR, "\\")                                                                            \
+  X(VD_SYM_IROLLL, "iRollL")                                                                       \
+  X(VD_SYM_IROLLR, "iRollR")                                                                       \
+  X(VD_SYM_TURN, "|")                                                                              \
+  X(VD_SYM_ROLLTOVERT, "@v")                                                                       \
+  X(VD_SYM_ROLLTOHORIZ, "@h")                                                                      \
+  X(VD_SYM_INCWIDTH, "_")                                                                          \
+  X(VD_SYM_DECWIDTH, "!")                                                                          \
+  X(VD_SYM_SETWIDTH, "SetWidth")                                                                   \
+  X(VD_SYM_INCCOLOR, ";")                                                                          \
+  X(VD_SYM_DECCOLOR, ",")                                                                          \
+  X(VD_SYM_SETCOLOR, "SetColor")                                                                   \
+  X(VD_SYM_INTERPCOLORS, "InterpolateColors")                                                      \
+  X(VD_SYM_SPHERE, "@O")                                                                           \
+  X(VD_SYM_CIRCLE, "@o")                                                                           \
+  X(VD_SYM_BOX, "@B")                                                                              \
+  X(VD_SYM_QUAD, "@b")                                                                             \
+  X(VD_SYM_SURFACE, "~")                                                                           \
+  X(VD_SYM_LEAF, "~l")                                                                             \
+  X(VD_SYM_BP, "{")                                                                                \
+  X(VD_SYM_PP, ".")                                                                                \
+  X(VD_SYM_EP, "}")                                                                                \
+  X(VD_SYM_STARTGC, "@Gc")                                                                         \
+  X(VD_SYM_ENDGC, "@Ge")                                                                           \
+  X(VD_SYM_TROPISM, "@Tp")                                                                         \
+  X(VD_SYM_ELASTICITY, "@Ts")                                                                      \
+  X(VD_SYM_TROPISM_LONG, "Tropism")                                                                \
+  X(VD_SYM_ELASTICITY_LONG, "Elasticity")                                                          \
+  X(VD_SYM_MOVETO, "@M")                                                                           \
+  X(VD_SYM_MOVEREL, "MoveRel")                                                                     \
+  X(VD_SYM_SETHEAD, "@R")                                                                          \
+  X(VD_SYM_PINPOINT, "Pinpoint")                                                                   \
+  X(VD_SYM_PINPOINTREL, "PinpointRel")                                                             \
+  X(VD_SYM_LINETO, "LineTo")                                                                       \
+  X(VD_SYM_OLINETO, "OLineTo")                                                                     \
+  X(VD_SYM_LINEREL, "LineRel")                                                                     \
+  X(VD_SYM_OLINEREL, "OLineRel")                                                                   \
+  X(VD_SYM_EULER, "EulerAngles")                                                                   \
+  X(VD_SYM_SETSCALE, "@D")                                                                         \
+  X(VD_SYM_MULTSCALE, "@Di")                                                                       \
+  X(VD_SYM_DIVSCALE, "@Dd")                                                                        \
+  X(VD_SYM_SECTIONRES, "SectionResolution")                                                        \
+  X(VD_SYM_CUT, "%")                                                                               \
+  X(VD_SYM_LABEL, "@L")                                                                            \
+  X(VD_SYM_FRAME, "Frame")                                                                         \
+  X(VD_SYM_ARROW, "Arrow")                                                                         \
+  X(VD_SYM_PGLSHAPE, "@g")                                                                         \
+  X(VD_SYM_2D, "@2D")                                                                              \
+  X(VD_SYM_3D, "@3D")                                                                              \
+  X(VD_SYM_SETGUIDE, "SetGuide")                                                                   \
+  X(VD_SYM_ENDGUIDE, "EndGuide")                                                                   \
+  X(VD_SYM_POSONGUIDE, "PositionOnGuide")                                                          \
+  X(VD_SYM_SWEEP, "Sweep")                                                                         \
+  X(VD_SYM_SETCONTOUR, "SetContour")                                                               \
+  X(VD_SYM_TEXSCALE, "TextureScale")                                                               \
+  X(VD_SYM_TEXUSCALE, "TextureUScale")                                                             \
+  X(VD_SYM_TEXVSCALE, "TextureVScale")                                                             \
+  X(VD_SYM_TEXTRANS, "TextureTranslation")                                                         \
+  X(VD_SYM_TEXROT, "TextureRotation")                                                              \
+  X(VD_SYM_GETPOS, "?P")                                                                           \
+  X(VD_SYM_GETHEAD, "?H")                                                                          \
+  X(VD_SYM_GETUP, "?U")                                                                            \
+  X(VD_SYM_GETLEFT, "?L")                                                                          \
+  X(VD_SYM_GETRIGHT, "?R")                                                                         \
+  X(VD_SYM_GETFRAME, "?F")                                                                         \
+  X(VD_SYM_SETAGE, "SetAge")
+
+typedef enum vd_sym {
+#define VD_SYM_ENUM(e, s) e,
+  VD_SYM_LIST(VD_SYM_ENUM)
+#undef VD_SYM_ENUM
+      VD_SYM_PREDEFINED_COUNT
+} vd_sym;
+
+// Name of a predefined symbol ("@O"), or NULL for ids outside the predefined range.
+const char* vd_sym_predefined_name(int sym);
+
+// A flat L-string: module i has symbol sym[i] and the parameters val[par[i]] .. val[par[i+1]-1].
+typedef struct vd_lstring {
+  int64_t n;      // number of modules
+  int32_t* sym;   // symbol id of each module (n)
+  int64_t* par;   // first-parameter offset of each module, and the total at par[n] (n + 1)
+  double* val;    // parameter values (par[n]); strings are NaN-boxed ids (vd_lsys_value_str)
+  int64_t* src;   // Nullable: index of the derived-string module each module came from (n)
+  int64_t cap, vcap;  // capacities of the module and value arrays
+} vd_lstring;
+
+// Empty L-string (no allocation).
+static inline vd_lstring vd_lstring_empty(void) {
+  vd_lstring s = {0, 0, 0, 0, 0, 0, 0};
+  return s;
+}
+// Free an L-string's arrays and make it empty.
+void vd_lstring_free(vd_lstring* s);
+// Number of parameters of module i.
+static inline int vd_lstring_nparam(const vd_lstring* s, int64_t i) {
+  return (int)(s->par[i + 1] - s->par[i]);
+}
+
+// A parsed L-system (opaque).
+typedef struct vd_lsystem vd_lsystem;
+
+// Settings of one derivation; defaults from vd_lsys_def_default().
+typedef struct vd_lsys_def {
+  int steps;            // derivation steps; -1 = the file's `derivation length` (default -1)
+  uint64_t seed;        // random seed, as if random.seed(seed) ran before the axiom (default 0)
+  int64_t max_modules;  // largest L-string allowed, error VD_ERR_LIMIT beyond (default 50e6)
+  // Nullable: called after each step with (step, steps, modules); return non-zero to stop.
+  int (*progress)(void* user, int step, int steps, int64_t modules);
+  void* progress_user;  // passed to progress
+} vd_lsys_def;
+
+// Default derivation settings (see vd_lsys_def).
+vd_lsys_def vd_lsys_def_default(void);
+
+// Parse L-Py text; name is the file name used in errors (Nullable).
+vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsystem** out,
+                        vd_error* err);
+// Read and parse an .lpy file.
+vd_status vd_lsys_load(const char* path, vd_lsystem** out, vd_error* err);
+// Free an lsystem (NULL is fine).
+void vd_lsys_destroy(vd_lsystem* ls);
+// Replace global `name` by the value of the Python expression `value` (--set NAME=VALUE).
+// The global must exist in the file (VD_ERR_NAME otherwise).
+vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* value, vd_error* err);
+// Current numeric value of a global; VD_ERR_NAME if absent, VD_ERR_TYPE if not a number.
+vd_status vd_lsys_get_global(const vd_lsystem* ls, const char* name, double* value);
+// The file's derivation length (after globals are set).
+int vd_lsys_derivation_length(const vd_lsystem* ls);
+
+// Derive: reset globals to their initial values (with --set overrides), run the axiom and
+// `derivation length` (or def->steps) production steps with decomposition; the result is the
+// derived string (before interpretation) in *out, which is overwritten.
+vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err);
+// Apply interpretation (homomorphism) rules to a derived string; out->src maps each module back
+// to its module in `in`.
+vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lstring* in,
+                            vd_lstring* out, vd_error* err);
+// Name of a symbol id ("Leaf", "@O"), or "?" if out of range.
+const char* vd_lsys_symbol_name(const vd_lsystem* ls, int sym);
+// Number of symbols (predefined + declared + seen).
+int vd_lsys_symbol_count(const vd_lsystem* ls);
+// Symbol id of a name, or -1.
+int vd_lsys_symbol_find(const vd_lsystem* ls, const char* name);
+// Append a textual form of s ("F(1)[+(30)A]") to buf (cap bytes, truncated); returns buf.
+char* vd_lsys_format(const vd_lsystem* ls, const vd_lstring* s, char* buf, size_t cap);
+// Parse an L-string written in the file's module names, with constant parameters.
+vd_status vd_lsys_parse_lstring(vd_lsystem* ls, const char* text, vd_lstring* out, vd_error* err);
+
+// Strings inside L-strings are NaN-boxed: test and extract the string id of a value.
+int vd_lsys_value_is_str(double v);
+// String text of a NaN-boxed value, or NULL when it is not a string of this lsystem.
+const char* vd_lsys_value_str(const vd_lsystem* ls, double v);
+
+// Label names declared by the file (LABELS = {id: "name", ...} or material names); count.
+int vd_lsys_label_count(const vd_lsystem* ls);
+// Label i declared by the file: its id and name.
+void vd_lsys_label_get(const vd_lsystem* ls, int i, int* id, const char** name);
+
+// ---------------------------------------------------------------------------------------------
+// turtle
+
+// Turtle settings; defaults from vd_turtle_def_default() are L-Py's.
+typedef struct vd_turtle_def {
+  double angle;          // default turn angle (degrees), 60
+  double step;           // default F/f length (m), 1
+  double width;          // initial width, a radius (m), 0.1
+  double width_inc;      // _ and ! without argument add/subtract this (m), 1
+  double scale_factor;   // @Di / @Dd without argument multiply/divide the scale by this, 0.5
+  int color;             // initial colour (material) index = label, 1
+  int slices;            // sections of cylinders and spheres, 8
+  vd_vec3 tropism;       // tropism direction, (0, 0, 1)
+  double elasticity;     // tropism strength in [0, 1], 0 (off)
+} vd_turtle_def;
+
+// L-Py's turtle defaults (see vd_turtle_def).
+vd_turtle_def vd_turtle_def_default(void);
+
+// Interpret an L-string with the turtle and append the geometry to plant. Instance ids come
+// from s->src when present (one per derived module), else from the module index.
+vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
+                        vd_plant_spec* plant, vd_error* err);
+
+// Derive, interpret and run the turtle (tdef Nullable: defaults); labels declared by the file
+// are named in plant.
+vd_status vd_lsys_grow(vd_lsystem* ls, const vd_lsys_def* def, const vd_turtle_def* tdef,
+                       vd_plant_spec* plant, vd_error* err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// core: status/error formatting, allocator accounting, arena, rng (against CPython's random),
+// vector and quaternion math, atomic files.
+#include <stdlib.h>
+
+#include "test.h"
+
+TEST(core, error_format) {
+  vd_error e = {0};
+  char buf[256];
+  CHECK_INT(vd_error_set(&e, VD_ERR_SYNTAX, "a.lpy", 3, 7, "expected %s", "':'"), VD_ERR_SYNTAX);
+  CHECK_STR(vd_error_format(&e, buf, sizeof buf), "a.lpy:3:7: expected ':'");
+  // the first error is kept
+  vd_error_set(&e, VD_ERR_IO, "b", 1, 1, "later");
+  CHECK_INT(e.status, VD_ERR_SYNTAX);
+  CHECK_STR(vd_status_str(VD_ERR_LIMIT), "limit exceeded");
+  CHECK_STR(vd_status_str((vd_status)999), "unknown status");
+}
+
+TEST(core, alloc_counts_bytes) {
+  int64_t b0 = vd_alloc_bytes();
+  void* p = vd_malloc(100);
+  CHECK_INT(vd_alloc_bytes() - b0, 100);
+  p = vd_realloc(p, 100, 300);
+  CHECK_INT(vd_alloc_bytes() - b0, 300);
+  vd_free(p, 300);
+  CHECK_INT(vd_alloc_bytes() - b0, 0);
+  CHECK(vd_calloc((size_t)-1, 16) == NULL);
+  int* arr = NULL;
+  int cap = 0;
+  REQUIRE(vd_grow((void**)&arr, &cap, 1000, sizeof(int)));
+  CHECK(cap >= 1000);
+  vd_free(arr, (size_t)cap * sizeof(int));
+}
+
+// an allocator that fails after a budget: out-of-memory paths return NULL, never crash
+static int64_t budget;
+static void* failing_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
+  (void)user;
+  (void)old_size;
+  if (new_size == 0) {
+    free(ptr);
+    return NULL;
+  }
+  if (budget-- <= 0) return NULL;
+  return realloc(ptr, new_size);
+}
+
+TEST(core, allocator_hook_out_of_memory) {
+  budget = 1;
+  vd_set_allocator(failing_realloc, NULL);
+  void* a = vd_malloc(10);
+  void* b = vd_malloc(10);
+  vd_set_allocator(NULL, NULL);
+  CHECK(a != NULL);
+  CHECK(b == NULL);
+  vd_free(a, 10);
+}
+
+TEST(core, arena) {
+  vd_arena a;
+  vd_arena_init(&a, 256);
+  char* p = vd_arena_alloc(&a, 100);
+  char* q = vd_arena_alloc(&a, 1000);  // larger than a block
+  REQUIRE(p && q);
+  CHECK(((uintptr_t)p & 15) == 0 && ((uintptr_t)q & 15) == 0);
+  memset(q, 1, 1000);
+  vd_arena_reset(&a);
+  CHECK_INT(a.used, 0);
+  CHECK(vd_arena_alloc(&a, 500) != NULL);
+  vd_arena_free(&a);
+}
+
+TEST(rng, matches_cpython) {
+  // reference values printed by CPython 3.11: random.seed(42); random.random() ...
+  vd_rng r;
+  vd_rng_seed(&r, 42);
+  CHECK(vd_rng_random(&r) == 0.6394267984578837);
+  CHECK(vd_rng_random(&r) == 0.025010755222666936);
+  CHECK(vd_rng_random(&r) == 0.27502931836911926);
+  vd_rng_seed(&r, 42);
+  CHECK(vd_rng_uniform(&r, 2, 5) == 3.9182803953736514);
+  CHECK(vd_rng_gauss(&r, 1, 2) == 2.5842894818995816);
+  CHECK(vd_rng_gauss(&r, 1, 2) == 1.2510365514065214);
+  CHECK_INT(vd_rng_randint(&r, 1, 6), 2);
+  CHECK_INT(vd_rng_randint(&r, 0, 1000000), 146316);
+  vd_rng_seed(&r, ((uint64_t)1 << 40) + 7);
+  CHECK(vd_rng_random(&r) == 0.6137037779936511);
+  vd_rng_seed(&r, 0);
+  CHECK(vd_rng_random(&r) == 0.8444218515250481);
+}
+
+TEST(rng, streams_independent_and_reproducible) {
+  vd_rng a, b, c;
+  vd_rng_stream(&a, 7, 3);
+  vd_rng_stream(&b, 7, 3);
+  vd_rng_stream(&c, 7, 4);
+  int same = 1, diff = 0;
+  for (int i = 0; i < 100; i++) {
+    uint32_t x = vd_rng_u32(&a), y = vd_rng_u32(&b), z = vd_rng_u32(&c);
+    same &= x == y;
+    diff += x != z;
+  }
+  CHECK(same);
+  CHECK(diff > 90);
+}
+
+TEST(core, rotate_and_quat) {
+  vd_vec3 v = vd_rotate(vd_v3(1, 0, 0), vd_v3(0, 0, 1), VD_PI / 2);
+  CHECK_NEAR(v.x, 0, 1e-15);
+  CHECK_NEAR(v.y, 1, 1e-15);
+  vd_quat q = vd_quat_axis_angle(vd_v3(0, 0, 1), VD_PI / 2);
+  vd_vec3 w = vd_quat_rotate(q, vd_v3(1, 0, 0));
+  CHECK_NEAR(w.y, 1, 1e-15);
+  vd_quat f = vd_quat_from_axes(vd_v3(0, 1, 0), vd_v3(-1, 0, 0), vd_v3(0, 0, 1));
+  vd_vec3 u = vd_quat_rotate(f, vd_v3(1, 0, 0));
+  CHECK_NEAR(u.y, 1, 1e-12);
+  vd_quat id = vd_quat_mul(q, vd_quat_conj(q));
+  CHECK_NEAR(id.w, 1, 1e-15);
+}
+
+TEST(core, atomic_file) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/atomic.txt", vdt_tmpdir());
+  vd_error e = {0};
+  vd_outfile f;
+  CHECK_STATUS(vd_outfile_open(&f, path, &e), VD_OK, e);
+  fputs("hello", f.fp);
+  FILE* probe = fopen(path, "rb");
+  CHECK(probe == NULL);  // nothing at the final name before commit
+  if (probe) fclose(probe);
+  CHECK_STATUS(vd_outfile_commit(&f, &e), VD_OK, e);
+  char* text;
+  size_t len;
+  CHECK_STATUS(vd_file_read(path, &text, &len, &e), VD_OK, e);
+  CHECK_INT(len, 5);
+  CHECK_STR(text, "hello");
+  vd_free(text, len + 1);
+  // abort leaves nothing
+  snprintf(path, sizeof path, "%s/aborted.txt", vdt_tmpdir());
+  CHECK_STATUS(vd_outfile_open(&f, path, &e), VD_OK, e);
+  vd_outfile_abort(&f);
+  CHECK(fopen(path, "rb") == NULL);
+  vd_error e2 = {0};
+  CHECK_STATUS(vd_outfile_open(&f, "/nonexistent-dir/x.txt", &e2), VD_ERR_IO, e2);
+  vd_error e3 = {0};
+  CHECK_STATUS(vd_file_read("/nonexistent-file", &text, &len, &e3), VD_ERR_IO, e3);
+}
