@@ -1,4 +1,43 @@
 // SPDX-License-Identifier: MIT
+// The verdant command: git-style subcommands. The only place that prints or exits.
 #include <stdio.h>
-#include "verdant/core.h"
-int main(void) { printf("verdant %s\n", VD_VERSION_STRING); return 0; }
+#include <string.h>
+
+#include "cli.h"
+
+static void log_to_stderr(void* user, int level, const char* msg) {
+  (void)user;
+  fprintf(stderr, "%s%s\n", level ? "warning: " : "", msg);
+}
+
+static const char* main_help =
+    "usage: verdant <command> [options]\n"
+    "\n"
+    "Virtual plants: L-systems in the L-Py file syntax grown into labelled geometry.\n"
+    "\n"
+    "commands:\n"
+    "  grow      L-system (.lpy) or plant file → plant JSON, OBJ or PLY, with --stats\n"
+    "\n"
+    "Run 'verdant <command> --help' for the options of a command.\n"
+    "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
+
+int main(int argc, char** argv) {
+  vd_set_log(log_to_stderr, NULL);
+  if (argc < 2) {
+    fputs(main_help, stderr);
+    return EXIT_USAGE;
+  }
+  const char* cmd = argv[1];
+  if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
+    fputs(main_help, stdout);
+    return EXIT_OK;
+  }
+  if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+    printf("verdant %s\n", VD_VERSION_STRING);
+    return EXIT_OK;
+  }
+  if (!strcmp(cmd, "grow")) return cli_grow(argc - 1, argv + 1);
+  fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
+  fputs(main_help, stderr);
+  return EXIT_USAGE;
+}

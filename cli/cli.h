@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: MIT
+// Shared pieces of the verdant command: option parsing, loading a plant, errors, progress.
+#ifndef VERDANT_CLI_H
+#define VERDANT_CLI_H
+
+#include <stdio.h>
+
+#include "verdant/verdant.h"
+
+// exit codes (DESIGN.md): 0 success, 1 failed run, 2 bad usage or bad input
+enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2 };
+
+// Exit code for a library status: input faults are 2, resource and I/O faults of a run are 1.
+int cli_exit_code(vd_status st);
+// Print "verdant <cmd>: file:line:col: message" to stderr and return the exit code.
+int cli_report(const char* cmd, const vd_error* err, vd_status st);
+// Print a usage error and return EXIT_USAGE.
+int cli_usage_error(const char* cmd, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+
+// Options every command that takes a plant understands.
+typedef struct cli_plant_opts {
+  const char* path;        // .lpy or plant .json
+  int steps;               // -n/--steps, -1 = file's derivation length
+  uint64_t seed;           // --seed
+  int64_t max_modules;     // --max-modules
+  const char* set[64];     // --set NAME=VALUE
+  int nset;
+  const char* label[64];   // --label ID=NAME
+  int nlabel;
+  int progress;            // show a progress bar (stderr is a terminal)
+} cli_plant_opts;
+
+// Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
+void cli_plant_opts_init(cli_plant_opts* o);
+// Consume a plant option at argv[*i] (advancing *i past its value); 1 if consumed, 0 if not
+// a plant option, -1 on a bad value (message printed).
+int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int* i);
+// Help text lines for the plant options.
+extern const char* cli_plant_help;
+
+// Load the plant: derive an .lpy (and keep its derived string's module counts in stats) or
+// read a plant file. On success *out is a new spec.
+typedef struct cli_grow_info {
+  int64_t modules;          // modules of the derived string (0 for plant files)
+  int nsym;                 // symbol count of the lsystem
+  int64_t* sym_count;       // per-symbol module counts (nsym), owned (free with vd_free)
+  char** sym_name;          // per-symbol names (nsym), owned
+  double seconds_derive, seconds_turtle;
+} cli_grow_info;
+vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err);
+// Free what cli_load_plant put in info.
+void cli_grow_info_free(cli_grow_info* info);
+
+// Monotonic seconds.
+double cli_now(void);
+// Does path end with ext (case-insensitive, ext with the dot)?
+int cli_has_ext(const char* path, const char* ext);
+
+// Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
+vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
+
+// Subcommands.
+int cli_grow(int argc, char** argv);
+
+#endif

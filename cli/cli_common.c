@@ -1,0 +1,260 @@
+// SPDX-License-Identifier: MIT
+// Shared pieces of the verdant command: exit codes, error reports, plant options, loading a
+// plant from an .lpy file or a plant file, the progress bar.
+#define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+int cli_exit_code(vd_status st) {
+  switch (st) {
+    case VD_OK: return EXIT_OK;
+    case VD_ERR_NOMEM: return EXIT_FAIL;
+    default: return EXIT_USAGE;  // syntax, unsupported, names, types, values, limits, formats, I/O on inputs
+  }
+}
+
+int cli_report(const char* cmd, const vd_error* err, vd_status st) {
+  char buf[1024];
+  if (err && err->status != VD_OK)
+    fprintf(stderr, "verdant %s: %s\n", cmd, vd_error_format(err, buf, sizeof buf));
+  else
+    fprintf(stderr, "verdant %s: %s\n", cmd, vd_status_str(st));
+  return cli_exit_code(st);
+}
+
+int cli_usage_error(const char* cmd, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  fprintf(stderr, "verdant %s: ", cmd);
+  vfprintf(stderr, fmt, ap);
+  fprintf(stderr, "\n(see 'verdant %s --help')\n", cmd);
+  va_end(ap);
+  return EXIT_USAGE;
+}
+
+double cli_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int cli_has_ext(const char* path, const char* ext) {
+  size_t n = strlen(path), e = strlen(ext);
+  return n >= e && strcasecmp(path + n - e, ext) == 0;
+}
+
+const char* cli_plant_help =
+    "  -n, --steps N         derivation steps (default: the file's `derivation length`)\n"
+    "      --seed S          random seed, as random.seed(S) before the axiom (default 0)\n"
+    "      --set NAME=VALUE  replace a global of the .lpy file (repeatable)\n"
+    "      --label ID=NAME   name a label id (repeatable; the file's LABELS come first)\n"
+    "      --max-modules N   largest L-string allowed (default 50000000)\n"
+    "      --no-progress     no progress bar (it shows only when stderr is a terminal)\n";
+
+void cli_plant_opts_init(cli_plant_opts* o) {
+  memset(o, 0, sizeof *o);
+  o->steps = -1;
+  o->seed = 0;
+  o->max_modules = 50000000;
+  o->progress = isatty(2);
+}
+
+// strict integer parsing: the whole text, within [lo, hi]
+static int parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out) {
+  if (!s || !*s) return 0;
+  char* end;
+  errno = 0;
+  long long v = strtoll(s, &end, 10);
+  if (errno || *end || v < lo || v > hi) return 0;
+  *out = v;
+  return 1;
+}
+
+int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int* i) {
+  const char* a = argv[*i];
+  const char* val = NULL;
+#define TAKE()                                                                                     \
+  do {                                                                                             \
+    if (*i + 1 >= argc) {                                                                          \
+      cli_usage_error(cmd, "%s needs a value", a);                                                 \
+      return -1;                                                                                   \
+    }                                                                                              \
+    val = argv[++*i];                                                                              \
+  } while (0)
+  int64_t v;
+  if (!strcmp(a, "-n") || !strcmp(a, "--steps")) {
+    TAKE();
+    if (!parse_i64(val, 0, 1000000000, &v)) {
+      cli_usage_error(cmd, "%s expects an integer >= 0, got '%s'", a, val);
+      return -1;
+    }
+    o->steps = (int)v;
+    return 1;
+  }
+  if (!strcmp(a, "--seed")) {
+    TAKE();
+    if (!parse_i64(val, 0, INT64_MAX, &v)) {
+      cli_usage_error(cmd, "--seed expects an integer >= 0, got '%s'", val);
+      return -1;
+    }
+    o->seed = (uint64_t)v;
+    return 1;
+  }
+  if (!strcmp(a, "--max-modules")) {
+    TAKE();
+    if (!parse_i64(val, 1, INT64_MAX / 64, &v)) {
+      cli_usage_error(cmd, "--max-modules expects an integer >= 1, got '%s'", val);
+      return -1;
+    }
+    o->max_modules = v;
+    return 1;
+  }
+  if (!strcmp(a, "--set") || !strcmp(a, "--label")) {
+    TAKE();
+    const char* eq = strchr(val, '=');
+    if (!eq || eq == val || !eq[1]) {
+      cli_usage_error(cmd, "%s expects %s, got '%s'", a, a[2] == 's' ? "NAME=VALUE" : "ID=NAME", val);
+      return -1;
+    }
+    if (a[2] == 's') {
+      if (o->nset == 64) {
+        cli_usage_error(cmd, "too many --set options (64 at most)");
+        return -1;
+      }
+      o->set[o->nset++] = val;
+    } else {
+      char idbuf[32];
+      size_t n = (size_t)(eq - val);
+      if (n >= sizeof idbuf || !parse_i64((memcpy(idbuf, val, n), idbuf[n] = 0, idbuf), 0, 65535, &v)) {
+        cli_usage_error(cmd, "--label expects ID=NAME with an integer ID in 0..65535, got '%s'", val);
+        return -1;
+      }
+      if (o->nlabel == 64) {
+        cli_usage_error(cmd, "too many --label options (64 at most)");
+        return -1;
+      }
+      o->label[o->nlabel++] = val;
+    }
+    return 1;
+  }
+  if (!strcmp(a, "--no-progress")) {
+    o->progress = 0;
+    return 1;
+  }
+#undef TAKE
+  return 0;
+}
+
+// progress bar on stderr: only when it is a terminal
+static int progress_cb(void* user, int step, int steps, int64_t modules) {
+  (void)user;
+  int w = 30, fill = steps > 0 ? (int)((double)step / steps * w) : w;
+  char bar[64];
+  for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
+  bar[w] = 0;
+  fprintf(stderr, "\rderiving [%s] step %d/%d, %lld modules", bar, step, steps, (long long)modules);
+  if (step == steps) fprintf(stderr, "\n");
+  fflush(stderr);
+  return 0;
+}
+
+vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
+  memset(info, 0, sizeof *info);
+  *out = NULL;
+  vd_status st;
+  if (cli_has_ext(o->path, ".json")) {
+    if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
+    st = vd_plant_read_json(o->path, out, err);
+    for (int i = 0; !st && i < o->nlabel; i++) {
+      const char* eq = strchr(o->label[i], '=');
+      st = vd_plant_set_label(*out, atoi(o->label[i]), eq + 1);
+    }
+    return st;
+  }
+  vd_lsystem* ls;
+  st = vd_lsys_load(o->path, &ls, err);
+  if (st) return st;
+  for (int i = 0; !st && i < o->nset; i++) {
+    char name[128];
+    const char* eq = strchr(o->set[i], '=');
+    size_t n = (size_t)(eq - o->set[i]);
+    if (n >= sizeof name) n = sizeof name - 1;
+    memcpy(name, o->set[i], n);
+    name[n] = 0;
+    st = vd_lsys_set_global(ls, name, eq + 1, err);
+  }
+  vd_plant_spec* plant = st ? NULL : vd_plant_spec_create();
+  if (!st && !plant) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
+  vd_lsys_def def = vd_lsys_def_default();
+  def.steps = o->steps;
+  def.seed = o->seed;
+  def.max_modules = o->max_modules;
+  if (o->progress) def.progress = progress_cb;
+  double t0 = cli_now();
+  if (!st) st = vd_lsys_derive(ls, &def, &derived, err);
+  double t1 = cli_now();
+  if (!st) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
+  if (!st) {
+    vd_turtle_def td = vd_turtle_def_default();
+    st = vd_turtle_run(ls, &geo, &td, plant, err);
+  }
+  double t2 = cli_now();
+  // label names: the file's LABELS, then --label
+  for (int i = 0; !st && i < vd_lsys_label_count(ls); i++) {
+    int id;
+    const char* name;
+    vd_lsys_label_get(ls, i, &id, &name);
+    st = vd_plant_set_label(plant, id, name);
+  }
+  for (int i = 0; !st && i < o->nlabel; i++) {
+    const char* eq = strchr(o->label[i], '=');
+    st = vd_plant_set_label(plant, atoi(o->label[i]), eq + 1);
+  }
+  if (!st) st = vd_plant_complete_labels(plant);
+  if (!st) {
+    // module counts by symbol for --stats
+    info->modules = derived.n;
+    info->nsym = vd_lsys_symbol_count(ls);
+    info->sym_count = vd_calloc((size_t)info->nsym, sizeof(int64_t));
+    info->sym_name = vd_calloc((size_t)info->nsym, sizeof(char*));
+    if (!info->sym_count || !info->sym_name) {
+      st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+    } else {
+      for (int64_t i = 0; i < derived.n; i++) info->sym_count[derived.sym[i]]++;
+      for (int k = 0; k < info->nsym && !st; k++) {
+        info->sym_name[k] = vd_strdup(vd_lsys_symbol_name(ls, k));
+        if (!info->sym_name[k]) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+      }
+    }
+    info->seconds_derive = t1 - t0;
+    info->seconds_turtle = t2 - t1;
+  }
+  vd_lstring_free(&derived);
+  vd_lstring_free(&geo);
+  vd_lsys_destroy(ls);
+  if (st) {
+    vd_plant_spec_destroy(plant);
+    cli_grow_info_free(info);
+    return st;
+  }
+  *out = plant;
+  return VD_OK;
+}
+
+void cli_grow_info_free(cli_grow_info* info) {
+  if (info->sym_name)
+    for (int k = 0; k < info->nsym; k++)
+      if (info->sym_name[k]) vd_free(info->sym_name[k], strlen(info->sym_name[k]) + 1);
+  vd_free(info->sym_name, sizeof(char*) * (size_t)info->nsym);
+  vd_free(info->sym_count, sizeof(int64_t) * (size_t)info->nsym);
+  memset(info, 0, sizeof *info);
+}

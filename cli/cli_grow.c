@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: MIT
+// verdant grow: L-system (or plant file) → plant JSON, OBJ or PLY, with --stats.
+#include <cjson/cJSON.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+static const char* grow_help =
+    "usage: verdant grow PLANT [-o OUT] [options]\n"
+    "\n"
+    "Grow a plant from an L-Py file (.lpy, derived on the fly) or read a plant file (.json),\n"
+    "and write it as plant JSON (.json) or a labelled mesh (.obj with .mtl, .ply).\n"
+    "\n"
+    "options:\n"
+    "  -o, --output OUT      output file; the extension picks the format: .json .obj .ply\n"
+    "      --ascii           write PLY as ASCII instead of binary little-endian\n"
+    "      --stats           print a JSON summary on stdout (modules, module_counts, segments,\n"
+    "                        spheres, leaves, labels, bbox_min, bbox_max (m), total_length (m))\n";
+
+static int cmp_u64(const void* a, const void* b) {
+  uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
+  return x < y ? -1 : x > y;
+}
+
+// number of distinct organ instances per label
+static cJSON* label_counts(const vd_plant_spec* p) {
+  size_t n = (size_t)p->nseg + (size_t)p->nsphere + (size_t)p->nmesh;
+  uint64_t* key = n ? vd_malloc(n * sizeof(uint64_t)) : NULL;
+  cJSON* obj = cJSON_CreateObject();
+  if ((n && !key) || !obj) {
+    vd_free(key, n * sizeof(uint64_t));
+    cJSON_Delete(obj);
+    return NULL;
+  }
+  size_t k = 0;
+  for (int i = 0; i < p->nseg; i++) key[k++] = ((uint64_t)(uint32_t)p->seg[i].label << 32) | (uint32_t)p->seg[i].instance;
+  for (int i = 0; i < p->nsphere; i++)
+    key[k++] = ((uint64_t)(uint32_t)p->sphere[i].label << 32) | (uint32_t)p->sphere[i].instance;
+  for (int i = 0; i < p->nmesh; i++) key[k++] = ((uint64_t)(uint32_t)p->mesh[i].label << 32) | (uint32_t)p->mesh[i].instance;
+  if (n) qsort(key, n, sizeof(uint64_t), cmp_u64);
+  // every label of the table appears, with 0 when nothing carries it
+  for (int l = 0; l < p->nlabel; l++) {
+    int count = 0;
+    for (size_t i = 0; i < n; i++)
+      if ((int)(key[i] >> 32) == p->label[l].id && (i == 0 || key[i] != key[i - 1])) count++;
+    cJSON_AddNumberToObject(obj, p->label[l].name, count);
+  }
+  vd_free(key, n * sizeof(uint64_t));
+  return obj;
+}
+
+static cJSON* vec_json(vd_vec3 v) {
+  double a[3] = {v.x, v.y, v.z};
+  return cJSON_CreateDoubleArray(a, 3);
+}
+
+static int print_stats(const vd_plant_spec* p, const cli_grow_info* info) {
+  cJSON* root = cJSON_CreateObject();
+  if (!root) return 0;
+  vd_plant_stats ps;
+  vd_plant_spec_stats(p, &ps);
+  cJSON_AddNumberToObject(root, "modules", (double)info->modules);
+  cJSON* mc = cJSON_AddObjectToObject(root, "module_counts");
+  for (int k = 0; k < info->nsym; k++)
+    if (info->sym_count[k]) cJSON_AddNumberToObject(mc, info->sym_name[k], (double)info->sym_count[k]);
+  cJSON_AddNumberToObject(root, "nodes", p->nnode);
+  cJSON_AddNumberToObject(root, "segments", ps.nseg);
+  cJSON_AddNumberToObject(root, "spheres", ps.nsphere);
+  cJSON_AddNumberToObject(root, "leaves", ps.nleaf);
+  cJSON_AddNumberToObject(root, "meshes", p->nmesh);
+  cJSON_AddNumberToObject(root, "instances", p->ninstance);
+  cJSON* labels = label_counts(p);
+  if (labels) cJSON_AddItemToObject(root, "labels", labels);
+  cJSON_AddItemToObject(root, "bbox_min", vec_json(ps.bbox_min));
+  cJSON_AddItemToObject(root, "bbox_max", vec_json(ps.bbox_max));
+  cJSON_AddNumberToObject(root, "total_length", ps.total_length);
+  cJSON* t = cJSON_AddObjectToObject(root, "seconds");
+  cJSON_AddNumberToObject(t, "derive", info->seconds_derive);
+  cJSON_AddNumberToObject(t, "turtle", info->seconds_turtle);
+  char* text = cJSON_Print(root);
+  int ok = text != NULL;
+  if (text) {
+    fputs(text, stdout);
+    fputc('\n', stdout);
+    cJSON_free(text);
+  }
+  cJSON_Delete(root);
+  return ok;
+}
+
+int cli_grow(int argc, char** argv) {
+  cli_plant_opts po;
+  cli_plant_opts_init(&po);
+  const char* out = NULL;
+  int stats = 0, ascii = 0;
+  for (int i = 1; i < argc; i++) {
+    const char* a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      fputs(grow_help, stdout);
+      fputs(cli_plant_help, stdout);
+      return EXIT_OK;
+    }
+    int r = cli_plant_opt(&po, "grow", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      if (i + 1 >= argc) return cli_usage_error("grow", "%s needs a file name", a);
+      out = argv[++i];
+    } else if (!strcmp(a, "--stats")) {
+      stats = 1;
+    } else if (!strcmp(a, "--ascii")) {
+      ascii = 1;
+    } else if (a[0] == '-' && a[1]) {
+      return cli_usage_error("grow", "unknown option '%s'", a);
+    } else if (!po.path) {
+      po.path = a;
+    } else {
+      return cli_usage_error("grow", "unexpected argument '%s'", a);
+    }
+  }
+  if (!po.path) return cli_usage_error("grow", "missing PLANT (an .lpy or plant .json file)");
+  if (!out && !stats) return cli_usage_error("grow", "nothing to do: give -o OUT and/or --stats");
+  if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
+    return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
+  vd_error err = {0};
+  vd_plant_spec* plant;
+  cli_grow_info info;
+  vd_status st = cli_load_plant(&po, &plant, &info, &err);
+  if (st) return cli_report("grow", &err, st);
+  if (out) st = cli_write_plant(plant, out, ascii, &err);
+  if (!st && stats && !print_stats(plant, &info)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_plant_spec_destroy(plant);
+  cli_grow_info_free(&info);
+  if (st) {
+    int code = cli_report("grow", &err, st);
+    return st == VD_ERR_IO ? EXIT_FAIL : code;  // failing to write the output is a failed run
+  }
+  return EXIT_OK;
+}
