@@ -45,6 +45,11 @@ typedef struct jw {
 
 // shortest of %.15g, %.16g, %.17g that reads back to the same double
 static void fmt_double(char* buf, size_t cap, double v) {
+  // integral values below 1e15 print the same digits as %.15g, without the search
+  if (v == floor(v) && fabs(v) < 1e15 && !(v == 0 && signbit(v))) {
+    snprintf(buf, cap, "%lld", (long long)v);
+    return;
+  }
   for (int prec = 15; prec <= 17; prec++) {
     snprintf(buf, cap, "%.*g", prec, v);
     if (prec == 17 || strtod(buf, NULL) == v) return;
