@@ -3,7 +3,20 @@
 #include "cli.h"
 
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
-  (void)ascii;
   if (cli_has_ext(path, ".json")) return vd_plant_write_json(plant, path, err);
-  return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "mesh output is not available in this build");
+  // meshes: compile, tessellate the rest shape, write with the label table
+  vd_model* m = NULL;
+  vd_status st = vd_plant_compile(plant, &m, err);
+  if (st) return st;
+  vd_mesh mesh;
+  st = vd_geom_tessellate(m, NULL, NULL, &mesh, err);
+  if (!st) {
+    if (cli_has_ext(path, ".obj"))
+      st = vd_geom_write_obj(&mesh, m->labels, m->nlabel, path, err);
+    else
+      st = vd_geom_write_ply(&mesh, m->labels, m->nlabel, path, !ascii, err);
+    vd_mesh_free(&mesh);
+  }
+  vd_model_destroy(m);
+  return st;
 }

@@ -140,6 +140,9 @@ vd_status vd_plant_set_label(vd_plant_spec* s, int id, const char* name);
 const vd_label* vd_plant_find_label(const vd_plant_spec* s, int id);
 // Make sure every label id used by an element has a table entry (default name "label_<id>").
 vd_status vd_plant_complete_labels(vd_plant_spec* s);
+// Default display colour of a label id: a fixed palette for 0..6 (grey, brown, green, red,
+// yellow, blue, purple), then a colour hashed from the id.
+void vd_plant_default_rgb(int id, float rgb[3]);
 
 // Summary of a plant for --stats.
 typedef struct vd_plant_stats {

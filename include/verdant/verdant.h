@@ -16,5 +16,6 @@
 #include "verdant/core.h"
 #include "verdant/plant.h"
 #include "verdant/lsys.h"
+#include "verdant/geom.h"
 
 #endif
