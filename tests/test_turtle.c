@@ -20,7 +20,7 @@ static const char* const names[] = {
 // module and value capacities of a test string (kept beside it; freed by lfree)
 typedef struct {
   vd_lstring s;
-  int64_t scap;  // capacity of src, 0 if none
+  int64_t scap; // capacity of src, 0 if none
 } lbuf;
 
 static void lpush(lbuf* b, int sym, const double* v, int nv) {
@@ -37,12 +37,14 @@ static void lpush(lbuf* b, int sym, const double* v, int nv) {
   int64_t nval = s->par[s->n];
   if (nval + nv > s->vcap) {
     int64_t nc = s->vcap ? 2 * s->vcap : 16;
-    while (nc < nval + nv) nc *= 2;
+    while (nc < nval + nv)
+      nc *= 2;
     s->val = vd_realloc(s->val, (size_t)s->vcap * sizeof *s->val, (size_t)nc * sizeof *s->val);
     s->vcap = nc;
     if (!s->val) abort();
   }
-  for (int k = 0; k < nv; k++) s->val[nval + k] = v[k];
+  for (int k = 0; k < nv; k++)
+    s->val[nval + k] = v[k];
   s->sym[s->n] = sym;
   s->par[s->n + 1] = nval + nv;
   s->n++;
@@ -75,7 +77,8 @@ static void ladd(lbuf* b, const char* text) {
         char* end;
         v[nv++] = strtod(c, &end);
         c = end;
-        while (*c == ' ' || *c == ',') c++;
+        while (*c == ' ' || *c == ',')
+          c++;
       }
       if (*c == ')') c++;
     }
@@ -110,7 +113,9 @@ static vd_status run_def(const char* text, const vd_turtle_def* def, vd_plant_sp
   return st;
 }
 
-static vd_status run(const char* text, vd_plant_spec** out) { return run_def(text, NULL, out); }
+static vd_status run(const char* text, vd_plant_spec** out) {
+  return run_def(text, NULL, out);
+}
 
 // status of a run whose plant is thrown away
 static vd_status status_of(const char* text) {
@@ -129,8 +134,12 @@ static vd_status status_of(const char* text) {
     CHECK_NEAR(v_.z, (Z), TOL);                                                                    \
   } while (0)
 
-static vd_vec3 seg_a(const vd_plant_spec* P, int k) { return P->node[P->seg[k].node0]; }
-static vd_vec3 seg_b(const vd_plant_spec* P, int k) { return P->node[P->seg[k].node1]; }
+static vd_vec3 seg_a(const vd_plant_spec* P, int k) {
+  return P->node[P->seg[k].node0];
+}
+static vd_vec3 seg_b(const vd_plant_spec* P, int k) {
+  return P->node[P->seg[k].node1];
+}
 static vd_vec3 mvert(const vd_plant_spec* P, int m, int j) {
   return P->vert[P->mesh[m].vert_start + j];
 }
@@ -168,8 +177,8 @@ TEST(turtle, single_F) {
   CHECK_INT(P->nnode, 2);
   const vd_segment_spec* g = &P->seg[0];
   CHECK_V3(seg_a(P, 0), 0, 0, 0);
-  CHECK_V3(seg_b(P, 0), 0, 0, 1);  // heading +Z
-  CHECK_V3(g->up, 1, 0, 0);        // up +X
+  CHECK_V3(seg_b(P, 0), 0, 0, 1); // heading +Z
+  CHECK_V3(g->up, 1, 0, 0);       // up +X
   CHECK_NEAR(g->r0, 0.1, TOL);
   CHECK_NEAR(g->r1, 0.1, TOL);
   CHECK_INT(g->parent, -1);
@@ -211,14 +220,14 @@ TEST(turtle, rotations_match_rodrigues) {
   // an independent frame: rotate (H, L, U) about the current axes with vd_rotate
   vd_vec3 H = vd_v3(0, 0, 1), L = vd_v3(0, -1, 0), U = vd_v3(1, 0, 0), pos = vd_v3(0, 0, 0);
   double d = VD_PI / 180;
-  H = vd_rotate(H, U, 30 * d), L = vd_rotate(L, U, 30 * d);    // +(30)
-  pos = vd_add(pos, H);                                        // F
-  vd_vec3 h2 = vd_rotate(H, L, 45 * d), u2 = vd_rotate(U, L, 45 * d);  // &(45)
+  H = vd_rotate(H, U, 30 * d), L = vd_rotate(L, U, 30 * d);           // +(30)
+  pos = vd_add(pos, H);                                               // F
+  vd_vec3 h2 = vd_rotate(H, L, 45 * d), u2 = vd_rotate(U, L, 45 * d); // &(45)
   H = h2, U = u2;
-  vd_vec3 l3 = vd_rotate(L, H, 60 * d), u3 = vd_rotate(U, H, 60 * d);  // /(60)
+  vd_vec3 l3 = vd_rotate(L, H, 60 * d), u3 = vd_rotate(U, H, 60 * d); // /(60)
   L = l3, U = u3;
-  H = vd_rotate(H, U, -20 * d), L = vd_rotate(L, U, -20 * d);  // -(20)
-  pos = vd_add(pos, vd_scale(H, 2));                           // F(2)
+  H = vd_rotate(H, U, -20 * d), L = vd_rotate(L, U, -20 * d); // -(20)
+  pos = vd_add(pos, vd_scale(H, 2));                          // F(2)
   vd_plant_spec* P;
   REQUIRE(run("+(30) F &(45) /(60) -(20) F(2)", &P) == VD_OK);
   CHECK_V3(seg_b(P, 1), pos.x, pos.y, pos.z);
@@ -229,7 +238,8 @@ TEST(turtle, rotations_match_rodrigues) {
 TEST(turtle, frame_stays_orthonormal) {
   // 20000 small turns, pitches and rolls: the frame is re-orthonormalised as it goes
   lbuf b = {0};
-  for (int k = 0; k < 5000; k++) ladd(&b, "+(7.3) &(3.1) /(11.7) F(0.01)");
+  for (int k = 0; k < 5000; k++)
+    ladd(&b, "+(7.3) &(3.1) /(11.7) F(0.01)");
   vd_plant_spec* P = vd_plant_spec_create();
   REQUIRE(vd_turtle_run(NULL, &b.s, NULL, P, NULL) == VD_OK);
   for (int k = 0; k < P->nseg; k += 499) {
@@ -257,7 +267,7 @@ TEST(turtle, euler_and_sethead) {
   CHECK_V3(seg_b(P, 0), 1, 0, 0);
   CHECK_V3(P->seg[0].up, 0, 0, 1);
   vd_plant_spec_destroy(P);
-  REQUIRE(run("@R(0,2,0, 1,1,1) F", &P) == VD_OK);  // up re-orthogonalised against H
+  REQUIRE(run("@R(0,2,0, 1,1,1) F", &P) == VD_OK); // up re-orthogonalised against H
   CHECK_V3(seg_b(P, 0), 0, 1, 0);
   CHECK_V3(P->seg[0].up, sqrt(0.5), 0, sqrt(0.5));
   vd_plant_spec_destroy(P);
@@ -287,20 +297,21 @@ TEST(turtle, frustum_top_radius) {
   CHECK_NEAR(P->seg[0].r0, 0.1, TOL);
   CHECK_NEAR(P->seg[0].r1, 0.05, TOL);
   CHECK_V3(seg_b(P, 0), 0, 0, 2);
-  CHECK_NEAR(P->seg[1].r0, 0.05, TOL);  // width carried on
+  CHECK_NEAR(P->seg[1].r0, 0.05, TOL); // width carried on
   CHECK_NEAR(P->seg[1].r1, 0.05, TOL);
-  CHECK_NEAR(P->seg[2].r1, 0, TOL);  // a cone
+  CHECK_NEAR(P->seg[2].r1, 0, TOL); // a cone
   CHECK_NEAR(P->seg[3].r0, 0, TOL);
-  CHECK_NEAR(P->seg[4].r1, 0, TOL);  // negative top radius = none
+  CHECK_NEAR(P->seg[4].r1, 0, TOL); // negative top radius = none
   vd_plant_spec_destroy(P);
 }
 
 TEST(turtle, width_commands) {
   vd_plant_spec* P;
   REQUIRE(run("F _ F ! F _(0.3) F !(0.2) F SetWidth(0.4) F ! F", &P) == VD_OK);
-  static const double r[7] = {0.1, 1.1, 0.1, 0.3, 0.2, 0.4, 0.4};  // last ! would go negative
+  static const double r[7] = {0.1, 1.1, 0.1, 0.3, 0.2, 0.4, 0.4}; // last ! would go negative
   REQUIRE(P->nseg == 7);
-  for (int k = 0; k < 7; k++) CHECK_NEAR(P->seg[k].r0, r[k], TOL);
+  for (int k = 0; k < 7; k++)
+    CHECK_NEAR(P->seg[k].r0, r[k], TOL);
   vd_plant_spec_destroy(P);
   vd_turtle_def d = vd_turtle_def_default();
   d.width = 0.5;
@@ -313,11 +324,11 @@ TEST(turtle, width_commands) {
 
 TEST(turtle, colours_are_labels) {
   vd_plant_spec* P;
-  REQUIRE(run("F ; F ;(5) F , F SetColor(2) F SetColor(10,20,30) F , , , F ;(3.9) F", &P) ==
-          VD_OK);
+  REQUIRE(run("F ; F ;(5) F , F SetColor(2) F SetColor(10,20,30) F , , , F ;(3.9) F", &P) == VD_OK);
   static const int lab[8] = {1, 2, 5, 4, 2, 2, 0, 3};
   REQUIRE(P->nseg == 8);
-  for (int k = 0; k < 8; k++) CHECK_INT(P->seg[k].label, lab[k]);
+  for (int k = 0; k < 8; k++)
+    CHECK_INT(P->seg[k].label, lab[k]);
   vd_plant_spec_destroy(P);
   // the colour is part of the branch state
   REQUIRE(run("F [ ;(4) F ] F", &P) == VD_OK);
@@ -332,7 +343,7 @@ TEST(turtle, explicit_trailing_label) {
           VD_OK);
   CHECK_INT(P->seg[0].label, 7);
   CHECK_NEAR(P->seg[0].r1, 0.2, TOL);
-  CHECK_INT(P->seg[1].label, 1);  // only for that primitive
+  CHECK_INT(P->seg[1].label, 1); // only for that primitive
   CHECK_NEAR(P->seg[1].r0, 0.2, TOL);
   CHECK_INT(P->sphere[0].label, 3);
   CHECK_NEAR(P->sphere[0].radius, 0.3, TOL);
@@ -390,7 +401,8 @@ TEST(turtle, instances_many_unordered) {
   vd_plant_spec* P = vd_plant_spec_create();
   REQUIRE(vd_turtle_run(NULL, &b.s, NULL, P, NULL) == VD_OK);
   REQUIRE(P->nseg == n);
-  for (int k = 0; k < n; k++) CHECK_INT(P->seg[k].instance, k % 1000 + 1);
+  for (int k = 0; k < n; k++)
+    CHECK_INT(P->seg[k].instance, k % 1000 + 1);
   CHECK_INT(P->ninstance, 1000);
   vd_plant_spec_destroy(P);
   vd_free(src, (size_t)n * sizeof *src);
@@ -428,7 +440,7 @@ TEST(turtle, nodes_shared_along_axis) {
   CHECK(P->seg[1].node0 != P->seg[0].node1);
   CHECK_V3(seg_a(P, 1), 0, 0, 2);
   CHECK_INT(P->seg[1].parent, 0);
-  CHECK_INT(P->seg[2].node0, P->seg[1].node1);  // rotations keep the node
+  CHECK_INT(P->seg[2].node0, P->seg[1].node1); // rotations keep the node
   vd_plant_spec_destroy(P);
   REQUIRE(run("F MoveRel(0,3,0) F", &P) == VD_OK);
   CHECK_INT(P->nnode, 4);
@@ -494,7 +506,7 @@ TEST(turtle, sphere) {
   CHECK_INT(P->sphere[0].node, -1);
   CHECK_INT(P->sphere[0].parent, -1);
   CHECK_V3(P->sphere[1].center, 0, 0, 1);
-  CHECK_NEAR(P->sphere[1].radius, 0.1, TOL);  // default: the width
+  CHECK_NEAR(P->sphere[1].radius, 0.1, TOL); // default: the width
   CHECK_INT(P->sphere[1].node, P->seg[0].node1);
   CHECK_INT(P->sphere[1].parent, 0);
   CHECK_INT(P->sphere[1].label, 1);
@@ -568,13 +580,13 @@ TEST(turtle, quad) {
   REQUIRE(P->nmesh == 1);
   CHECK_INT(P->mesh[0].nvert, 4);
   CHECK_INT(P->mesh[0].ntri, 2);
-  CHECK_V3(mvert(P, 0, 0), 0, -0.1, 0);  // base + width L
+  CHECK_V3(mvert(P, 0, 0), 0, -0.1, 0); // base + width L
   CHECK_V3(mvert(P, 0, 1), 0, 0.1, 0);
   CHECK_V3(mvert(P, 0, 2), 0, 0.1, 1);
   CHECK_V3(mvert(P, 0, 3), 0, -0.1, 1);
   CHECK(mnormal(P, 0, 0).x > 0 && mnormal(P, 0, 1).x > 0);
   vd_plant_spec_destroy(P);
-  REQUIRE(run("@b(1, 0)", &P) == VD_OK);  // a triangle when the top radius is 0
+  REQUIRE(run("@b(1, 0)", &P) == VD_OK); // a triangle when the top radius is 0
   CHECK_INT(P->mesh[0].nvert, 3);
   CHECK_INT(P->mesh[0].ntri, 1);
   vd_plant_spec_destroy(P);
@@ -584,18 +596,22 @@ TEST(turtle, leaf_hexagon) {
   vd_plant_spec* P;
   REQUIRE(run("~l F @D(2) ~l(0.5) /(90) ~l", &P) == VD_OK);
   REQUIRE(P->nmesh == 3);
-  static const double v[7][3] = {{0, 0, 0.5},        {0, 0, 0},         {0, -0.25, 1.0 / 3},
-                                 {0, -0.25, 2.0 / 3}, {0, 0, 1},         {0, 0.25, 2.0 / 3},
+  static const double v[7][3] = {{0, 0, 0.5},         {0, 0, 0}, {0, -0.25, 1.0 / 3},
+                                 {0, -0.25, 2.0 / 3}, {0, 0, 1}, {0, 0.25, 2.0 / 3},
                                  {0, 0.25, 1.0 / 3}};
   static const int t[18] = {0, 2, 1, 0, 3, 2, 0, 4, 3, 0, 5, 4, 0, 6, 5, 0, 1, 6};
   CHECK_INT(P->mesh[0].nvert, 7);
   CHECK_INT(P->mesh[0].ntri, 6);
   CHECK_INT(P->mesh[0].closed, 0);
-  for (int j = 0; j < 7; j++) CHECK_V3(mvert(P, 0, j), v[j][0], v[j][1], v[j][2]);
-  for (int j = 0; j < 18; j++) CHECK_INT(P->tri[3 * P->mesh[0].tri_start + j] - P->mesh[0].vert_start, t[j]);
-  for (int j = 0; j < 6; j++) CHECK(mnormal(P, 0, j).x > 0);  // faces along U
+  for (int j = 0; j < 7; j++)
+    CHECK_V3(mvert(P, 0, j), v[j][0], v[j][1], v[j][2]);
+  for (int j = 0; j < 18; j++)
+    CHECK_INT(P->tri[3 * P->mesh[0].tri_start + j] - P->mesh[0].vert_start, t[j]);
+  for (int j = 0; j < 6; j++)
+    CHECK(mnormal(P, 0, j).x > 0); // faces along U
   // scale x parameter: the same leaf, at the top of the F
-  for (int j = 0; j < 7; j++) CHECK_V3(mvert(P, 1, j), v[j][0], v[j][1], v[j][2] + 1);
+  for (int j = 0; j < 7; j++)
+    CHECK_V3(mvert(P, 1, j), v[j][0], v[j][1], v[j][2] + 1);
   // after a roll L = +X (scale 2)
   CHECK_V3(mvert(P, 2, 2), 0.5, 0, 1 + 2.0 / 3);
   CHECK_INT(P->mesh[1].parent, 0);
@@ -630,7 +646,7 @@ TEST(turtle, polygon_points) {
   CHECK_INT(P->mesh[0].nvert, 4);
   CHECK_INT(P->mesh[0].label, 3);
   CHECK_INT(P->seg[0].instance, 1);
-  CHECK_INT(P->mesh[0].instance, 5);  // module 0 (the {) drew last
+  CHECK_INT(P->mesh[0].instance, 5); // module 0 (the {) drew last
   vd_plant_spec_destroy(P);
   // fewer than three points: nothing
   REQUIRE(run("{ . f . } { f f }", &P) == VD_OK);
@@ -655,8 +671,10 @@ TEST(turtle, polygon_concave) {
       signed_area += 0.5 * nrm.x;
     }
     CHECK_NEAR(fabs(signed_area), 3, TOL);
-    if (concave) CHECK_NEAR(area, 3, TOL);  // ear clipping: no overlap
-    else CHECK(area > 3 + 0.1);             // the plain fan overlaps (as PlantGL's default)
+    if (concave)
+      CHECK_NEAR(area, 3, TOL); // ear clipping: no overlap
+    else
+      CHECK(area > 3 + 0.1); // the plain fan overlaps (as PlantGL's default)
     vd_plant_spec_destroy(P);
   }
 }
@@ -666,7 +684,8 @@ TEST(turtle, generalized_cylinder_flags) {
   REQUIRE(run("F @Gc F F [ F ] F @Ge F", &P) == VD_OK);
   REQUIRE(P->nseg == 6);
   static const unsigned gc[6] = {0, 0, VD_SEG_GC, VD_SEG_GC, VD_SEG_GC, 0};
-  for (int k = 0; k < 6; k++) CHECK_INT(P->seg[k].flags & VD_SEG_GC, gc[k]);
+  for (int k = 0; k < 6; k++)
+    CHECK_INT(P->seg[k].flags & VD_SEG_GC, gc[k]);
   vd_plant_spec_destroy(P);
 }
 
@@ -678,11 +697,11 @@ TEST(turtle, scale) {
   REQUIRE(run("@D(2) F f F @Di F @Dd @Dd F @Di(0.25) F @O", &P) == VD_OK);
   CHECK_V3(seg_b(P, 0), 0, 0, 2);
   CHECK_NEAR(P->seg[0].r0, 0.2, TOL);
-  CHECK_V3(seg_a(P, 1), 0, 0, 4);  // f scaled too
+  CHECK_V3(seg_a(P, 1), 0, 0, 4); // f scaled too
   CHECK_V3(seg_b(P, 1), 0, 0, 6);
   CHECK_V3(seg_b(P, 2), 0, 0, 7);  // x 0.5
-  CHECK_V3(seg_b(P, 3), 0, 0, 11);  // / 0.5 / 0.5
-  CHECK_V3(seg_b(P, 4), 0, 0, 12);  // x 0.25
+  CHECK_V3(seg_b(P, 3), 0, 0, 11); // / 0.5 / 0.5
+  CHECK_V3(seg_b(P, 4), 0, 0, 12); // x 0.25
   CHECK_NEAR(P->seg[4].r0, 0.1, TOL);
   CHECK_NEAR(P->sphere[0].radius, 0.1, TOL);
   vd_plant_spec_destroy(P);
@@ -718,7 +737,7 @@ TEST(turtle, tropism_rule) {
 
 TEST(turtle, move_pinpoint_lineto) {
   CHECK_V3(end_of("@M(1,2,3) F"), 1, 2, 4);
-  CHECK_V3(end_of("F @M(5) F"), 5, 0, 2);  // missing coordinates keep their value
+  CHECK_V3(end_of("F @M(5) F"), 5, 0, 2); // missing coordinates keep their value
   CHECK_V3(end_of("Pinpoint(0,3,4) F"), 0, 0.6, 0.8);
   CHECK_V3(end_of("@M(0,0,1) PinpointRel(1,0,0) F"), 1, 0, 1);
   vd_plant_spec* P;
@@ -747,7 +766,7 @@ TEST(turtle, nF_chain) {
   CHECK_INT(P->seg[1].node0, P->seg[0].node1);
   CHECK_INT(P->seg[2].instance, 1);
   vd_plant_spec_destroy(P);
-  REQUIRE(run("nF(2, 1, 0.3)", &P) == VD_OK);  // radius 0.1 -> 0.3 linearly
+  REQUIRE(run("nF(2, 1, 0.3)", &P) == VD_OK); // radius 0.1 -> 0.3 linearly
   REQUIRE(P->nseg == 2);
   CHECK_NEAR(P->seg[0].r0, 0.1, TOL);
   CHECK_NEAR(P->seg[0].r1, 0.2, TOL);
@@ -762,7 +781,7 @@ TEST(turtle, negative_length) {
   REQUIRE(run("F(-1) F", &P) == VD_OK);
   CHECK_V3(seg_b(P, 0), 0, 0, -1);
   CHECK_V3(P->seg[0].up, 1, 0, 0);
-  CHECK_V3(seg_b(P, 1), 0, 0, 0);  // the frame is restored after drawing
+  CHECK_V3(seg_b(P, 1), 0, 0, 0); // the frame is restored after drawing
   vd_plant_spec_destroy(P);
   CHECK_V3(end_of("f(-2) F"), 0, 0, -1);
 }
@@ -820,9 +839,11 @@ static void* failing_realloc(void* user, void* ptr, size_t old_size, size_t new_
 TEST(turtle, out_of_memory) {
   // every failure point returns VD_ERR_NOMEM and leaks nothing; the last budget succeeds
   lbuf b = {0};
-  for (int k = 0; k < 40; k++) ladd(&b, "F [ +F @O ~l ] { . f . +(90) f . } @B(0.1) [ [ F ] ");
+  for (int k = 0; k < 40; k++)
+    ladd(&b, "F [ +F @O ~l ] { . f . +(90) f . } @B(0.1) [ [ F ] ");
   int64_t* src = vd_malloc((size_t)b.s.n * sizeof *src);
-  for (int64_t k = 0; k < b.s.n; k++) src[k] = (k * 37) % b.s.n;
+  for (int64_t k = 0; k < b.s.n; k++)
+    src[k] = (k * 37) % b.s.n;
   lsrc(&b, src);
   vd_free(src, (size_t)b.s.n * sizeof *src);
   int ok = 0;
@@ -833,8 +854,10 @@ TEST(turtle, out_of_memory) {
     vd_set_allocator(failing_realloc, NULL);
     vd_status st = vd_turtle_run(NULL, &b.s, NULL, P, NULL);
     vd_set_allocator(NULL, NULL);
-    if (st == VD_OK) ok = 1;
-    else CHECK_INT(st, VD_ERR_NOMEM);
+    if (st == VD_OK)
+      ok = 1;
+    else
+      CHECK_INT(st, VD_ERR_NOMEM);
     vd_plant_spec_destroy(P);
   }
   CHECK(ok);

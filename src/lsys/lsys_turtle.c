@@ -14,11 +14,11 @@
 
 #include "verdant/lsys.h"
 
-#define EPS 1e-10                 // lengths and radii below this draw nothing (m)
-#define NF_MAX_STEPS 100000000.0  // nF refuses to draw more segments than this in one module
-#define SLICES_MIN 3              // SectionResolution bounds
+#define EPS 1e-10                // lengths and radii below this draw nothing (m)
+#define NF_MAX_STEPS 100000000.0 // nF refuses to draw more segments than this in one module
+#define SLICES_MIN 3             // SectionResolution bounds
 #define SLICES_MAX 1024
-#define REORTHO_EVERY 64          // re-orthonormalise the frame after this many rotations
+#define REORTHO_EVERY 64 // re-orthonormalise the frame after this many rotations
 
 // predefined symbol names, for messages when no lsystem is at hand
 static const char* const sym_names[] = {
@@ -29,68 +29,68 @@ static const char* const sym_names[] = {
 
 // What [ pushes and ] pops: the whole drawing state of one path.
 typedef struct tstate {
-  vd_vec3 pos;        // position (m)
-  vd_vec3 h, l, u;    // heading, left, up: orthonormal, H = L x U
-  double width;       // current radius before scaling (m)
-  double scale;       // uniform turtle scale (@D, @Di, @Dd)
-  double age;         // age written on segments (SetAge)
-  vd_vec3 tropism;    // unit tropism direction, or 0 for none
-  double elasticity;  // tropism strength in [0, 1]
-  int color;          // material index = semantic label
-  int slices;         // section resolution of segments, spheres and discs
-  int node;           // plant node at pos, -1 after a move without drawing
-  int parent;         // last segment drawn on this path, -1 at the root
-  int axis, order;    // axis id and branching order of the segments drawn next
-  int pending;        // 1 inside a [ that has not drawn a segment yet (axis not created)
-  int tail;           // last segment drawn on this state's own axis, -1 if none
-  int gc;             // 1 between @Gc and @Ge
-  int gc_prev;        // last segment of the current generalised cylinder, -1 if none
-  int polygon;        // 1 between { and }
+  vd_vec3 pos;       // position (m)
+  vd_vec3 h, l, u;   // heading, left, up: orthonormal, H = L x U
+  double width;      // current radius before scaling (m)
+  double scale;      // uniform turtle scale (@D, @Di, @Dd)
+  double age;        // age written on segments (SetAge)
+  vd_vec3 tropism;   // unit tropism direction, or 0 for none
+  double elasticity; // tropism strength in [0, 1]
+  int color;         // material index = semantic label
+  int slices;        // section resolution of segments, spheres and discs
+  int node;          // plant node at pos, -1 after a move without drawing
+  int parent;        // last segment drawn on this path, -1 at the root
+  int axis, order;   // axis id and branching order of the segments drawn next
+  int pending;       // 1 inside a [ that has not drawn a segment yet (axis not created)
+  int tail;          // last segment drawn on this state's own axis, -1 if none
+  int gc;            // 1 between @Gc and @Ge
+  int gc_prev;       // last segment of the current generalised cylinder, -1 if none
+  int polygon;       // 1 between { and }
 } tstate;
 
 // One run of the turtle over one L-string.
 typedef struct turtle {
-  const vd_lsystem* ls;  // Nullable: names and strings
-  const vd_lstring* s;   // the string being read
-  vd_turtle_def def;     // settings
-  vd_plant_spec* plant;  // output
-  vd_error* err;         // Nullable: error record
-  tstate t;              // current state
-  tstate* stack;         // saved states ([ ... ]) (nstack)
+  const vd_lsystem* ls; // Nullable: names and strings
+  const vd_lstring* s;  // the string being read
+  vd_turtle_def def;    // settings
+  vd_plant_spec* plant; // output
+  vd_error* err;        // Nullable: error record
+  tstate t;             // current state
+  tstate* stack;        // saved states ([ ... ]) (nstack)
   int nstack, cap_stack;
-  int next_axis;         // id of the next axis created
-  int nrot;              // rotations since the frame was last re-orthonormalised
+  int next_axis; // id of the next axis created
+  int nrot;      // rotations since the frame was last re-orthonormalised
   // the module being interpreted
-  int64_t i;        // index in s
-  int sym;          // its symbol
-  const double* p;  // its parameters (np)
+  int64_t i;       // index in s
+  int sym;         // its symbol
+  const double* p; // its parameters (np)
   int np;
   // instance numbering: module -> 1..K in order of first drawing
-  int ninst;             // last instance id handed out
-  int64_t last_module;   // module of the last lookup
-  int last_instance;     // its instance id
-  int64_t max_module;    // largest module seen so far
-  int hashed;            // 1 once modules stopped arriving in increasing order
-  int64_t* hkey;         // open-addressing table: module, -1 = empty (hcap)
-  int* hval;             // instance of each key (hcap)
+  int ninst;           // last instance id handed out
+  int64_t last_module; // module of the last lookup
+  int last_instance;   // its instance id
+  int64_t max_module;  // largest module seen so far
+  int hashed;          // 1 once modules stopped arriving in increasing order
+  int64_t* hkey;       // open-addressing table: module, -1 = empty (hcap)
+  int* hval;           // instance of each key (hcap)
   int64_t hcap, hcount;
-  int seg0, sphere0, mesh0;  // first elements of this run in the plant
+  int seg0, sphere0, mesh0; // first elements of this run in the plant
   // polygon being recorded ({ . })
-  vd_vec3* poly;          // recorded points (m) (npoly)
+  vd_vec3* poly; // recorded points (m) (npoly)
   int npoly, cap_poly;
-  int poly_label;         // label of the polygon (colour at {, or set inside)
-  int64_t poly_module;    // module of the {
+  int poly_label;      // label of the polygon (colour at {, or set inside)
+  int64_t poly_module; // module of the {
   int poly_node, poly_parent;
   // scratch for meshes
-  vd_vec3* vbuf;  // vertices (cap_vbuf)
+  vd_vec3* vbuf; // vertices (cap_vbuf)
   int cap_vbuf;
-  int* tbuf;      // triangle indices (cap_tbuf ints)
+  int* tbuf; // triangle indices (cap_tbuf ints)
   int cap_tbuf;
-  int* ibuf;      // ear-clipping index list (cap_ibuf)
+  int* ibuf; // ear-clipping index list (cap_ibuf)
   int cap_ibuf;
   // cached sine and cosine of the last angle (degrees)
   double c_deg, c_sin, c_cos;
-  int warned_guide, warned_width, warned_color;  // warnings already logged once
+  int warned_guide, warned_width, warned_color; // warnings already logged once
 } turtle;
 
 // ---------------------------------------------------------------------------------------------
@@ -135,7 +135,9 @@ static vd_status fail(turtle* T, vd_status st, const char* fmt, ...) {
                       sym_name(T, T->sym), msg);
 }
 
-static vd_status nomem(turtle* T) { return fail(T, VD_ERR_NOMEM, "out of memory"); }
+static vd_status nomem(turtle* T) {
+  return fail(T, VD_ERR_NOMEM, "out of memory");
+}
 
 // parameter k of the current module as a finite number
 static vd_status num(turtle* T, int k, double* out) {
@@ -194,7 +196,9 @@ static vd_status label_at(turtle* T, int k, int* label) {
 }
 
 // index of the derived-string module that produced module i
-static int64_t module_of(const turtle* T, int64_t i) { return T->s->src ? T->s->src[i] : i; }
+static int64_t module_of(const turtle* T, int64_t i) {
+  return T->s->src ? T->s->src[i] : i;
+}
 
 // ---------------------------------------------------------------------------------------------
 // instance ids: compact renumbering of producing modules, in order of first drawing
@@ -210,7 +214,8 @@ static uint64_t hash64(int64_t k) {
 // find the slot of key (or the empty slot where it belongs)
 static int64_t hash_slot(const turtle* T, int64_t key) {
   int64_t mask = T->hcap - 1, j = (int64_t)(hash64(key) & (uint64_t)mask);
-  while (T->hkey[j] != -1 && T->hkey[j] != key) j = (j + 1) & mask;
+  while (T->hkey[j] != -1 && T->hkey[j] != key)
+    j = (j + 1) & mask;
   return j;
 }
 
@@ -610,7 +615,8 @@ static vd_status draw_disc(turtle* T) {
   T->vbuf[0] = t->pos;
   for (int k = 0; k < n; k++) {
     double a = 2.0 * VD_PI * k / n;
-    T->vbuf[1 + k] = vd_add(t->pos, vd_add(vd_scale(t->h, rs * cos(a)), vd_scale(t->l, rs * sin(a))));
+    T->vbuf[1 + k] =
+        vd_add(t->pos, vd_add(vd_scale(t->h, rs * cos(a)), vd_scale(t->l, rs * sin(a))));
     tri(T->tbuf, k, 0, 1 + k, 1 + (k + 1) % n);
   }
   return add_mesh(T, n + 1, n, 0, label, module_of(T, T->i), t->node, t->parent);
@@ -743,7 +749,8 @@ static int ear_clip(turtle* T, const vd_vec3* p, int n, int* t) {
   e1 = vd_normalize(vd_sub(e1, vd_scale(nrm, vd_dot(e1, nrm))));
   vd_vec3 e2 = vd_cross(nrm, e1);
   int* v = T->ibuf;
-  for (int k = 0; k < n; k++) v[k] = k;
+  for (int k = 0; k < n; k++)
+    v[k] = k;
   int m = n, nt = 0;
 #define PX(k) vd_dot(p[k], e1)
 #define PY(k) vd_dot(p[k], e2)
@@ -753,7 +760,7 @@ static int ear_clip(turtle* T, const vd_vec3* p, int n, int* t) {
       int a = v[(k + m - 1) % m], b = v[k], c = v[(k + 1) % m];
       double ax = PX(a), ay = PY(a), bx = PX(b), by = PY(b), cx = PX(c), cy = PY(c);
       double cr = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-      if (cr <= 0) continue;  // reflex or flat corner
+      if (cr <= 0) continue; // reflex or flat corner
       // no other vertex inside or on the triangle
       int inside = 0;
       for (int j = 0; j < m && !inside; j++) {
@@ -814,7 +821,9 @@ static void end_axis(turtle* T, const tstate* t) {
 }
 
 // the angle parameter in degrees (default: the def's angle)
-static vd_status angle_arg(turtle* T, double* deg) { return num_or(T, 0, T->def.angle, deg); }
+static vd_status angle_arg(turtle* T, double* deg) {
+  return num_or(T, 0, T->def.angle, deg);
+}
 
 // a vector from up to three parameters starting at k (missing ones from dflt)
 static vd_status vec_args(turtle* T, int k, vd_vec3 dflt, vd_vec3* out) {
@@ -887,270 +896,273 @@ static vd_status step(turtle* T) {
   int c;
   vd_status st = VD_OK;
   switch ((vd_sym)T->sym) {
-    // structure
-    case VD_SYM_SB:
-      if (!vd_grow((void**)&T->stack, &T->cap_stack, T->nstack + 1, sizeof *T->stack))
-        return nomem(T);
-      T->stack[T->nstack++] = *t;
-      t->pending = 1;
-      t->tail = -1;
-      return VD_OK;
-    case VD_SYM_EB:
-      if (T->nstack == 0) return fail(T, VD_ERR_SYNTAX, "']' without a matching '['");
-      end_axis(T, t);
-      *t = T->stack[--T->nstack];
-      return VD_OK;
+  // structure
+  case VD_SYM_SB:
+    if (!vd_grow((void**)&T->stack, &T->cap_stack, T->nstack + 1, sizeof *T->stack))
+      return nomem(T);
+    T->stack[T->nstack++] = *t;
+    t->pending = 1;
+    t->tail = -1;
+    return VD_OK;
+  case VD_SYM_EB:
+    if (T->nstack == 0) return fail(T, VD_ERR_SYNTAX, "']' without a matching '['");
+    end_axis(T, t);
+    *t = T->stack[--T->nstack];
+    return VD_OK;
 
-    // moves and drawing
-    case VD_SYM_F: {
-      int label;
-      if ((st = max_params(T, 3)) || (st = num_or(T, 0, T->def.step, &a)) ||
-          (st = num_or(T, 1, -1, &b)) || (st = label_at(T, 2, &label)))
-        return st;
-      return draw_F(T, a, b, label);
+  // moves and drawing
+  case VD_SYM_F: {
+    int label;
+    if ((st = max_params(T, 3)) || (st = num_or(T, 0, T->def.step, &a)) ||
+        (st = num_or(T, 1, -1, &b)) || (st = label_at(T, 2, &label)))
+      return st;
+    return draw_F(T, a, b, label);
+  }
+  case VD_SYM_f:
+    if ((st = num_or(T, 0, T->def.step, &a))) return st;
+    move_f(T, a);
+    return VD_OK;
+  case VD_SYM_nF:
+    return draw_nF(T);
+
+  // rotations
+  case VD_SYM_LEFT:
+  case VD_SYM_RIGHT:
+    if ((st = angle_arg(T, &a))) return st;
+    turn_left(T, T->sym == VD_SYM_LEFT ? a : -a);
+    return VD_OK;
+  case VD_SYM_DOWN:
+  case VD_SYM_UP:
+    if ((st = angle_arg(T, &a))) return st;
+    pitch_down(T, T->sym == VD_SYM_DOWN ? a : -a);
+    return VD_OK;
+  case VD_SYM_ROLLL:
+  case VD_SYM_ROLLR:
+  case VD_SYM_IROLLL:
+  case VD_SYM_IROLLR:
+    // without a guide the intrinsic rolls are the plain rolls (PlantGL)
+    if ((st = angle_arg(T, &a))) return st;
+    roll_left(T, T->sym == VD_SYM_ROLLL || T->sym == VD_SYM_IROLLL ? a : -a);
+    return VD_OK;
+  case VD_SYM_TURN:
+    turn_around(t);
+    return VD_OK;
+  case VD_SYM_ROLLTOVERT:
+    if ((st = num_or(T, 0, 1, &a))) return st;
+    roll_to_vert(T, a);
+    return VD_OK;
+  case VD_SYM_ROLLTOHORIZ:
+    if ((st = num_or(T, 0, 1, &a))) return st;
+    roll_to_horizontal(T, a);
+    return VD_OK;
+
+  // width: no parameter = +-width_inc, a parameter sets it
+  case VD_SYM_INCWIDTH:
+  case VD_SYM_DECWIDTH:
+  case VD_SYM_SETWIDTH:
+    if (T->np > 0) {
+      if ((st = nonneg_or(T, 0, 0, "width", &a))) return st;
+      t->width = a;
+    } else if (T->sym == VD_SYM_INCWIDTH) {
+      t->width += T->def.width_inc;
+    } else if (T->sym == VD_SYM_DECWIDTH && t->width - T->def.width_inc > -EPS) {
+      t->width = fmax(t->width - T->def.width_inc, 0);
+    } else if (!T->warned_width) {
+      // L-Py warns and keeps the width (negative widths, SetWidth without value)
+      vd_log(1,
+             "turtle: module %lld '%s' would make the width negative or has no value; "
+             "width kept",
+             (long long)T->i, sym_name(T, T->sym));
+      T->warned_width = 1;
     }
-    case VD_SYM_f:
-      if ((st = num_or(T, 0, T->def.step, &a))) return st;
-      move_f(T, a);
-      return VD_OK;
-    case VD_SYM_nF:
-      return draw_nF(T);
+    return VD_OK;
 
-    // rotations
-    case VD_SYM_LEFT:
-    case VD_SYM_RIGHT:
-      if ((st = angle_arg(T, &a))) return st;
-      turn_left(T, T->sym == VD_SYM_LEFT ? a : -a);
-      return VD_OK;
-    case VD_SYM_DOWN:
-    case VD_SYM_UP:
-      if ((st = angle_arg(T, &a))) return st;
-      pitch_down(T, T->sym == VD_SYM_DOWN ? a : -a);
-      return VD_OK;
-    case VD_SYM_ROLLL:
-    case VD_SYM_ROLLR:
-    case VD_SYM_IROLLL:
-    case VD_SYM_IROLLR:
-      // without a guide the intrinsic rolls are the plain rolls (PlantGL)
-      if ((st = angle_arg(T, &a))) return st;
-      roll_left(T, T->sym == VD_SYM_ROLLL || T->sym == VD_SYM_IROLLL ? a : -a);
-      return VD_OK;
-    case VD_SYM_TURN:
-      turn_around(t);
-      return VD_OK;
-    case VD_SYM_ROLLTOVERT:
-      if ((st = num_or(T, 0, 1, &a))) return st;
-      roll_to_vert(T, a);
-      return VD_OK;
-    case VD_SYM_ROLLTOHORIZ:
-      if ((st = num_or(T, 0, 1, &a))) return st;
-      roll_to_horizontal(T, a);
-      return VD_OK;
-
-    // width: no parameter = +-width_inc, a parameter sets it
-    case VD_SYM_INCWIDTH:
-    case VD_SYM_DECWIDTH:
-    case VD_SYM_SETWIDTH:
-      if (T->np > 0) {
-        if ((st = nonneg_or(T, 0, 0, "width", &a))) return st;
-        t->width = a;
-      } else if (T->sym == VD_SYM_INCWIDTH) {
-        t->width += T->def.width_inc;
-      } else if (T->sym == VD_SYM_DECWIDTH && t->width - T->def.width_inc > -EPS) {
-        t->width = fmax(t->width - T->def.width_inc, 0);
-      } else if (!T->warned_width) {
-        // L-Py warns and keeps the width (negative widths, SetWidth without value)
-        vd_log(1, "turtle: module %lld '%s' would make the width negative or has no value; "
-                  "width kept", (long long)T->i, sym_name(T, T->sym));
-        T->warned_width = 1;
-      }
-      return VD_OK;
-
-    // colour = label
-    case VD_SYM_INCCOLOR:
-    case VD_SYM_DECCOLOR:
-      if (T->np > 0) {
-        if ((st = index_at(T, 0, "colour index", &c))) return st;
-        set_color(T, c);
-      } else if (T->sym == VD_SYM_INCCOLOR) {
-        set_color(T, t->color + 1);
-      } else if (t->color > 0) {
-        set_color(T, t->color - 1);
-      } else if (!T->warned_color) {
-        vd_log(1, "turtle: module %lld ',' below colour 0; colour kept", (long long)T->i);
-        T->warned_color = 1;
-      }
-      return VD_OK;
-    case VD_SYM_SETCOLOR:
-      // SetColor(i) sets the index; SetColor(r,g,b[,a]) is a custom material: label unchanged
-      if (T->np == 1) {
-        if ((st = index_at(T, 0, "colour index", &c))) return st;
-        set_color(T, c);
-      }
-      return VD_OK;
-
-    // primitives
-    case VD_SYM_SPHERE:
-      return draw_sphere(T);
-    case VD_SYM_CIRCLE:
-      return draw_disc(T);
-    case VD_SYM_BOX:
-    case VD_SYM_QUAD:
-      return draw_box_quad(T, T->sym == VD_SYM_BOX);
-    case VD_SYM_LEAF:
-      return draw_leaf(T, 0);
-    case VD_SYM_SURFACE: {
-      const char* name = NULL;
-      if (T->np > 0 && T->ls && vd_lsys_value_is_str(T->p[0]))
-        name = vd_lsys_value_str(T->ls, T->p[0]);
-      if (name && strcmp(name, "l") == 0) return draw_leaf(T, 1);
-      return fail(T, VD_ERR_UNSUPPORTED, "unknown surface '%s' (only 'l' is predefined)",
-                  name ? name : "?");
+  // colour = label
+  case VD_SYM_INCCOLOR:
+  case VD_SYM_DECCOLOR:
+    if (T->np > 0) {
+      if ((st = index_at(T, 0, "colour index", &c))) return st;
+      set_color(T, c);
+    } else if (T->sym == VD_SYM_INCCOLOR) {
+      set_color(T, t->color + 1);
+    } else if (t->color > 0) {
+      set_color(T, t->color - 1);
+    } else if (!T->warned_color) {
+      vd_log(1, "turtle: module %lld ',' below colour 0; colour kept", (long long)T->i);
+      T->warned_color = 1;
     }
-
-    // polygons
-    case VD_SYM_BP:
-      t->polygon = 1;
-      T->npoly = 0;
-      T->poly_label = t->color;
-      T->poly_module = module_of(T, T->i);
-      T->poly_node = t->node;
-      T->poly_parent = t->parent;
-      return VD_OK;
-    case VD_SYM_PP:
-      return t->polygon ? poly_push(T) : VD_OK;
-    case VD_SYM_EP:
-      return t->polygon ? end_polygon(T) : VD_OK;
-
-    // generalised cylinders
-    case VD_SYM_STARTGC:
-      t->gc = 1;
-      t->gc_prev = -1;
-      return VD_OK;
-    case VD_SYM_ENDGC:
-      t->gc = 0;
-      t->gc_prev = -1;
-      return VD_OK;
-
-    // tropism: Tropism() = (0,0,1); one or two values fill x, y with z = 1 (PlantGL defaults)
-    case VD_SYM_TROPISM:
-    case VD_SYM_TROPISM_LONG:
-      if ((st = vec_args(T, 0, vd_v3(0, 0, 1), &v))) return st;
-      t->tropism = vd_norm(v) > 0 ? vd_normalize(v) : vd_v3(0, 0, 0);
-      return VD_OK;
-    case VD_SYM_ELASTICITY:
-    case VD_SYM_ELASTICITY_LONG:
-      // exactly one value sets it; otherwise L-Py resets it to 0
-      a = 0;
-      if (T->np == 1 && (st = num(T, 0, &a))) return st;
-      if (a < 0 || a > 1) return fail(T, VD_ERR_VALUE, "elasticity %g outside [0, 1]", a);
-      t->elasticity = a;
-      return VD_OK;
-
-    // absolute placement and orientation
-    case VD_SYM_MOVETO:
-      if ((st = vec_args(T, 0, T->np == 0 ? vd_v3(0, 0, 0) : t->pos, &v))) return st;
-      move_to(t, v);
-      return VD_OK;
-    case VD_SYM_MOVEREL:
-      if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v))) return st;
-      move_to(t, vd_add(t->pos, v));
-      return VD_OK;
-    case VD_SYM_SETHEAD: {
-      vd_vec3 u;
-      if (T->np == 0) return set_head(T, vd_v3(0, 0, 1), vd_v3(1, 0, 0));
-      if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = vec_args(T, 3, vd_v3(0, 0, 0), &u)))
-        return st;
-      if (vd_norm(v) < EPS) return fail(T, VD_ERR_VALUE, "zero heading");
-      if (T->np <= 3 || vd_norm(u) < EPS) {
-        // no usable up: turn toward the heading like PinpointRel
-        tend_to(T, vd_normalize(v), 1);
-        return VD_OK;
-      }
-      return set_head(T, v, u);
+    return VD_OK;
+  case VD_SYM_SETCOLOR:
+    // SetColor(i) sets the index; SetColor(r,g,b[,a]) is a custom material: label unchanged
+    if (T->np == 1) {
+      if ((st = index_at(T, 0, "colour index", &c))) return st;
+      set_color(T, c);
     }
-    case VD_SYM_PINPOINT:
-    case VD_SYM_PINPOINTREL:
-      if (T->np == 0) return VD_OK;
-      if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v))) return st;
-      if (T->sym == VD_SYM_PINPOINT) v = vd_sub(v, t->pos);
-      if (vd_norm(v) > EPS) tend_to(T, vd_normalize(v), 1);
+    return VD_OK;
+
+  // primitives
+  case VD_SYM_SPHERE:
+    return draw_sphere(T);
+  case VD_SYM_CIRCLE:
+    return draw_disc(T);
+  case VD_SYM_BOX:
+  case VD_SYM_QUAD:
+    return draw_box_quad(T, T->sym == VD_SYM_BOX);
+  case VD_SYM_LEAF:
+    return draw_leaf(T, 0);
+  case VD_SYM_SURFACE: {
+    const char* name = NULL;
+    if (T->np > 0 && T->ls && vd_lsys_value_is_str(T->p[0]))
+      name = vd_lsys_value_str(T->ls, T->p[0]);
+    if (name && strcmp(name, "l") == 0) return draw_leaf(T, 1);
+    return fail(T, VD_ERR_UNSUPPORTED, "unknown surface '%s' (only 'l' is predefined)",
+                name ? name : "?");
+  }
+
+  // polygons
+  case VD_SYM_BP:
+    t->polygon = 1;
+    T->npoly = 0;
+    T->poly_label = t->color;
+    T->poly_module = module_of(T, T->i);
+    T->poly_node = t->node;
+    T->poly_parent = t->parent;
+    return VD_OK;
+  case VD_SYM_PP:
+    return t->polygon ? poly_push(T) : VD_OK;
+  case VD_SYM_EP:
+    return t->polygon ? end_polygon(T) : VD_OK;
+
+  // generalised cylinders
+  case VD_SYM_STARTGC:
+    t->gc = 1;
+    t->gc_prev = -1;
+    return VD_OK;
+  case VD_SYM_ENDGC:
+    t->gc = 0;
+    t->gc_prev = -1;
+    return VD_OK;
+
+  // tropism: Tropism() = (0,0,1); one or two values fill x, y with z = 1 (PlantGL defaults)
+  case VD_SYM_TROPISM:
+  case VD_SYM_TROPISM_LONG:
+    if ((st = vec_args(T, 0, vd_v3(0, 0, 1), &v))) return st;
+    t->tropism = vd_norm(v) > 0 ? vd_normalize(v) : vd_v3(0, 0, 0);
+    return VD_OK;
+  case VD_SYM_ELASTICITY:
+  case VD_SYM_ELASTICITY_LONG:
+    // exactly one value sets it; otherwise L-Py resets it to 0
+    a = 0;
+    if (T->np == 1 && (st = num(T, 0, &a))) return st;
+    if (a < 0 || a > 1) return fail(T, VD_ERR_VALUE, "elasticity %g outside [0, 1]", a);
+    t->elasticity = a;
+    return VD_OK;
+
+  // absolute placement and orientation
+  case VD_SYM_MOVETO:
+    if ((st = vec_args(T, 0, T->np == 0 ? vd_v3(0, 0, 0) : t->pos, &v))) return st;
+    move_to(t, v);
+    return VD_OK;
+  case VD_SYM_MOVEREL:
+    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v))) return st;
+    move_to(t, vd_add(t->pos, v));
+    return VD_OK;
+  case VD_SYM_SETHEAD: {
+    vd_vec3 u;
+    if (T->np == 0) return set_head(T, vd_v3(0, 0, 1), vd_v3(1, 0, 0));
+    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = vec_args(T, 3, vd_v3(0, 0, 0), &u)))
+      return st;
+    if (vd_norm(v) < EPS) return fail(T, VD_ERR_VALUE, "zero heading");
+    if (T->np <= 3 || vd_norm(u) < EPS) {
+      // no usable up: turn toward the heading like PinpointRel
+      tend_to(T, vd_normalize(v), 1);
       return VD_OK;
-    case VD_SYM_LINETO:
-    case VD_SYM_OLINETO:
-    case VD_SYM_LINEREL:
-    case VD_SYM_OLINEREL: {
-      int rel = T->sym == VD_SYM_LINEREL || T->sym == VD_SYM_OLINEREL;
-      int keep = T->sym == VD_SYM_LINETO || T->sym == VD_SYM_LINEREL;
-      if (T->np == 0) return VD_OK;
-      if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = num_or(T, 3, -1, &b))) return st;
-      return line_to(T, rel ? vd_add(t->pos, v) : v, b, keep);
     }
-    case VD_SYM_EULER:
-      if ((st = vec_args(T, 0, vd_v3(180, 90, 0), &v))) return st;
-      euler_angles(T, v.x, v.y, v.z);
-      return VD_OK;
+    return set_head(T, v, u);
+  }
+  case VD_SYM_PINPOINT:
+  case VD_SYM_PINPOINTREL:
+    if (T->np == 0) return VD_OK;
+    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v))) return st;
+    if (T->sym == VD_SYM_PINPOINT) v = vd_sub(v, t->pos);
+    if (vd_norm(v) > EPS) tend_to(T, vd_normalize(v), 1);
+    return VD_OK;
+  case VD_SYM_LINETO:
+  case VD_SYM_OLINETO:
+  case VD_SYM_LINEREL:
+  case VD_SYM_OLINEREL: {
+    int rel = T->sym == VD_SYM_LINEREL || T->sym == VD_SYM_OLINEREL;
+    int keep = T->sym == VD_SYM_LINETO || T->sym == VD_SYM_LINEREL;
+    if (T->np == 0) return VD_OK;
+    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = num_or(T, 3, -1, &b))) return st;
+    return line_to(T, rel ? vd_add(t->pos, v) : v, b, keep);
+  }
+  case VD_SYM_EULER:
+    if ((st = vec_args(T, 0, vd_v3(180, 90, 0), &v))) return st;
+    euler_angles(T, v.x, v.y, v.z);
+    return VD_OK;
 
-    // scale
-    case VD_SYM_SETSCALE:
-    case VD_SYM_MULTSCALE:
-    case VD_SYM_DIVSCALE:
-      if ((st = num_or(T, 0, T->sym == VD_SYM_SETSCALE ? 1 : T->def.scale_factor, &a))) return st;
-      if (a <= 0) return fail(T, VD_ERR_VALUE, "scale %g must be positive", a);
-      t->scale = T->sym == VD_SYM_SETSCALE ? a : T->sym == VD_SYM_MULTSCALE ? t->scale * a
-                                                                            : t->scale / a;
-      if (!isfinite(t->scale) || t->scale <= 0) return fail(T, VD_ERR_VALUE, "scale overflow");
-      return VD_OK;
-    case VD_SYM_SECTIONRES:
-      if (T->np == 0) return VD_OK;
-      if ((st = num(T, 0, &a))) return st;
-      if (a < SLICES_MIN || a >= SLICES_MAX + 1)
-        return fail(T, VD_ERR_VALUE, "section resolution %g outside [%d, %d]", a, SLICES_MIN,
-                    SLICES_MAX);
-      t->slices = (int)a;
-      return VD_OK;
+  // scale
+  case VD_SYM_SETSCALE:
+  case VD_SYM_MULTSCALE:
+  case VD_SYM_DIVSCALE:
+    if ((st = num_or(T, 0, T->sym == VD_SYM_SETSCALE ? 1 : T->def.scale_factor, &a))) return st;
+    if (a <= 0) return fail(T, VD_ERR_VALUE, "scale %g must be positive", a);
+    t->scale = T->sym == VD_SYM_SETSCALE    ? a
+               : T->sym == VD_SYM_MULTSCALE ? t->scale * a
+                                            : t->scale / a;
+    if (!isfinite(t->scale) || t->scale <= 0) return fail(T, VD_ERR_VALUE, "scale overflow");
+    return VD_OK;
+  case VD_SYM_SECTIONRES:
+    if (T->np == 0) return VD_OK;
+    if ((st = num(T, 0, &a))) return st;
+    if (a < SLICES_MIN || a >= SLICES_MAX + 1)
+      return fail(T, VD_ERR_VALUE, "section resolution %g outside [%d, %d]", a, SLICES_MIN,
+                  SLICES_MAX);
+    t->slices = (int)a;
+    return VD_OK;
 
-    // verdant extension: age written on the following segments
-    case VD_SYM_SETAGE:
-      if ((st = num_or(T, 0, 0, &a))) return st;
-      t->age = a;
-      return VD_OK;
+  // verdant extension: age written on the following segments
+  case VD_SYM_SETAGE:
+    if ((st = num_or(T, 0, 0, &a))) return st;
+    t->age = a;
+    return VD_OK;
 
-    // curves are not supported: accepted and ignored with one warning
-    case VD_SYM_SETGUIDE:
-    case VD_SYM_SWEEP:
-    case VD_SYM_SETCONTOUR:
-      if (!T->warned_guide) {
-        vd_log(1, "turtle: module %lld '%s' needs curve objects; ignored", (long long)T->i,
-               sym_name(T, T->sym));
-        T->warned_guide = 1;
-      }
-      return VD_OK;
+  // curves are not supported: accepted and ignored with one warning
+  case VD_SYM_SETGUIDE:
+  case VD_SYM_SWEEP:
+  case VD_SYM_SETCONTOUR:
+    if (!T->warned_guide) {
+      vd_log(1, "turtle: module %lld '%s' needs curve objects; ignored", (long long)T->i,
+             sym_name(T, T->sym));
+      T->warned_guide = 1;
+    }
+    return VD_OK;
 
-    // display-only and query modules; % is applied by the derivation
-    case VD_SYM_INTERPCOLORS:
-    case VD_SYM_CUT:
-    case VD_SYM_LABEL:
-    case VD_SYM_FRAME:
-    case VD_SYM_ARROW:
-    case VD_SYM_PGLSHAPE:
-    case VD_SYM_2D:
-    case VD_SYM_3D:
-    case VD_SYM_ENDGUIDE:
-    case VD_SYM_POSONGUIDE:
-    case VD_SYM_TEXSCALE:
-    case VD_SYM_TEXUSCALE:
-    case VD_SYM_TEXVSCALE:
-    case VD_SYM_TEXTRANS:
-    case VD_SYM_TEXROT:
-    case VD_SYM_GETPOS:
-    case VD_SYM_GETHEAD:
-    case VD_SYM_GETUP:
-    case VD_SYM_GETLEFT:
-    case VD_SYM_GETRIGHT:
-    case VD_SYM_GETFRAME:
-    case VD_SYM_PREDEFINED_COUNT:
-      return VD_OK;
+  // display-only and query modules; % is applied by the derivation
+  case VD_SYM_INTERPCOLORS:
+  case VD_SYM_CUT:
+  case VD_SYM_LABEL:
+  case VD_SYM_FRAME:
+  case VD_SYM_ARROW:
+  case VD_SYM_PGLSHAPE:
+  case VD_SYM_2D:
+  case VD_SYM_3D:
+  case VD_SYM_ENDGUIDE:
+  case VD_SYM_POSONGUIDE:
+  case VD_SYM_TEXSCALE:
+  case VD_SYM_TEXUSCALE:
+  case VD_SYM_TEXVSCALE:
+  case VD_SYM_TEXTRANS:
+  case VD_SYM_TEXROT:
+  case VD_SYM_GETPOS:
+  case VD_SYM_GETHEAD:
+  case VD_SYM_GETUP:
+  case VD_SYM_GETLEFT:
+  case VD_SYM_GETRIGHT:
+  case VD_SYM_GETFRAME:
+  case VD_SYM_PREDEFINED_COUNT:
+    return VD_OK;
   }
   return VD_OK;
 }
@@ -1161,16 +1173,24 @@ static vd_status step(turtle* T) {
 // settings that would make the turtle draw nonsense
 static vd_status check_def(const vd_turtle_def* d, vd_error* err) {
   const char* bad = NULL;
-  if (!isfinite(d->angle)) bad = "angle";
-  else if (!isfinite(d->step)) bad = "step";
-  else if (!(d->width >= 0) || !isfinite(d->width)) bad = "width";
-  else if (!(d->width_inc >= 0) || !isfinite(d->width_inc)) bad = "width_inc";
-  else if (!(d->scale_factor > 0) || !isfinite(d->scale_factor)) bad = "scale_factor";
-  else if (d->color < 0) bad = "color";
-  else if (d->slices < SLICES_MIN || d->slices > SLICES_MAX) bad = "slices";
+  if (!isfinite(d->angle))
+    bad = "angle";
+  else if (!isfinite(d->step))
+    bad = "step";
+  else if (!(d->width >= 0) || !isfinite(d->width))
+    bad = "width";
+  else if (!(d->width_inc >= 0) || !isfinite(d->width_inc))
+    bad = "width_inc";
+  else if (!(d->scale_factor > 0) || !isfinite(d->scale_factor))
+    bad = "scale_factor";
+  else if (d->color < 0)
+    bad = "color";
+  else if (d->slices < SLICES_MIN || d->slices > SLICES_MAX)
+    bad = "slices";
   else if (!isfinite(d->tropism.x) || !isfinite(d->tropism.y) || !isfinite(d->tropism.z))
     bad = "tropism";
-  else if (!(d->elasticity >= 0 && d->elasticity <= 1)) bad = "elasticity";
+  else if (!(d->elasticity >= 0 && d->elasticity <= 1))
+    bad = "elasticity";
   if (bad) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "turtle: bad setting '%s'", bad);
   return VD_OK;
 }
@@ -1239,7 +1259,8 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
   // the string ends every open axis (unclosed [ are tolerated, as in L-Py)
   if (st == VD_OK) {
     end_axis(&T, &T.t);
-    for (int k = T.nstack - 1; k >= 0; k--) end_axis(&T, &T.stack[k]);
+    for (int k = T.nstack - 1; k >= 0; k--)
+      end_axis(&T, &T.stack[k]);
     if (T.t.polygon && T.npoly > 0)
       vd_log(1, "turtle: polygon not closed with '}' at the end of the string; dropped");
   }

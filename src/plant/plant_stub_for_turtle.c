@@ -7,7 +7,9 @@
 
 #include "verdant/plant.h"
 
-vd_plant_spec* vd_plant_spec_create(void) { return vd_calloc(1, sizeof(vd_plant_spec)); }
+vd_plant_spec* vd_plant_spec_create(void) {
+  return vd_calloc(1, sizeof(vd_plant_spec));
+}
 
 void vd_plant_spec_destroy(vd_plant_spec* s) {
   if (!s) return;
@@ -89,7 +91,8 @@ int vd_plant_add_mesh(vd_plant_spec* s, const vd_mesh_spec* m, const vd_vec3* ve
   d->tri_start = s->ntri;
   d->ntri = ntri;
   memcpy(s->vert + s->nvert, verts, (size_t)nvert * sizeof *verts);
-  for (int k = 0; k < 3 * ntri; k++) s->tri[3 * s->ntri + k] = tris[k] + s->nvert;
+  for (int k = 0; k < 3 * ntri; k++)
+    s->tri[3 * s->ntri + k] = tris[k] + s->nvert;
   s->nvert += nvert;
   s->ntri += ntri;
   note_instance(s, m->instance);
@@ -99,7 +102,8 @@ int vd_plant_add_mesh(vd_plant_spec* s, const vd_mesh_spec* m, const vd_vec3* ve
 vd_status vd_plant_set_label(vd_plant_spec* s, int id, const char* name) {
   // find the slot (sorted by id), insert when absent
   int k = 0;
-  while (k < s->nlabel && s->label[k].id < id) k++;
+  while (k < s->nlabel && s->label[k].id < id)
+    k++;
   if (k == s->nlabel || s->label[k].id != id) {
     if (!vd_grow((void**)&s->label, &s->cap_label, s->nlabel + 1, sizeof *s->label))
       return VD_ERR_NOMEM;
