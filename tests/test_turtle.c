@@ -528,6 +528,8 @@ TEST(turtle, disc) {
   CHECK_INT(m->node, P->seg[0].node1);
   CHECK_INT(m->parent, 0);
   CHECK_V3(mvert(P, 0, 0), 0, 0, 1);
+  CHECK_V3(mvert(P, 0, 1), 0, 0, 0.5); // PlantGL's first rim point: -H
+  CHECK_V3(mvert(P, 0, 3), 0, 0.5, 1); // a quarter turn on: -L
   // the rim lies in the plane of H and L (normal U = +X), faces point along U
   double area = 0;
   for (int j = 1; j < 9; j++) {

@@ -610,8 +610,9 @@ static vd_status draw_disc(turtle* T) {
   const tstate* t = &T->t;
   int n = t->slices;
   if ((st = scratch(T, n + 1, n))) return st;
-  // fan around the centre, counter-clockwise about U
-  double rs = r * t->scale;
+  // fan around the centre, counter-clockwise about U; rim point k at -cos(a) H - sin(a) L, where
+  // PlantGL's Disc (x = cos, y = sin in its plane) lands after the turtle's orientation
+  double rs = -r * t->scale;
   T->vbuf[0] = t->pos;
   for (int k = 0; k < n; k++) {
     double a = 2.0 * VD_PI * k / n;
