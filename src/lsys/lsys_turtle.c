@@ -284,8 +284,8 @@ static vd_status instance_of(turtle* T, int64_t module, int* out) {
     inst = ++T->ninst;
   } else {
     if (!T->hashed && !hash_start(T)) return nomem(T);
-    int64_t slot = hash_slot(T, module);
-    if (T->hkey[slot] == module) {
+    int64_t slot = T->hcap ? hash_slot(T, module) : -1;
+    if (slot >= 0 && T->hkey[slot] == module) {
       inst = T->hval[slot];
     } else {
       inst = ++T->ninst;
