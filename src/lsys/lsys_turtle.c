@@ -1265,6 +1265,8 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
     if (T.t.polygon && T.npoly > 0)
       vd_log(1, "turtle: polygon not closed with '}' at the end of the string; dropped");
   }
+  // the largest instance id in use, whether or not the plant's add functions track it
+  if (T.ninst > plant->ninstance) plant->ninstance = T.ninst;
   release(&T);
   return st;
 }
