@@ -408,3 +408,113 @@ TEST(lsys, binary_and_empty_input) {
   vd_error e3 = {0};
   CHECK_STATUS(vd_lsys_load("/nonexistent.lpy", &ls, &e3), VD_ERR_IO, e3);
 }
+
+// ---------------------------------------------------------------------------------------------
+// grow: derivation + interpretation + turtle, labels and instances end to end
+
+static vd_status grow_str(const char* src, vd_plant_spec** out, vd_error* e) {
+  vd_lsystem* ls;
+  *out = NULL;
+  vd_status st = vd_lsys_parse(src, strlen(src), "g.lpy", &ls, e);
+  if (st) return st;
+  vd_plant_spec* p = vd_plant_spec_create();
+  st = vd_lsys_grow(ls, NULL, NULL, p, e);
+  vd_lsys_destroy(ls);
+  if (st) {
+    vd_plant_spec_destroy(p);
+    return st;
+  }
+  *out = p;
+  return VD_OK;
+}
+
+TEST(lsys, grow_labels_and_instances) {
+  const char* src =
+      "LABELS = {1: 'stem', 2: 'leaf', 3: 'fruit'}\n"
+      "module I, Leaf, Fruit\n"
+      "Axiom: SetWidth(0.005) A(3)\n"
+      "derivation length: 4\n"
+      "production:\n"
+      "A(n) :\n"
+      "    if n > 0: produce I(0.05) [ +(50) Leaf(0.06) ] /(137.5) A(n - 1)\n"
+      "    else: produce Fruit(0.012)\n"
+      "interpretation:\n"
+      "I(l) --> ;(1) F(l, 0.004)\n"
+      "Leaf(s) --> ;(2) ~l(s) ~l(s * 0.5)\n"
+      "Fruit(r) --> ;(3) @O(r)\n"
+      "endlsystem\n";
+  vd_plant_spec* p;
+  vd_error e = {0};
+  CHECK_STATUS(grow_str(src, &p, &e), VD_OK, e);
+  REQUIRE(p);
+  CHECK_INT(p->nseg, 3);
+  CHECK_INT(p->nmesh, 6);
+  CHECK_INT(p->nsphere, 1);
+  // 3 internodes + 3 leaves (two surfaces each, one module) + 1 fruit
+  CHECK_INT(p->ninstance, 7);
+  CHECK_INT(p->mesh[0].instance, p->mesh[1].instance);
+  CHECK(p->mesh[2].instance != p->mesh[1].instance);
+  CHECK_INT(p->sphere[0].label, 3);
+  CHECK_STR(vd_plant_find_label(p, 3)->name, "fruit");
+  CHECK_INT(vd_plant_find_label(p, 3)->organ, VD_ORGAN_FRUIT);
+  // the stem: 3 segments of 0.05 m stacked on +Z, sharing nodes
+  CHECK_NEAR(p->node[p->seg[2].node1].z, 0.15, 1e-12);
+  CHECK_INT(p->seg[1].node0, p->seg[0].node1);
+  CHECK_INT(p->seg[1].parent, 0);
+  CHECK_NEAR(p->seg[0].r0, 0.005, 1e-15);
+  CHECK_NEAR(p->seg[0].r1, 0.004, 1e-15);
+  // the fruit sits at the stem's tip
+  CHECK_NEAR(p->sphere[0].center.z, 0.15, 1e-12);
+  vd_plant_spec_destroy(p);
+}
+
+TEST(lsys, grow_explicit_label_argument) {
+  // seed 003 style: the label travels as the last parameter
+  const char* src =
+      "module I\n"
+      "Axiom: I(0.1, 0.01, 8) F(0.1, 0.01, 9)\n"
+      "interpretation:\n"
+      "I(h, r, lab) --> F(h, r, lab)\n"
+      "endlsystem\n";
+  vd_plant_spec* p;
+  vd_error e = {0};
+  CHECK_STATUS(grow_str(src, &p, &e), VD_OK, e);
+  REQUIRE(p && p->nseg == 2);
+  CHECK_INT(p->seg[0].label, 8);
+  CHECK_INT(p->seg[1].label, 9);
+  CHECK_STR(vd_plant_find_label(p, 8)->name, "label_8");
+  vd_plant_spec_destroy(p);
+}
+
+TEST(lsys, grow_unknown_surface_rejected) {
+  vd_plant_spec* p;
+  vd_error e = {0};
+  CHECK_STATUS(grow_str("Axiom: ~q(1)\n", &p, &e), VD_ERR_UNSUPPORTED, e);
+  CHECK(p == NULL);
+}
+
+TEST(lsys, grow_same_seed_same_plant) {
+  const char* src =
+      "from random import *\n"
+      "Axiom: A(1)\n"
+      "derivation length: 6\n"
+      "production:\n"
+      "A(s) --> F(s * uniform(0.5, 1)) [ +(uniform(10, 60)) A(s * 0.7) ] /(gauss(137, 10)) A(s * 0.8)\n";
+  vd_lsystem* ls;
+  vd_error e = {0};
+  CHECK_STATUS(vd_lsys_parse(src, strlen(src), "s", &ls, &e), VD_OK, e);
+  vd_plant_spec *a = vd_plant_spec_create(), *b = vd_plant_spec_create(), *c = vd_plant_spec_create();
+  vd_lsys_def d = vd_lsys_def_default();
+  d.seed = 11;
+  CHECK_STATUS(vd_lsys_grow(ls, &d, NULL, a, &e), VD_OK, e);
+  CHECK_STATUS(vd_lsys_grow(ls, &d, NULL, b, &e), VD_OK, e);
+  d.seed = 12;
+  CHECK_STATUS(vd_lsys_grow(ls, &d, NULL, c, &e), VD_OK, e);
+  REQUIRE(a->nnode == b->nnode && a->nnode > 10);
+  CHECK(memcmp(a->node, b->node, sizeof(vd_vec3) * (size_t)a->nnode) == 0);
+  CHECK(c->nnode != a->nnode || memcmp(a->node, c->node, sizeof(vd_vec3) * (size_t)a->nnode) != 0);
+  vd_plant_spec_destroy(a);
+  vd_plant_spec_destroy(b);
+  vd_plant_spec_destroy(c);
+  vd_lsys_destroy(ls);
+}

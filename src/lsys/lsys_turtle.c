@@ -1249,7 +1249,15 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
   // interpret every predefined module; organ modules have no geometry
   for (int64_t i = 0; i < s->n && st == VD_OK; i++) {
     int sym = s->sym[i];
-    if (sym < 0 || sym >= VD_SYM_PREDEFINED_COUNT) continue;
+    if (sym < 0 || sym >= VD_SYM_PREDEFINED_COUNT) {
+      // `~x` surfaces other than the predefined leaf `~l` need PlantGL objects
+      const char* name = ls ? vd_lsys_symbol_name(ls, sym) : "";
+      if (name[0] == '~' && name[1])
+        st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                          "turtle: module %lld '%s': unsupported surface (only ~l is predefined)", (long long)i,
+                          name);
+      continue;
+    }
     T.i = i;
     T.sym = sym;
     T.np = (int)(s->par[i + 1] - s->par[i]);
