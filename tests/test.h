@@ -19,6 +19,10 @@ void vdt_fail(const char* file, int line, const char* fmt, ...)
 const char* vdt_path(const char* rel);
 // Scratch directory for this test run (created once).
 const char* vdt_tmpdir(void);
+// Install an allocator that lets `budget` more allocations succeed, then fails every one.
+void vdt_oom_begin(int64_t budget);
+// Restore the libc allocator after vdt_oom_begin.
+void vdt_oom_end(void);
 
 #define TEST(group, name)                                                                          \
   static void test_##group##_##name(void);                                                         \

@@ -33,25 +33,11 @@ TEST(core, alloc_counts_bytes) {
   vd_free(arr, (size_t)cap * sizeof(int));
 }
 
-// an allocator that fails after a budget: out-of-memory paths return NULL, never crash
-static int64_t budget;
-static void* failing_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
-  (void)user;
-  (void)old_size;
-  if (new_size == 0) {
-    free(ptr);
-    return NULL;
-  }
-  if (budget-- <= 0) return NULL;
-  return realloc(ptr, new_size);
-}
-
 TEST(core, allocator_hook_out_of_memory) {
-  budget = 1;
-  vd_set_allocator(failing_realloc, NULL);
+  vdt_oom_begin(1);
   void* a = vd_malloc(10);
   void* b = vd_malloc(10);
-  vd_set_allocator(NULL, NULL);
+  vdt_oom_end();
   CHECK(a != NULL);
   CHECK(b == NULL);
   vd_free(a, 10);

@@ -504,19 +504,6 @@ TEST(geom, write_ply) {
   vd_model_destroy(m);
 }
 
-// an allocator that fails after a budget of allocations
-static int64_t oom_budget;
-static void* oom_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
-  (void)user;
-  (void)old_size;
-  if (new_size == 0) {
-    free(ptr);
-    return NULL;
-  }
-  if (oom_budget-- <= 0) return NULL;
-  return realloc(ptr, new_size);
-}
-
 TEST(geom, out_of_memory) {
   vd_plant_spec* s = gc_tube(3, 8);
   REQUIRE(s);
@@ -526,8 +513,7 @@ TEST(geom, out_of_memory) {
   snprintf(path, sizeof path, "%s/oom.obj", vdt_tmpdir());
   int done = 0;
   for (int64_t b = 0; b < 20 && !done; b++) {
-    oom_budget = b;
-    vd_set_allocator(oom_realloc, NULL);
+    vdt_oom_begin(b);
     vd_mesh mesh;
     vd_error err = {0};
     vd_status st = vd_geom_tessellate(m, NULL, NULL, &mesh, &err);
@@ -535,7 +521,7 @@ TEST(geom, out_of_memory) {
     done = st == VD_OK;
     CHECK(st == VD_OK || st == VD_ERR_NOMEM);
     vd_mesh_free(&mesh);
-    vd_set_allocator(NULL, NULL);
+    vdt_oom_end();
   }
   CHECK(done);
   vd_model_destroy(m);

@@ -50,6 +50,26 @@ const char* vdt_tmpdir(void) {
   return dir;
 }
 
+// out-of-memory injection: an allocator that fails after a budget of allocations
+static int64_t oom_budget;
+static void* oom_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
+  (void)user;
+  (void)old_size;
+  if (new_size == 0) {
+    free(ptr);
+    return NULL;
+  }
+  if (oom_budget-- <= 0) return NULL;
+  return realloc(ptr, new_size);
+}
+
+void vdt_oom_begin(int64_t budget) {
+  oom_budget = budget;
+  vd_set_allocator(oom_realloc, NULL);
+}
+
+void vdt_oom_end(void) { vd_set_allocator(NULL, NULL); }
+
 static int cmp_case(const void* a, const void* b) {
   const vdt_case *x = a, *y = b;
   int c = strcmp(x->group, y->group);

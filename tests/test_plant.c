@@ -572,19 +572,6 @@ TEST(plant, json_every_prefix) {
   vd_free(t, len + 1);
 }
 
-// an allocator that fails after a budget of allocations
-static int64_t oom_budget;
-static void* oom_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
-  (void)user;
-  (void)old_size;
-  if (new_size == 0) {
-    free(ptr);
-    return NULL;
-  }
-  if (oom_budget-- <= 0) return NULL;
-  return realloc(ptr, new_size);
-}
-
 TEST(plant, out_of_memory) {
   size_t len = 0;
   char* t = plant_text(&len);
@@ -592,8 +579,7 @@ TEST(plant, out_of_memory) {
   // parse and compile under every allocation budget until one succeeds
   int done = 0;
   for (int64_t b = 0; b < 200 && !done; b++) {
-    oom_budget = b;
-    vd_set_allocator(oom_realloc, NULL);
+    vdt_oom_begin(b);
     vd_plant_spec* s = NULL;
     vd_model* m = NULL;
     vd_data* d = NULL;
@@ -606,7 +592,7 @@ TEST(plant, out_of_memory) {
     vd_data_destroy(d);
     vd_model_destroy(m);
     vd_plant_spec_destroy(s);
-    vd_set_allocator(NULL, NULL);
+    vdt_oom_end();
   }
   CHECK(done);
   vd_free(t, len + 1);

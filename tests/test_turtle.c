@@ -825,19 +825,6 @@ TEST(turtle, errors) {
   vd_plant_spec_destroy(P);
 }
 
-// an allocator that fails after a budget of allocations
-static int64_t budget;
-static void* failing_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
-  (void)user;
-  (void)old_size;
-  if (new_size == 0) {
-    free(ptr);
-    return NULL;
-  }
-  if (budget-- <= 0) return NULL;
-  return realloc(ptr, new_size);
-}
-
 TEST(turtle, out_of_memory) {
   // every failure point returns VD_ERR_NOMEM and leaks nothing; the last budget succeeds
   lbuf b = {0};
@@ -852,10 +839,9 @@ TEST(turtle, out_of_memory) {
   for (int64_t n = 0; n < 2000 && !ok; n++) {
     vd_plant_spec* P = vd_plant_spec_create();
     REQUIRE(P);
-    budget = n;
-    vd_set_allocator(failing_realloc, NULL);
+    vdt_oom_begin(n);
     vd_status st = vd_turtle_run(NULL, &b.s, NULL, P, NULL);
-    vd_set_allocator(NULL, NULL);
+    vdt_oom_end();
     if (st == VD_OK)
       ok = 1;
     else
