@@ -518,3 +518,24 @@ TEST(lsys, grow_same_seed_same_plant) {
   vd_plant_spec_destroy(c);
   vd_lsys_destroy(ls);
 }
+
+TEST(lsys, lstring_lines_do_not_join_on_brackets) {
+  // an nproduce line may open a branch that a later line closes (L-Py accepts it)
+  const char* src =
+      "module A, B\n"
+      "Axiom: A\n"
+      "production:\n"
+      "A :\n"
+      "    nproduce [\n"
+      "    t = 2\n"
+      "    nproduce B(t) ]\n"
+      "    produce B\n"
+      "endlsystem\n";
+  CHECK_DERIVE(src, 1, "[B(2)]B");
+  // a trailing backslash in an L-string is RollR, not a line continuation
+  CHECK_DERIVE("Axiom: F \\\nproduction:\nF --> F \\\n", 1, "F\\\\");
+  // an axiom line with an unclosed branch stays one line
+  CHECK_DERIVE("Axiom: A [ B\nproduction:\nB --> C\n", 1, "A[C");
+  // parentheses still join lines (Python's implicit continuation)
+  CHECK_DERIVE("Axiom: A(1,\n  2)\n", 0, "A(1,2)");
+}

@@ -69,11 +69,24 @@ static int is_blank(const char* s, int len) {
   return 1;
 }
 
-// bracket balance change of a physical line, ignoring strings and comments
+static int word_at(const char* s, int len, int i, const char* w) {
+  int n = (int)strlen(w);
+  if (i + n > len || memcmp(s + i, w, (size_t)n) != 0) return 0;
+  if (i > 0 && (isalnum((unsigned char)s[i - 1]) || s[i - 1] == '_')) return 0;
+  return i + n == len || !(isalnum((unsigned char)s[i + n]) || s[i + n] == '_');
+}
+
+// bracket balance change of a physical line, ignoring strings and comments. In L-strings
+// (after produce/nproduce, after -->, on Axiom:/ignore:/consider: lines) only parentheses
+// count: [ ] { } are modules there, and a trailing \ is the RollR module, not a continuation.
 static int bracket_delta(const char* s, int len, int* backslash) {
   int d = 0;
   char q = 0;
+  int lstr = 0;
   *backslash = 0;
+  static const char* lstr_lines[] = {"Axiom:", "axiom:", "ignore:", "consider:"};
+  for (size_t k = 0; k < sizeof lstr_lines / sizeof lstr_lines[0]; k++)
+    if (len >= (int)strlen(lstr_lines[k]) && memcmp(s, lstr_lines[k], strlen(lstr_lines[k])) == 0) lstr = 1;
   for (int i = 0; i < len; i++) {
     char c = s[i];
     if (q) {
@@ -82,13 +95,16 @@ static int bracket_delta(const char* s, int len, int* backslash) {
       continue;
     }
     if (c == '#') break;
+    if (!lstr && (word_at(s, len, i, "produce") || word_at(s, len, i, "nproduce") ||
+                  (i + 3 <= len && memcmp(s + i, "-->", 3) == 0)))
+      lstr = 1;
     if (c == '\'' || c == '"') q = c;
-    else if (c == '(' || c == '[' || c == '{') d++;
-    else if (c == ')' || c == ']' || c == '}') d--;
+    else if (c == '(' || (!lstr && (c == '[' || c == '{'))) d++;
+    else if (c == ')' || (!lstr && (c == ']' || c == '}'))) d--;
   }
   int e = len;
   while (e > 0 && isspace((unsigned char)s[e - 1])) e--;
-  if (e > 0 && s[e - 1] == '\\' && !q) *backslash = 1;
+  if (e > 0 && s[e - 1] == '\\' && !q && !lstr) *backslash = 1;
   return d;
 }
 
