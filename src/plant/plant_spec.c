@@ -233,12 +233,32 @@ static void label_set_name(vd_label* l, const char* name) {
   l->organ = vd_organ_from_name(l->name);
 }
 
+// colour of a label: by organ kind when the name tells it (fruit red, leaf green, ...), with a
+// small brightness shift by id so two labels of one organ stay apart; else the palette by id
+static void label_rgb(const vd_label* l, float rgb[3]) {
+  static const float organ_rgb[VD_ORGAN_COUNT][3] = {
+      [VD_ORGAN_STEM] = {0.45f, 0.30f, 0.16f},   [VD_ORGAN_LEAF] = {0.26f, 0.56f, 0.18f},
+      [VD_ORGAN_FLOWER] = {0.93f, 0.80f, 0.25f}, [VD_ORGAN_FRUIT] = {0.86f, 0.16f, 0.10f},
+      [VD_ORGAN_PEDICEL] = {0.45f, 0.65f, 0.25f}, [VD_ORGAN_ROOT] = {0.72f, 0.58f, 0.38f}};
+  if (l->organ == VD_ORGAN_OTHER) {
+    vd_plant_default_rgb(l->id, rgb);
+    return;
+  }
+  float f = 0.8f + 0.4f * (float)((l->id * 37) % 10) / 10.0f;
+  for (int k = 0; k < 3; k++) {
+    float c = organ_rgb[l->organ][k] * f;
+    rgb[k] = c > 1 ? 1 : c;
+  }
+}
+
 vd_status vd_plant_set_label(vd_plant_spec* s, int id, const char* name) {
   if (!s || !name || id < 0) return VD_ERR_ARG;
   int k = label_lower_bound(s->label, s->nlabel, id);
   // rename an existing entry (its colour stays)
   if (k < s->nlabel && s->label[k].id == id) {
+    vd_organ before = s->label[k].organ;
     label_set_name(&s->label[k], name);
+    if (s->label[k].organ != before && s->label[k].organ != VD_ORGAN_OTHER) label_rgb(&s->label[k], s->label[k].rgb);
     return VD_OK;
   }
   // insert a new entry at its sorted place
@@ -249,7 +269,7 @@ vd_status vd_plant_set_label(vd_plant_spec* s, int id, const char* name) {
   memset(l, 0, sizeof *l);
   l->id = id;
   label_set_name(l, name);
-  vd_plant_default_rgb(id, l->rgb);
+  label_rgb(l, l->rgb);
   s->nlabel++;
   return VD_OK;
 }
