@@ -14,7 +14,7 @@ d = json.load(open(sys.argv[1]))
 print(f"   {d['modules']} modules, {d['segments']} segments, {d['spheres']} spheres, {d['leaves']} leaves")
 print("   organs by label: " + ", ".join(f"{k} {v}" for k, v in d["labels"].items()))
 lo, hi = d["bbox_min"], d["bbox_max"]
-print(f"   size {hi[0]-lo[0]:.2f} x {hi[1]-lo[1]:.2f} x {hi[2]-lo[2]:.2f} m, {d['total_length']:.2f} m of stems")
+print(f"   size {hi[0]-lo[0]:.2f} x {hi[1]-lo[1]:.2f} x {hi[2]-lo[2]:.2f} m, {d['total_length']:.2f} m of segments in all")
 PY
 for p in arabidopsis tree lilac; do
   echo "== growing data/$p.lpy"
