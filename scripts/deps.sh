@@ -3,7 +3,9 @@
 # Installs the Debian packages verdant needs, when missing. As root it runs apt-get itself;
 # otherwise it prints the exact command and fails.
 set -eu
-need=(cmake make gcc pkg-config libcjson-dev python3)
+# build and test: cmake make gcc pkg-config; JSON: libcjson-dev; PNG: libpng-dev;
+# robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3
+need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3)
 missing=()
 for p in "${need[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -57,7 +57,7 @@ TEST(core, arena) {
   vd_arena_free(&a);
 }
 
-TEST(rng, matches_cpython) {
+TEST(core, rng_matches_cpython) {
   // reference values printed by CPython 3.11: random.seed(42); random.random() ...
   vd_rng r;
   vd_rng_seed(&r, 42);
@@ -76,7 +76,7 @@ TEST(rng, matches_cpython) {
   CHECK(vd_rng_random(&r) == 0.8444218515250481);
 }
 
-TEST(rng, streams_independent_and_reproducible) {
+TEST(core, rng_streams_independent_and_reproducible) {
   vd_rng a, b, c;
   vd_rng_stream(&a, 7, 3);
   vd_rng_stream(&b, 7, 3);
