@@ -577,6 +577,36 @@ TEST(collide, broad_phase_equals_brute_force) {
   CHECK_STATUS(vd_collide_self(&p, &def, &arena, &L2, &err), VD_OK, err);
   CHECK_INT(L2.n, 5);
   CHECK_INT(L2.ndropped, nb - 5);
+  // the broad phase alone with a larger growth, reused after small moves: the same contacts as
+  // a full query on the moved plant
+  def.max_contacts = 1000000;
+  vd_arena keep;
+  vd_arena_init(&keep, 0);
+  vd_pair_list pairs;
+  CHECK_STATUS(vd_collide_self_pairs(&p, 0.015, &keep, &pairs, &err), VD_OK, err);
+  CHECK(pairs.n > nb);
+  int sorted = 1;
+  for (int k = 1; k < pairs.n; k++)
+    sorted &= pairs.pair[2 * k - 2] < pairs.pair[2 * k] ||
+              (pairs.pair[2 * k - 2] == pairs.pair[2 * k] &&
+               pairs.pair[2 * k - 1] < pairs.pair[2 * k + 1]);
+  CHECK(sorted);
+  for (int i = 0; i < 3 * sp.nnode; i++)
+    sp.node[i] += vd_rng_uniform(&r, -0.0028, 0.0028) / sqrt(3);
+  for (int i = 0; i < 3 * sp.nsph; i++)
+    sp.sph[i] += vd_rng_uniform(&r, -0.0028, 0.0028) / sqrt(3);
+  vd_contact_list full, reused;
+  vd_arena_reset(&arena);
+  CHECK_STATUS(vd_collide_self(&p, &def, &arena, &full, &err), VD_OK, err);
+  CHECK_STATUS(vd_collide_pairs(&p, &pairs, &def, &arena, &reused, &err), VD_OK, err);
+  CHECK(full.n > 20 && full.n == reused.n &&
+        memcmp(full.c, reused.c, (size_t)full.n * sizeof *full.c) == 0);
+  CHECK_INT(reused.ntested, pairs.n);
+  // a bad pair list is refused
+  int bad[2] = {3, 3};
+  vd_pair_list bl = {1, bad};
+  CHECK_STATUS(vd_collide_pairs(&p, &bl, &def, &arena, &reused, &err), VD_ERR_ARG, err);
+  vd_arena_free(&keep);
   vd_arena_free(&arena);
   vd_collide_exclusion_free(&ex);
 }

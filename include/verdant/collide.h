@@ -229,6 +229,22 @@ vd_status vd_collide_colliders(const vd_collide_prims* prims, const vd_collider*
 // their surfaces are closer than margin, else 0.
 int vd_collide_pair(const vd_collide_prims* prims, int i, int j, double margin, vd_contact* c);
 
+// Candidate pairs of the broad phase, to reuse over several steps (a Verlet list).
+typedef struct vd_pair_list {
+  int n;     // pairs
+  int* pair; // primitive pairs (a < b), ascending by (a, b) (n x 2), in an arena
+} vd_pair_list;
+
+// The broad phase alone: pairs (not excluded, not skipped) whose boxes, grown by `grow` (m),
+// overlap. While no primitive moves more than (grow - margin) / 2, every contact within margin
+// is among them: build them every few steps into an arena kept until the next build.
+vd_status vd_collide_self_pairs(const vd_collide_prims* prims, double grow, vd_arena* arena,
+                                vd_pair_list* out, vd_error* err);
+// The narrow phase over given pairs: their contacts within def.margin, sorted by (a, b).
+vd_status vd_collide_pairs(const vd_collide_prims* prims, const vd_pair_list* pairs,
+                           const vd_collide_def* def, vd_arena* arena, vd_contact_list* out,
+                           vd_error* err);
+
 #ifdef __cplusplus
 }
 #endif

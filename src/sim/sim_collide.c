@@ -15,8 +15,13 @@
 
 #include "verdant/collide.h"
 
-// bisection steps: 2^-60 of the axis is below double round-off
-#define BISECT_STEPS 60
+// bisection steps: 2^-52 of the axis is at double round-off
+#define BISECT_STEPS 52
+
+// Euclidean length (inline: the queries below are the inner loop of every step)
+static inline double len3(vd_vec3 a) {
+  return sqrt(vd_dot(a, a));
+}
 
 vd_pose vd_pose_identity(void) {
   vd_pose p = {{0, 0, 0}, {1, 0, 0, 0}};
@@ -98,8 +103,32 @@ void vd_collider_set_pose(vd_collider* c, vd_pose pose) {
   c->pose = pose;
 }
 
-static vd_vec3 to_local(const vd_pose* p, vd_vec3 x) {
-  return vd_quat_rotate(vd_quat_conj(p->rot), vd_sub(x, p->pos));
+// a pose as a rotation matrix, built once per query (cheaper than quaternion rotations)
+typedef struct frame {
+  double R[9]; // columns: the local axes in world (row-major)
+  vd_vec3 pos; // origin (m)
+} frame;
+
+static frame frame_of(const vd_pose* p) {
+  frame f;
+  vd_quat q = p->rot;
+  double w = q.w, x = q.x, y = q.y, z = q.z;
+  f.R[0] = 1 - 2 * (y * y + z * z), f.R[1] = 2 * (x * y - w * z), f.R[2] = 2 * (x * z + w * y);
+  f.R[3] = 2 * (x * y + w * z), f.R[4] = 1 - 2 * (x * x + z * z), f.R[5] = 2 * (y * z - w * x);
+  f.R[6] = 2 * (x * z - w * y), f.R[7] = 2 * (y * z + w * x), f.R[8] = 1 - 2 * (x * x + y * y);
+  f.pos = p->pos;
+  return f;
+}
+static vd_vec3 f_rotate(const frame* f, vd_vec3 v) {
+  const double* R = f->R;
+  return vd_v3(R[0] * v.x + R[1] * v.y + R[2] * v.z, R[3] * v.x + R[4] * v.y + R[5] * v.z,
+               R[6] * v.x + R[7] * v.y + R[8] * v.z);
+}
+static vd_vec3 f_local(const frame* f, vd_vec3 x) {
+  const double* R = f->R;
+  vd_vec3 v = vd_sub(x, f->pos);
+  return vd_v3(R[0] * v.x + R[3] * v.y + R[6] * v.z, R[1] * v.x + R[4] * v.y + R[7] * v.z,
+               R[2] * v.x + R[5] * v.y + R[8] * v.z);
 }
 static vd_vec3 to_world(const vd_pose* p, vd_vec3 x) {
   return vd_add(p->pos, vd_quat_rotate(p->rot, x));
@@ -156,14 +185,14 @@ static double shape_sd(const vd_collider* c, vd_vec3 p, vd_vec3* n) {
     *n = vd_v3(0, 0, 1);
     return p.z;
   case VD_SHAPE_SPHERE: {
-    double d = vd_norm(p);
+    double d = len3(p);
     *n = d > 0 ? vd_scale(p, 1.0 / d) : vd_v3(0, 0, 1);
     return d - c->radius;
   }
   case VD_SHAPE_CAPSULE: {
     double h = c->half_length, z = p.z < -h ? -h : (p.z > h ? h : p.z);
     vd_vec3 v = vd_v3(p.x, p.y, p.z - z);
-    double d = vd_norm(v);
+    double d = len3(v);
     *n = d > 0 ? vd_scale(v, 1.0 / d) : vd_v3(1, 0, 0);
     return d - c->radius;
   }
@@ -196,7 +225,7 @@ static double shape_sd(const vd_collider* c, vd_vec3 p, vd_vec3* n) {
   case VD_SHAPE_SDF: {
     vd_vec3 g;
     double d = vd_sdf_eval(c->sdf, p, &g);
-    double len = vd_norm(g);
+    double len = len3(g);
     *n = len > 0 ? vd_scale(g, 1.0 / len) : vd_v3(0, 0, 1);
     return d;
   }
@@ -207,14 +236,20 @@ static double shape_sd(const vd_collider* c, vd_vec3 p, vd_vec3* n) {
   }
 }
 
-static vd_hit hit_from_local(const vd_collider* c, vd_vec3 pw, double sd, vd_vec3 nl, double r,
+static vd_hit hit_from_local(const frame* f, vd_vec3 pw, double sd, vd_vec3 nl, double r,
                              double t) {
   vd_hit h;
-  h.normal = vd_quat_rotate(c->pose.rot, nl);
+  h.normal = f_rotate(f, nl);
   h.point = vd_madd(pw, h.normal, -sd);
   h.dist = sd - r;
   h.t = t;
   return h;
+}
+
+static vd_hit sphere_query(const vd_collider* c, const frame* f, vd_vec3 p, double r) {
+  vd_vec3 n;
+  double sd = shape_sd(c, f_local(f, p), &n);
+  return hit_from_local(f, p, sd, n, r, 0);
 }
 
 vd_hit vd_collide_point(const vd_collider* c, vd_vec3 p) {
@@ -223,9 +258,8 @@ vd_hit vd_collide_point(const vd_collider* c, vd_vec3 p) {
 
 vd_hit vd_collide_sphere(const vd_collider* c, vd_vec3 p, double r) {
   VD_ASSERT(c);
-  vd_vec3 n;
-  double sd = shape_sd(c, to_local(&c->pose, p), &n);
-  return hit_from_local(c, p, sd, n, r, 0);
+  frame f = frame_of(&c->pose);
+  return sphere_query(c, &f, p, r);
 }
 
 // derivative of f(t) = sd(a + t d) - (ra + t dr) along the axis (a subgradient at kinks)
@@ -238,7 +272,7 @@ static double axis_slope(const vd_collider* c, vd_vec3 a, vd_vec3 d, double dr, 
 // the deepest axis parameter of a convex shape: the minimiser of the convex f, the middle of the
 // flat part when f is flat (slopes within tol of zero)
 static double convex_argmin(const vd_collider* c, vd_vec3 a, vd_vec3 d, double dr) {
-  double tol = 1e-12 * (vd_norm(d) + fabs(dr));
+  double tol = 1e-12 * (len3(d) + fabs(dr));
   if (!(tol > 0)) return 0.5; // the axis is a point with one radius
   // the lowest t with slope >= -tol, and the highest with slope <= tol
   double lo_end, hi_end;
@@ -275,6 +309,21 @@ static double convex_argmin(const vd_collider* c, vd_vec3 a, vd_vec3 d, double d
   return 0.5 * (lo_end + hi_end);
 }
 
+// the deepest axis parameter against a sphere at the origin, in closed form: f(t) = |a + t d|
+// - t dr (+ constants) has f' = 0 where (t - t0) |d|^2 / |a + t d| = dr, t0 the foot of the
+// perpendicular from the centre, so t = t0 + dr h / (|d| sqrt(|d|^2 - dr^2)), h the distance
+// from the centre to the axis line; clamped to the axis (f is convex)
+static double sphere_argmin(vd_vec3 a, vd_vec3 d, double dr) {
+  double dd = vd_dot(d, d);
+  if (!(dd > 0)) return 0.5;
+  if (dr * dr >= dd) return dr > 0 ? 1 : 0; // one end's sphere holds the whole capsule
+  double t0 = -vd_dot(a, d) / dd;
+  vd_vec3 foot = vd_madd(a, d, t0);
+  double h = len3(foot);
+  double t = t0 + dr * h / (sqrt(dd) * sqrt(dd - dr * dr));
+  return t < 0 ? 0 : (t > 1 ? 1 : t);
+}
+
 // f along the axis of a capsule in the collider's frame
 static double axis_f(const vd_collider* c, vd_vec3 a, vd_vec3 d, double ra, double dr, double t) {
   vd_vec3 n;
@@ -284,7 +333,7 @@ static double axis_f(const vd_collider* c, vd_vec3 a, vd_vec3 d, double ra, doub
 // the deepest axis parameter against a distance grid: samples every half cell, then a
 // golden-section search around the best sample
 static double sdf_argmin(const vd_collider* c, vd_vec3 a, vd_vec3 d, double ra, double dr) {
-  double len = vd_norm(d);
+  double len = len3(d);
   int m = (int)ceil(len / (0.5 * c->sdf->cell));
   if (m < 1) m = 1;
   if (m > 4096) m = 4096;
@@ -313,17 +362,25 @@ static double sdf_argmin(const vd_collider* c, vd_vec3 a, vd_vec3 d, double ra, 
   return fmin(f1, f2) < fb ? t : (double)best / m;
 }
 
-vd_hit vd_collide_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double ra, double rb) {
-  VD_ASSERT(c);
+static vd_hit capsule_query(const vd_collider* c, const frame* f, vd_vec3 a, vd_vec3 b, double ra,
+                            double rb) {
   // the axis in the collider's frame
-  vd_vec3 al = to_local(&c->pose, a), bl = to_local(&c->pose, b);
+  vd_vec3 al = f_local(f, a), bl = f_local(f, b);
   vd_vec3 d = vd_sub(bl, al);
   double dr = rb - ra;
-  double t = c->shape == VD_SHAPE_SDF ? sdf_argmin(c, al, d, ra, dr) : convex_argmin(c, al, d, dr);
+  double t = c->shape == VD_SHAPE_SDF      ? sdf_argmin(c, al, d, ra, dr)
+             : c->shape == VD_SHAPE_SPHERE ? sphere_argmin(al, d, dr)
+                                           : convex_argmin(c, al, d, dr);
   // the hit at the deepest axis point
   vd_vec3 n;
   double sd = shape_sd(c, vd_madd(al, d, t), &n);
-  return hit_from_local(c, vd_madd(a, vd_sub(b, a), t), sd, n, ra + t * dr, t);
+  return hit_from_local(f, vd_madd(a, vd_sub(b, a), t), sd, n, ra + t * dr, t);
+}
+
+vd_hit vd_collide_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double ra, double rb) {
+  VD_ASSERT(c);
+  frame f = frame_of(&c->pose);
+  return capsule_query(c, &f, a, b, ra, rb);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -401,7 +458,7 @@ int vd_collide_pair(const vd_collide_prims* P, int i, int j, double margin, vd_c
     double rb =
         P->capsule_radius[2 * j] + c.tb * (P->capsule_radius[2 * j + 1] - P->capsule_radius[2 * j]);
     vd_vec3 v = vd_sub(pa, pb);
-    double d = vd_norm(v);
+    double d = len3(v);
     c.dist = d - ra - rb;
     if (!(c.dist < margin)) return 0;
     double scale = vd_norm(vd_sub(a1, a0)) + vd_norm(vd_sub(b1, b0));
@@ -465,18 +522,13 @@ static int cbuf_push(vd_arena* ar, cbuf* b, const vd_contact* c) {
   return 1;
 }
 
-static int cmp_contact(const void* pa, const void* pb) {
-  const vd_contact *x = pa, *y = pb;
-  if (x->a != y->a) return x->a < y->a ? -1 : 1;
-  return (x->b > y->b) - (x->b < y->b);
-}
-
 // bounding box of primitive i, grown by g on every side
 static void prim_bounds(const vd_collide_prims* P, int i, double g, vd_vec3* lo, vd_vec3* hi) {
   if (i < P->ncapsule) {
     vd_vec3 a = vec_at(P->node_pos, P->capsule_node[2 * i]);
     vd_vec3 b = vec_at(P->node_pos, P->capsule_node[2 * i + 1]);
-    double r = fmax(P->capsule_radius[2 * i], P->capsule_radius[2 * i + 1]) + g;
+    double r0 = P->capsule_radius[2 * i], r1 = P->capsule_radius[2 * i + 1];
+    double r = (r0 > r1 ? r0 : r1) + g;
     *lo = vd_sub(vd_vmin(a, b), vd_v3(r, r, r));
     *hi = vd_add(vd_vmax(a, b), vd_v3(r, r, r));
   } else {
@@ -523,20 +575,145 @@ static vd_status check_prims(const vd_collide_prims* P, const vd_collide_def* de
   return VD_OK;
 }
 
-// sort key of the sweep: the box's low end on the sweep axis, ties by index
-typedef struct sap_key {
-  double lo;
-  int i;
-} sap_key;
+// a sort key: ordered by k, then t (sweep: box low end, primitive; contacts: a, then b with
+// the contact's index in the low 31 bits)
+typedef struct skey {
+  double k;
+  int64_t t;
+} skey;
 
-static int cmp_sap(const void* pa, const void* pb) {
-  const sap_key *x = pa, *y = pb;
-  if (x->lo != y->lo) return x->lo < y->lo ? -1 : 1;
-  return (x->i > y->i) - (x->i < y->i);
+static int skey_before(const skey* x, const skey* y) {
+  return x->k < y->k || (x->k == y->k && x->t < y->t);
+}
+
+// bottom-up merge sort of n keys with tmp (n keys) as scratch; returns the sorted array (a or
+// tmp). Both come from the caller's arena: no heap in a step (qsort may allocate)
+static skey* sort_keys(skey* a, skey* tmp, int n) {
+  skey *src = a, *dst = tmp;
+  for (int w = 1; w < n; w *= 2) {
+    for (int lo = 0; lo < n; lo += 2 * w) {
+      int mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+      int i = lo, j = mid, o = lo;
+      while (i < mid && j < hi)
+        dst[o++] = skey_before(&src[j], &src[i]) ? src[j++] : src[i++];
+      while (i < mid)
+        dst[o++] = src[i++];
+      while (j < hi)
+        dst[o++] = src[j++];
+    }
+    skey* x = src;
+    src = dst, dst = x;
+  }
+  return src;
+}
+
+// the contact list ordered by (a, b), copied into a fresh arena array; 0 when out of memory
+static int sort_contacts(vd_arena* ar, cbuf* b) {
+  if (b->n < 2) return 1;
+  skey* k = vd_arena_alloc(ar, (size_t)b->n * sizeof *k);
+  skey* tmp = vd_arena_alloc(ar, (size_t)b->n * sizeof *tmp);
+  vd_contact* out = vd_arena_alloc(ar, (size_t)b->n * sizeof *out);
+  if (!k || !tmp || !out) return 0;
+  for (int i = 0; i < b->n; i++)
+    k[i].k = b->c[i].a, k[i].t = ((int64_t)b->c[i].b << 31) | i;
+  skey* s = sort_keys(k, tmp, b->n);
+  for (int i = 0; i < b->n; i++)
+    out[i] = b->c[s[i].t & 0x7fffffff];
+  b->c = out, b->cap = b->n;
+  return 1;
 }
 
 static double comp(vd_vec3 v, int a) {
   return a == 0 ? v.x : (a == 1 ? v.y : v.z);
+}
+
+// a growable array of candidate pairs (a < b) in the arena
+typedef struct pbuf {
+  int* p; // (n x 2)
+  int n, cap;
+} pbuf;
+
+static int pbuf_push(vd_arena* ar, pbuf* b, int i, int j) {
+  if (b->n == b->cap) {
+    int cap = b->cap ? 2 * b->cap : 256;
+    int* p = vd_arena_alloc(ar, (size_t)cap * 2 * sizeof *p);
+    if (!p) return 0;
+    if (b->n) memcpy(p, b->p, (size_t)b->n * 2 * sizeof *p);
+    b->p = p, b->cap = cap;
+  }
+  b->p[2 * b->n] = i, b->p[2 * b->n + 1] = j;
+  b->n++;
+  return 1;
+}
+
+// the broad phase: pairs of primitives that take part, are not excluded and whose boxes, grown
+// by grow / 2 each, overlap; sweep and prune along the axis where the box centres spread most
+static vd_status broad_phase(const vd_collide_prims* P, double grow, vd_arena* arena, pbuf* out,
+                             vd_error* err) {
+  const char* oom = "collide: arena out of memory";
+  int n = P->ncapsule + P->nsphere;
+  out->p = NULL, out->n = out->cap = 0;
+  if (n < 2) return VD_OK;
+  vd_vec3* lo = vd_arena_alloc(arena, (size_t)n * sizeof *lo);
+  vd_vec3* hi = vd_arena_alloc(arena, (size_t)n * sizeof *hi);
+  skey* key = vd_arena_alloc(arena, (size_t)n * sizeof *key);
+  skey* tmp = vd_arena_alloc(arena, (size_t)n * sizeof *tmp);
+  if (!lo || !hi || !key || !tmp) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
+  int m = 0;
+  vd_vec3 cmin = vd_v3(HUGE_VAL, HUGE_VAL, HUGE_VAL), cmax = vd_scale(cmin, -1);
+  for (int i = 0; i < n; i++) {
+    if (P->skip && P->skip[i]) continue;
+    prim_bounds(P, i, 0.5 * grow, &lo[i], &hi[i]);
+    vd_vec3 c = vd_scale(vd_add(lo[i], hi[i]), 0.5);
+    cmin = vd_vmin(cmin, c), cmax = vd_vmax(cmax, c);
+    key[m++].t = i;
+  }
+  vd_vec3 spread = vd_sub(cmax, cmin);
+  int ax = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
+  for (int k = 0; k < m; k++)
+    key[k].k = comp(lo[key[k].t], ax);
+  key = sort_keys(key, tmp, m);
+  for (int k = 0; k < m; k++) {
+    int i = (int)key[k].t;
+    double end = comp(hi[i], ax);
+    for (int q = k + 1; q < m && key[q].k <= end; q++) {
+      int j = (int)key[q].t;
+      // boxes overlap on the other two axes, the pair is not excluded
+      if (lo[i].x > hi[j].x || lo[j].x > hi[i].x || lo[i].y > hi[j].y || lo[j].y > hi[i].y ||
+          lo[i].z > hi[j].z || lo[j].z > hi[i].z)
+        continue;
+      int a = i < j ? i : j, b = i < j ? j : i;
+      if (excluded(P, a, b)) continue;
+      if (!pbuf_push(arena, out, a, b)) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
+    }
+  }
+  return VD_OK;
+}
+
+// the narrow phase over candidate pairs, contacts sorted by (a, b)
+static vd_status narrow_phase(const vd_collide_prims* P, const int* pair, int npair,
+                              const vd_collide_def* def, vd_arena* arena, vd_contact_list* out,
+                              vd_error* err) {
+  cbuf buf = {NULL, 0, 0};
+  for (int k = 0; k < npair; k++) {
+    int a = pair[2 * k], b = pair[2 * k + 1];
+    if (P->skip && (P->skip[a] || P->skip[b])) continue;
+    out->ntested++;
+    vd_contact c;
+    if (!vd_collide_pair(P, a, b, def->margin, &c)) continue;
+    if (buf.n >= def->max_contacts) {
+      out->ndropped++;
+      continue;
+    }
+    if (!cbuf_push(arena, &buf, &c))
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
+  }
+  // fixed order whatever the sweep met first
+  if (!sort_contacts(arena, &buf))
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
+  out->n = buf.n;
+  out->c = buf.c;
+  return VD_OK;
 }
 
 vd_status vd_collide_self(const vd_collide_prims* P, const vd_collide_def* def_in, vd_arena* arena,
@@ -544,56 +721,55 @@ vd_status vd_collide_self(const vd_collide_prims* P, const vd_collide_def* def_i
   vd_status st = check_prims(P, def_in, arena, out, err);
   if (st) return st;
   vd_collide_def def = def_in ? *def_in : vd_collide_def_default();
-  int n = P->ncapsule + P->nsphere;
-  if (n < 2) return VD_OK;
-  const char* oom = "collide: arena out of memory";
-  // boxes of the primitives that take part, grown by half the margin each
-  vd_vec3* lo = vd_arena_alloc(arena, (size_t)n * sizeof *lo);
-  vd_vec3* hi = vd_arena_alloc(arena, (size_t)n * sizeof *hi);
-  sap_key* key = vd_arena_alloc(arena, (size_t)n * sizeof *key);
-  if (!lo || !hi || !key) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
-  int m = 0;
-  vd_vec3 cmin = vd_v3(HUGE_VAL, HUGE_VAL, HUGE_VAL), cmax = vd_scale(cmin, -1);
-  for (int i = 0; i < n; i++) {
-    if (P->skip && P->skip[i]) continue;
-    prim_bounds(P, i, 0.5 * def.margin, &lo[i], &hi[i]);
-    vd_vec3 c = vd_scale(vd_add(lo[i], hi[i]), 0.5);
-    cmin = vd_vmin(cmin, c), cmax = vd_vmax(cmax, c);
-    key[m++].i = i;
+  pbuf pairs;
+  if ((st = broad_phase(P, def.margin, arena, &pairs, err))) return st;
+  return narrow_phase(P, pairs.p, pairs.n, &def, arena, out, err);
+}
+
+vd_status vd_collide_self_pairs(const vd_collide_prims* P, double grow, vd_arena* arena,
+                                vd_pair_list* out, vd_error* err) {
+  vd_contact_list dummy;
+  if (!out) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: null argument");
+  memset(out, 0, sizeof *out);
+  vd_status st = check_prims(P, NULL, arena, &dummy, err);
+  if (st) return st;
+  if (!(grow >= 0) || !isfinite(grow))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: grow must be >= 0 m");
+  pbuf pairs;
+  if ((st = broad_phase(P, grow, arena, &pairs, err))) return st;
+  // ascending (a, b)
+  if (pairs.n > 1) {
+    skey* k = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *k);
+    skey* tmp = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *tmp);
+    int* sorted = vd_arena_alloc(arena, (size_t)pairs.n * 2 * sizeof *sorted);
+    if (!k || !tmp || !sorted)
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
+    for (int i = 0; i < pairs.n; i++)
+      k[i].k = pairs.p[2 * i], k[i].t = pairs.p[2 * i + 1];
+    skey* s = sort_keys(k, tmp, pairs.n);
+    for (int i = 0; i < pairs.n; i++)
+      sorted[2 * i] = (int)s[i].k, sorted[2 * i + 1] = (int)s[i].t;
+    pairs.p = sorted;
   }
-  // sweep along the axis where the box centres spread most
-  vd_vec3 spread = vd_sub(cmax, cmin);
-  int ax = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
-  for (int k = 0; k < m; k++)
-    key[k].lo = comp(lo[key[k].i], ax);
-  qsort(key, (size_t)m, sizeof *key, cmp_sap);
-  cbuf buf = {NULL, 0, 0};
-  for (int k = 0; k < m; k++) {
-    int i = key[k].i;
-    double end = comp(hi[i], ax);
-    for (int q = k + 1; q < m && key[q].lo <= end; q++) {
-      int j = key[q].i;
-      // boxes overlap on the other two axes, the pair is not excluded
-      if (lo[i].x > hi[j].x || lo[j].x > hi[i].x || lo[i].y > hi[j].y || lo[j].y > hi[i].y ||
-          lo[i].z > hi[j].z || lo[j].z > hi[i].z)
-        continue;
-      int a = i < j ? i : j, b = i < j ? j : i;
-      if (excluded(P, a, b)) continue;
-      out->ntested++;
-      vd_contact c;
-      if (!vd_collide_pair(P, a, b, def.margin, &c)) continue;
-      if (buf.n >= def.max_contacts) {
-        out->ndropped++;
-        continue;
-      }
-      if (!cbuf_push(arena, &buf, &c)) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
-    }
-  }
-  // fixed order whatever the sweep met first
-  if (buf.n > 1) qsort(buf.c, (size_t)buf.n, sizeof *buf.c, cmp_contact);
-  out->n = buf.n;
-  out->c = buf.c;
+  out->n = pairs.n;
+  out->pair = pairs.p;
   return VD_OK;
+}
+
+vd_status vd_collide_pairs(const vd_collide_prims* P, const vd_pair_list* pairs,
+                           const vd_collide_def* def_in, vd_arena* arena, vd_contact_list* out,
+                           vd_error* err) {
+  vd_status st = check_prims(P, def_in, arena, out, err);
+  if (st) return st;
+  if (!pairs || (pairs->n > 0 && !pairs->pair) || pairs->n < 0)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: bad pair list");
+  int n = P->ncapsule + P->nsphere;
+  for (int k = 0; k < 2 * pairs->n; k++)
+    if (pairs->pair[k] < 0 || pairs->pair[k] >= n ||
+        (k % 2 && pairs->pair[k] == pairs->pair[k - 1]))
+      return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: pair %d: bad primitive", k / 2);
+  vd_collide_def def = def_in ? *def_in : vd_collide_def_default();
+  return narrow_phase(P, pairs->pair, pairs->n, &def, arena, out, err);
 }
 
 vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col, int ncol,
@@ -612,6 +788,7 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
   cbuf buf = {NULL, 0, 0};
   for (int k = 0; k < ncol; k++) {
     const vd_collider* c = &col[k];
+    frame f = frame_of(&c->pose);
     vd_vec3 clo, chi;
     vd_collider_bounds(c, &clo, &chi);
     for (int i = 0; i < n; i++) {
@@ -631,13 +808,13 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
         vd_vec3 a0 = vec_at(P->node_pos, P->capsule_node[2 * i]);
         vd_vec3 a1 = vec_at(P->node_pos, P->capsule_node[2 * i + 1]);
         double r0 = P->capsule_radius[2 * i], r1 = P->capsule_radius[2 * i + 1];
-        h = vd_collide_capsule(c, a0, a1, r0, r1);
+        h = capsule_query(c, &f, a0, a1, r0, r1);
         ct.ta = h.t;
         ct.pa = vd_madd(vd_madd(a0, vd_sub(a1, a0), h.t), h.normal, -(r0 + h.t * (r1 - r0)));
       } else {
         vd_vec3 ci = vec_at(P->sphere_pos, i - P->ncapsule);
         double ri = P->sphere_radius[i - P->ncapsule];
-        h = vd_collide_sphere(c, ci, ri);
+        h = sphere_query(c, &f, ci, ri);
         ct.pa = vd_madd(ci, h.normal, -ri);
       }
       if (!(h.dist < def.margin)) continue;
@@ -652,7 +829,8 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
         return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
     }
   }
-  if (buf.n > 1) qsort(buf.c, (size_t)buf.n, sizeof *buf.c, cmp_contact);
+  if (!sort_contacts(arena, &buf))
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
   out->n = buf.n;
   out->c = buf.c;
   return VD_OK;
