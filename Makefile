@@ -26,6 +26,9 @@ test: all
 
 bench: all
 	./$(BUILD)/verdant_bench $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_collide --csv bench/results/collide-2core.csv
+	@if [ -x ./$(BUILD)/verdant_bench_mujoco ]; then \
+	  ./$(BUILD)/verdant_bench_mujoco --csv bench/results/mujoco-chain-2core.csv; fi
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant

@@ -601,7 +601,7 @@ TEST(collide, broad_phase_equals_brute_force) {
   CHECK_STATUS(vd_collide_pairs(&p, &pairs, &def, &arena, &reused, &err), VD_OK, err);
   CHECK(full.n > 20 && full.n == reused.n &&
         memcmp(full.c, reused.c, (size_t)full.n * sizeof *full.c) == 0);
-  CHECK_INT(reused.ntested, pairs.n);
+  CHECK(reused.ntested < pairs.n);  // the current boxes cull most candidates first
   // a bad pair list is refused
   int bad[2] = {3, 3};
   vd_pair_list bl = {1, bad};

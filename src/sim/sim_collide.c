@@ -347,7 +347,7 @@ static double sdf_argmin(const vd_collider* c, vd_vec3 a, vd_vec3 d, double ra, 
   const double g = 0.6180339887498949;
   double x1 = h - g * (h - l), x2 = l + g * (h - l);
   double f1 = axis_f(c, a, d, ra, dr, x1), f2 = axis_f(c, a, d, ra, dr, x2);
-  for (int i = 0; i < 40; i++) {
+  for (int i = 0; i < 24; i++) {
     if (f1 <= f2) {
       h = x2, x2 = x1, f2 = f1;
       x1 = h - g * (h - l);
@@ -368,9 +368,18 @@ static vd_hit capsule_query(const vd_collider* c, const frame* f, vd_vec3 a, vd_
   vd_vec3 al = f_local(f, a), bl = f_local(f, b);
   vd_vec3 d = vd_sub(bl, al);
   double dr = rb - ra;
-  double t = c->shape == VD_SHAPE_SDF      ? sdf_argmin(c, al, d, ra, dr)
-             : c->shape == VD_SHAPE_SPHERE ? sphere_argmin(al, d, dr)
-                                           : convex_argmin(c, al, d, dr);
+  double t;
+  if (c->shape == VD_SHAPE_PLANE) {
+    // linear along the axis: the lower end, the middle when level
+    double f0 = al.z - ra, f1 = bl.z - rb, tol = 1e-12 * (len3(d) + fabs(dr));
+    t = f0 < f1 - tol ? 0 : (f1 < f0 - tol ? 1 : 0.5);
+  } else if (c->shape == VD_SHAPE_SPHERE) {
+    t = sphere_argmin(al, d, dr);
+  } else if (c->shape == VD_SHAPE_SDF) {
+    t = sdf_argmin(c, al, d, ra, dr);
+  } else {
+    t = convex_argmin(c, al, d, dr);
+  }
   // the hit at the deepest axis point
   vd_vec3 n;
   double sd = shape_sd(c, vd_madd(al, d, t), &n);
@@ -690,14 +699,22 @@ static vd_status broad_phase(const vd_collide_prims* P, double grow, vd_arena* a
   return VD_OK;
 }
 
-// the narrow phase over candidate pairs, contacts sorted by (a, b)
+// the narrow phase over candidate pairs, contacts sorted by (a, b); boxes: test the current
+// boxes first (pairs kept from an earlier broad phase)
 static vd_status narrow_phase(const vd_collide_prims* P, const int* pair, int npair,
-                              const vd_collide_def* def, vd_arena* arena, vd_contact_list* out,
-                              vd_error* err) {
+                              const vd_collide_def* def, int boxes, vd_arena* arena,
+                              vd_contact_list* out, vd_error* err) {
   cbuf buf = {NULL, 0, 0};
   for (int k = 0; k < npair; k++) {
     int a = pair[2 * k], b = pair[2 * k + 1];
     if (P->skip && (P->skip[a] || P->skip[b])) continue;
+    if (boxes) {
+      vd_vec3 la, ha, lb, hb;
+      prim_bounds(P, a, 0.5 * def->margin, &la, &ha);
+      prim_bounds(P, b, 0.5 * def->margin, &lb, &hb);
+      if (la.x > hb.x || lb.x > ha.x || la.y > hb.y || lb.y > ha.y || la.z > hb.z || lb.z > ha.z)
+        continue;
+    }
     out->ntested++;
     vd_contact c;
     if (!vd_collide_pair(P, a, b, def->margin, &c)) continue;
@@ -723,7 +740,7 @@ vd_status vd_collide_self(const vd_collide_prims* P, const vd_collide_def* def_i
   vd_collide_def def = def_in ? *def_in : vd_collide_def_default();
   pbuf pairs;
   if ((st = broad_phase(P, def.margin, arena, &pairs, err))) return st;
-  return narrow_phase(P, pairs.p, pairs.n, &def, arena, out, err);
+  return narrow_phase(P, pairs.p, pairs.n, &def, 0, arena, out, err);
 }
 
 vd_status vd_collide_self_pairs(const vd_collide_prims* P, double grow, vd_arena* arena,
@@ -769,7 +786,7 @@ vd_status vd_collide_pairs(const vd_collide_prims* P, const vd_pair_list* pairs,
         (k % 2 && pairs->pair[k] == pairs->pair[k - 1]))
       return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: pair %d: bad primitive", k / 2);
   vd_collide_def def = def_in ? *def_in : vd_collide_def_default();
-  return narrow_phase(P, pairs->pair, pairs->n, &def, arena, out, err);
+  return narrow_phase(P, pairs->pair, pairs->n, &def, 1, arena, out, err);
 }
 
 vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col, int ncol,
@@ -785,6 +802,13 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
       return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: collider %d: bad shape", k);
   vd_collide_def def = def_in ? *def_in : vd_collide_def_default();
   int n = P->ncapsule + P->nsphere;
+  // the primitives' boxes, grown by the margin, once for all colliders
+  vd_vec3* plo = vd_arena_alloc(arena, (size_t)(n ? n : 1) * sizeof *plo);
+  vd_vec3* phi = vd_arena_alloc(arena, (size_t)(n ? n : 1) * sizeof *phi);
+  if (!plo || !phi)
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
+  for (int i = 0; i < n; i++)
+    prim_bounds(P, i, def.margin, &plo[i], &phi[i]);
   cbuf buf = {NULL, 0, 0};
   for (int k = 0; k < ncol; k++) {
     const vd_collider* c = &col[k];
@@ -793,8 +817,7 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
     vd_collider_bounds(c, &clo, &chi);
     for (int i = 0; i < n; i++) {
       if (P->skip && P->skip[i]) continue;
-      vd_vec3 lo, hi;
-      prim_bounds(P, i, def.margin, &lo, &hi);
+      vd_vec3 lo = plo[i], hi = phi[i];
       if (lo.x > chi.x || clo.x > hi.x || lo.y > chi.y || clo.y > hi.y || lo.z > chi.z ||
           clo.z > hi.z)
         continue;
@@ -808,6 +831,14 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
         vd_vec3 a0 = vec_at(P->node_pos, P->capsule_node[2 * i]);
         vd_vec3 a1 = vec_at(P->node_pos, P->capsule_node[2 * i + 1]);
         double r0 = P->capsule_radius[2 * i], r1 = P->capsule_radius[2 * i + 1];
+        // far from the shape: the distance at the axis' middle less half the axis bounds every
+        // point's (signed distances are 1-Lipschitz; a trilinear grid's at most sqrt(3))
+        vd_vec3 nm;
+        double half = 0.5 * len3(vd_sub(a1, a0)),
+               lip = c->shape == VD_SHAPE_SDF ? 1.7320508075688772 : 1;
+        double sd_mid = shape_sd(c, f_local(&f, vd_scale(vd_add(a0, a1), 0.5)), &nm);
+        double slack = c->shape == VD_SHAPE_SDF ? 0.1 * c->sdf->cell : 0; // swept values' error
+        if (sd_mid - lip * half - (r0 > r1 ? r0 : r1) - slack >= def.margin) continue;
         h = capsule_query(c, &f, a0, a1, r0, r1);
         ct.ta = h.t;
         ct.pa = vd_madd(vd_madd(a0, vd_sub(a1, a0), h.t), h.normal, -(r0 + h.t * (r1 - r0)));
