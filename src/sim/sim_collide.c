@@ -584,33 +584,40 @@ static vd_status check_prims(const vd_collide_prims* P, const vd_collide_def* de
   return VD_OK;
 }
 
-// a sort key: ordered by k, then t (sweep: box low end, primitive; contacts: a, then b with
-// the contact's index in the low 31 bits)
-typedef struct skey {
-  double k;
-  int64_t t;
-} skey;
+// a sort key: ordered by k; equal keys keep their input order (the sort is stable)
+typedef struct rkey {
+  uint64_t k; // sweep: the box's low end as ordered bits; contacts and pairs: a << 32 | b
+  int v;      // sweep: the primitive; contacts: the contact's index
+} rkey;
 
-static int skey_before(const skey* x, const skey* y) {
-  return x->k < y->k || (x->k == y->k && x->t < y->t);
+// the bits of a double as an unsigned integer in the same order (negatives flipped)
+static uint64_t ordered_bits(double x) {
+  uint64_t u;
+  memcpy(&u, &x, sizeof u);
+  return (u >> 63) ? ~u : u | ((uint64_t)1 << 63);
 }
 
-// bottom-up merge sort of n keys with tmp (n keys) as scratch; returns the sorted array (a or
-// tmp). Both come from the caller's arena: no heap in a step (qsort may allocate)
-static skey* sort_keys(skey* a, skey* tmp, int n) {
-  skey *src = a, *dst = tmp;
-  for (int w = 1; w < n; w *= 2) {
-    for (int lo = 0; lo < n; lo += 2 * w) {
-      int mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
-      int i = lo, j = mid, o = lo;
-      while (i < mid && j < hi)
-        dst[o++] = skey_before(&src[j], &src[i]) ? src[j++] : src[i++];
-      while (i < mid)
-        dst[o++] = src[i++];
-      while (j < hi)
-        dst[o++] = src[j++];
+// least-significant-digit radix sort (8 passes of 8 bits, passes with a single digit skipped)
+// of n keys with tmp (n keys) as scratch; returns the sorted array (a or tmp). Branch-free,
+// linear, stable, and both arrays come from the caller's arena: no heap in a step
+static rkey* sort_keys(rkey* a, rkey* tmp, int n) {
+  uint32_t count[8][256];
+  memset(count, 0, sizeof count);
+  for (int i = 0; i < n; i++)
+    for (int d = 0; d < 8; d++)
+      count[d][(a[i].k >> (8 * d)) & 255]++;
+  rkey *src = a, *dst = tmp;
+  for (int d = 0; d < 8; d++) {
+    uint32_t* c = count[d];
+    if (n == 0 || c[(src[0].k >> (8 * d)) & 255] == (uint32_t)n) continue; // one digit only
+    uint32_t sum = 0;
+    for (int q = 0; q < 256; q++) {
+      uint32_t x = c[q];
+      c[q] = sum, sum += x;
     }
-    skey* x = src;
+    for (int i = 0; i < n; i++)
+      dst[c[(src[i].k >> (8 * d)) & 255]++] = src[i];
+    rkey* x = src;
     src = dst, dst = x;
   }
   return src;
@@ -619,15 +626,15 @@ static skey* sort_keys(skey* a, skey* tmp, int n) {
 // the contact list ordered by (a, b), copied into a fresh arena array; 0 when out of memory
 static int sort_contacts(vd_arena* ar, cbuf* b) {
   if (b->n < 2) return 1;
-  skey* k = vd_arena_alloc(ar, (size_t)b->n * sizeof *k);
-  skey* tmp = vd_arena_alloc(ar, (size_t)b->n * sizeof *tmp);
+  rkey* k = vd_arena_alloc(ar, (size_t)b->n * sizeof *k);
+  rkey* tmp = vd_arena_alloc(ar, (size_t)b->n * sizeof *tmp);
   vd_contact* out = vd_arena_alloc(ar, (size_t)b->n * sizeof *out);
   if (!k || !tmp || !out) return 0;
   for (int i = 0; i < b->n; i++)
-    k[i].k = b->c[i].a, k[i].t = ((int64_t)b->c[i].b << 31) | i;
-  skey* s = sort_keys(k, tmp, b->n);
+    k[i].k = (uint64_t)(uint32_t)b->c[i].a << 32 | (uint32_t)b->c[i].b, k[i].v = i;
+  rkey* s = sort_keys(k, tmp, b->n);
   for (int i = 0; i < b->n; i++)
-    out[i] = b->c[s[i].t & 0x7fffffff];
+    out[i] = b->c[s[i].v];
   b->c = out, b->cap = b->n;
   return 1;
 }
@@ -665,9 +672,11 @@ static vd_status broad_phase(const vd_collide_prims* P, double grow, vd_arena* a
   if (n < 2) return VD_OK;
   vd_vec3* lo = vd_arena_alloc(arena, (size_t)n * sizeof *lo);
   vd_vec3* hi = vd_arena_alloc(arena, (size_t)n * sizeof *hi);
-  skey* key = vd_arena_alloc(arena, (size_t)n * sizeof *key);
-  skey* tmp = vd_arena_alloc(arena, (size_t)n * sizeof *tmp);
-  if (!lo || !hi || !key || !tmp) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
+  rkey* key = vd_arena_alloc(arena, (size_t)n * sizeof *key);
+  rkey* tmp = vd_arena_alloc(arena, (size_t)n * sizeof *tmp);
+  double* start = vd_arena_alloc(arena, (size_t)n * sizeof *start);
+  if (!lo || !hi || !key || !tmp || !start)
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
   int m = 0;
   vd_vec3 cmin = vd_v3(HUGE_VAL, HUGE_VAL, HUGE_VAL), cmax = vd_scale(cmin, -1);
   for (int i = 0; i < n; i++) {
@@ -675,22 +684,24 @@ static vd_status broad_phase(const vd_collide_prims* P, double grow, vd_arena* a
     prim_bounds(P, i, 0.5 * grow, &lo[i], &hi[i]);
     vd_vec3 c = vd_scale(vd_add(lo[i], hi[i]), 0.5);
     cmin = vd_vmin(cmin, c), cmax = vd_vmax(cmax, c);
-    key[m++].t = i;
+    key[m++].v = i;
   }
   vd_vec3 spread = vd_sub(cmax, cmin);
   int ax = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
   for (int k = 0; k < m; k++)
-    key[k].k = comp(lo[key[k].t], ax);
+    key[k].k = ordered_bits(comp(lo[key[k].v], ax));
   key = sort_keys(key, tmp, m);
+  for (int k = 0; k < m; k++)
+    start[k] = comp(lo[key[k].v], ax);
   for (int k = 0; k < m; k++) {
-    int i = (int)key[k].t;
+    int i = key[k].v;
     double end = comp(hi[i], ax);
-    for (int q = k + 1; q < m && key[q].k <= end; q++) {
-      int j = (int)key[q].t;
-      // boxes overlap on the other two axes, the pair is not excluded
-      if (lo[i].x > hi[j].x || lo[j].x > hi[i].x || lo[i].y > hi[j].y || lo[j].y > hi[i].y ||
-          lo[i].z > hi[j].z || lo[j].z > hi[i].z)
-        continue;
+    for (int q = k + 1; q < m && start[q] <= end; q++) {
+      int j = key[q].v;
+      // boxes overlap on the other two axes (all six tests at once), the pair is not excluded
+      int apart = (lo[i].x > hi[j].x) | (lo[j].x > hi[i].x) | (lo[i].y > hi[j].y) |
+                  (lo[j].y > hi[i].y) | (lo[i].z > hi[j].z) | (lo[j].z > hi[i].z);
+      if (apart) continue;
       int a = i < j ? i : j, b = i < j ? j : i;
       if (excluded(P, a, b)) continue;
       if (!pbuf_push(arena, out, a, b)) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "%s", oom);
@@ -756,16 +767,16 @@ vd_status vd_collide_self_pairs(const vd_collide_prims* P, double grow, vd_arena
   if ((st = broad_phase(P, grow, arena, &pairs, err))) return st;
   // ascending (a, b)
   if (pairs.n > 1) {
-    skey* k = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *k);
-    skey* tmp = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *tmp);
+    rkey* k = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *k);
+    rkey* tmp = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *tmp);
     int* sorted = vd_arena_alloc(arena, (size_t)pairs.n * 2 * sizeof *sorted);
     if (!k || !tmp || !sorted)
       return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
     for (int i = 0; i < pairs.n; i++)
-      k[i].k = pairs.p[2 * i], k[i].t = pairs.p[2 * i + 1];
-    skey* s = sort_keys(k, tmp, pairs.n);
+      k[i].k = (uint64_t)(uint32_t)pairs.p[2 * i] << 32 | (uint32_t)pairs.p[2 * i + 1], k[i].v = i;
+    rkey* s = sort_keys(k, tmp, pairs.n);
     for (int i = 0; i < pairs.n; i++)
-      sorted[2 * i] = (int)s[i].k, sorted[2 * i + 1] = (int)s[i].t;
+      sorted[2 * i] = pairs.p[2 * s[i].v], sorted[2 * i + 1] = pairs.p[2 * s[i].v + 1];
     pairs.p = sorted;
   }
   out->n = pairs.n;
