@@ -538,8 +538,20 @@ TEST(collide, broad_phase_equals_brute_force) {
   p.skip = skip;
   vd_collide_exclusion ex;
   vd_error err = {0};
+  // an exclusion for the capsules alone does not fit the primitives
   CHECK_STATUS(vd_collide_exclusion_build(sp.nnode, sp.ncap, sp.cap_node, 0, NULL, 0, &ex, &err),
                VD_OK, err);
+  vd_collide_prims_set_exclusion(&p, &ex);
+  vd_arena scratch;
+  vd_arena_init(&scratch, 0);
+  vd_contact_list wrong;
+  err = (vd_error){0};
+  CHECK_STATUS(vd_collide_self(&p, NULL, &scratch, &wrong, &err), VD_ERR_ARG, err);
+  vd_arena_free(&scratch);
+  vd_collide_exclusion_free(&ex);
+  CHECK_STATUS(
+      vd_collide_exclusion_build(sp.nnode, sp.ncap, sp.cap_node, sp.nsph, NULL, 0, &ex, &err),
+      VD_OK, err);
   vd_collide_prims_set_exclusion(&p, &ex);
   vd_collide_def def = vd_collide_def_default();
   def.margin = 0.005;
@@ -601,7 +613,7 @@ TEST(collide, broad_phase_equals_brute_force) {
   CHECK_STATUS(vd_collide_pairs(&p, &pairs, &def, &arena, &reused, &err), VD_OK, err);
   CHECK(full.n > 20 && full.n == reused.n &&
         memcmp(full.c, reused.c, (size_t)full.n * sizeof *full.c) == 0);
-  CHECK(reused.ntested < pairs.n);  // the current boxes cull most candidates first
+  CHECK(reused.ntested < pairs.n); // the current boxes cull most candidates first
   // a bad pair list is refused
   int bad[2] = {3, 3};
   vd_pair_list bl = {1, bad};

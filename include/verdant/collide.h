@@ -165,6 +165,7 @@ typedef struct vd_collide_prims {
                                 // primitive i never meets exclude[exclude_start[i] ..
                                 // exclude_start[i+1]) ((ncapsule + nsphere + 1) x 1)
   const int* exclude;           // excluded partners, ascending within each row (nexclude x 1)
+  int exclude_rows;             // rows of the adjacency: ncapsule + nsphere when one is given
 } vd_collide_prims;
 
 // An excluded-pair adjacency built from the plant's topology (one allocation).
@@ -185,7 +186,7 @@ vd_status vd_collide_exclusion_build(int nnode, int ncapsule, const int* capsule
                                      vd_error* err);
 // Free an exclusion's arrays and zero it.
 void vd_collide_exclusion_free(vd_collide_exclusion* ex);
-// Point prims' exclude_start / exclude at an exclusion's arrays.
+// Point prims' exclude_start / exclude / exclude_rows at an exclusion's arrays.
 void vd_collide_prims_set_exclusion(vd_collide_prims* prims, const vd_collide_exclusion* ex);
 
 // Contact queries' settings.

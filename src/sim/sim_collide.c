@@ -576,6 +576,10 @@ static vd_status check_prims(const vd_collide_prims* P, const vd_collide_def* de
     if (P->capsule_node[i] < 0 || P->capsule_node[i] >= P->nnode)
       return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: capsule %d: node out of range",
                           i / 2);
+  if (P->exclude_start && P->exclude_rows != P->ncapsule + P->nsphere)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "collide: the exclusion has %d rows for %d primitives", P->exclude_rows,
+                        P->ncapsule + P->nsphere);
   if (def && !(def->margin >= 0 && isfinite(def->margin)))
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: margin must be >= 0 m");
   if (def && def->max_contacts < 0)
@@ -1022,4 +1026,5 @@ void vd_collide_exclusion_free(vd_collide_exclusion* ex) {
 void vd_collide_prims_set_exclusion(vd_collide_prims* prims, const vd_collide_exclusion* ex) {
   prims->exclude_start = ex ? ex->start : NULL;
   prims->exclude = ex ? ex->exclude : NULL;
+  prims->exclude_rows = ex ? ex->nprim : 0;
 }
