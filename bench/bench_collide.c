@@ -25,7 +25,8 @@ static double calibration_ns(void) {
   double best = HUGE_VAL;
   for (int b = 0; b < 5; b++) {
     double t0 = now();
-    for (int k = 0; k < 10000000; k++) x += 1e-9;
+    for (int k = 0; k < 10000000; k++)
+      x += 1e-9;
     best = fmin(best, now() - t0);
   }
   return best / 1e7 * 1e9;
@@ -48,7 +49,8 @@ typedef struct sphere_mesh {
 
 static void icosphere(sphere_mesh* s, int level, double radius) {
   int nv_max = 12, nt_max = 20;
-  for (int l = 0; l < level; l++) nv_max += 3 * nt_max / 2, nt_max *= 4;
+  for (int l = 0; l < level; l++)
+    nv_max += 3 * nt_max / 2, nt_max *= 4;
   s->v = malloc(sizeof(double) * 3 * (size_t)nv_max);
   s->t = malloc(sizeof(int) * 3 * (size_t)nt_max);
   int* edge_a = malloc(sizeof(int) * 3 * (size_t)nt_max);
@@ -56,11 +58,12 @@ static void icosphere(sphere_mesh* s, int level, double radius) {
   int* edge_m = malloc(sizeof(int) * 3 * (size_t)nt_max);
   int* t2 = malloc(sizeof(int) * 3 * (size_t)nt_max);
   double p = (1 + sqrt(5)) / 2;
-  double v0[12][3] = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
-                      {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
-  int t0[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                   {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                   {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  double v0[12][3] = {{-1, p, 0},  {1, p, 0},  {-1, -p, 0}, {1, -p, 0}, {0, -1, p},  {0, 1, p},
+                      {0, -1, -p}, {0, 1, -p}, {p, 0, -1},  {p, 0, 1},  {-p, 0, -1}, {-p, 0, 1}};
+  int t0[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                   {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                   {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                   {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   s->nv = 12, s->nt = 20;
   for (int i = 0; i < 12; i++) {
     vd_vec3 q = vd_normalize(vd_v3(v0[i][0], v0[i][1], v0[i][2]));
@@ -77,14 +80,17 @@ static void icosphere(sphere_mesh* s, int level, double radius) {
           if ((edge_a[e] == a && edge_b[e] == b) || (edge_a[e] == b && edge_b[e] == a))
             found = edge_m[e];
         if (found < 0) {
-          vd_vec3 q = vd_normalize(vd_v3(s->v[3 * a] + s->v[3 * b], s->v[3 * a + 1] + s->v[3 * b + 1],
-                                         s->v[3 * a + 2] + s->v[3 * b + 2]));
+          vd_vec3 q =
+              vd_normalize(vd_v3(s->v[3 * a] + s->v[3 * b], s->v[3 * a + 1] + s->v[3 * b + 1],
+                                 s->v[3 * a + 2] + s->v[3 * b + 2]));
           s->v[3 * s->nv] = q.x, s->v[3 * s->nv + 1] = q.y, s->v[3 * s->nv + 2] = q.z;
           edge_a[ne] = a, edge_b[ne] = b, edge_m[ne++] = found = s->nv++;
         }
         mid[k] = found;
       }
-      int q[4][3] = {{c[0], mid[0], mid[2]}, {c[1], mid[1], mid[0]}, {c[2], mid[2], mid[1]},
+      int q[4][3] = {{c[0], mid[0], mid[2]},
+                     {c[1], mid[1], mid[0]},
+                     {c[2], mid[2], mid[1]},
                      {mid[0], mid[1], mid[2]}};
       memcpy(t2 + 3 * n2, q, sizeof q);
       n2 += 4;
@@ -92,7 +98,8 @@ static void icosphere(sphere_mesh* s, int level, double radius) {
     memcpy(s->t, t2, sizeof(int) * 3 * (size_t)n2);
     s->nt = n2;
   }
-  for (int i = 0; i < 3 * s->nv; i++) s->v[i] *= radius;
+  for (int i = 0; i < 3 * s->nv; i++)
+    s->v[i] *= radius;
   free(edge_a);
   free(edge_b);
   free(edge_m);
@@ -163,15 +170,17 @@ int main(int argc, char** argv) {
   for (int i = 0; i < NQ; i++) {
     pa[i] = vd_v3(vd_rng_uniform(&rng, -0.08, 0.08), vd_rng_uniform(&rng, -0.08, 0.08),
                   vd_rng_uniform(&rng, -0.08, 0.08));
-    pb[i] = vd_add(pa[i], vd_v3(vd_rng_uniform(&rng, -0.02, 0.02), vd_rng_uniform(&rng, -0.02, 0.02),
-                                vd_rng_uniform(&rng, -0.02, 0.02)));
+    pb[i] =
+        vd_add(pa[i], vd_v3(vd_rng_uniform(&rng, -0.02, 0.02), vd_rng_uniform(&rng, -0.02, 0.02),
+                            vd_rng_uniform(&rng, -0.02, 0.02)));
   }
   double sink = 0;
   for (int s = 0; s < 5; s++) {
     double best = HUGE_VAL;
     for (int batch = 0; batch < 5; batch++) {
       double t0 = now();
-      for (int i = 0; i < NQ; i++) sink += vd_collide_point(&col[s], pa[i]).dist;
+      for (int i = 0; i < NQ; i++)
+        sink += vd_collide_point(&col[s], pa[i]).dist;
       best = fmin(best, now() - t0);
     }
     row("point query", names[s], NQ, best, "queries/s");
@@ -213,7 +222,8 @@ int main(int argc, char** argv) {
   int* cnode = malloc(sizeof(int) * (size_t)cap_nodes);
   double* crad = malloc(sizeof(double) * (size_t)cap_nodes);
   int* first = malloc(sizeof(int) * (size_t)m->nnode);
-  for (int i = 0; i < m->nnode; i++) first[i] = -1;
+  for (int i = 0; i < m->nnode; i++)
+    first[i] = -1;
   for (int s = 0; s < m->nseg; s++) {
     int n0 = m->seg_node[2 * s], n1 = m->seg_node[2 * s + 1];
     const double* a = m->node_pos0 + 3 * n0;
@@ -230,7 +240,8 @@ int main(int argc, char** argv) {
         if (first[n1] < 0) first[n1] = nn, memcpy(node + 3 * nn++, b, sizeof(double) * 3);
         cur = first[n1];
       } else {
-        for (int c = 0; c < 3; c++) node[3 * nn + c] = a[c] + (b[c] - a[c]) * j / k;
+        for (int c = 0; c < 3; c++)
+          node[3 * nn + c] = a[c] + (b[c] - a[c]) * j / k;
         cur = nn++;
       }
       cnode[2 * np] = prev, cnode[2 * np + 1] = cur;
@@ -272,8 +283,8 @@ int main(int argc, char** argv) {
   char d[96];
   snprintf(d, sizeof d, "tomato %d caps + %d spheres", np, m->nsphere);
   row("self-collision (queries/s)", d, reps, t, "per s");
-  printf("  %d candidate pairs, %d contacts (touching organs), %.1f us per query\n",
-         (int)L.ntested, L.n, 1e6 * t / reps);
+  printf("  %d candidate pairs, %d contacts (touching organs), %.1f us per query\n", (int)L.ntested,
+         L.n, 1e6 * t / reps);
   // the broad phase every 10 steps with 0.01 m of growth, the narrow phase every step
   vd_arena keep;
   vd_arena_init(&keep, 1 << 20);
@@ -300,8 +311,10 @@ int main(int argc, char** argv) {
   vd_vec3 fc = vd_v3(m->sphere_pos0[3 * f], m->sphere_pos0[3 * f + 1], m->sphere_pos0[3 * f + 2]);
   vd_collider g[5];
   g[0] = vd_collider_plane(vd_v3(0, 0, 0), vd_v3(0, 0, 1));
-  g[1] = vd_collider_capsule(vd_add(fc, vd_v3(-0.02, 0.02, 0)), vd_add(fc, vd_v3(0.04, 0.02, 0)), 0.008);
-  g[2] = vd_collider_capsule(vd_add(fc, vd_v3(-0.02, -0.02, 0)), vd_add(fc, vd_v3(0.04, -0.02, 0)), 0.008);
+  g[1] = vd_collider_capsule(vd_add(fc, vd_v3(-0.02, 0.02, 0)), vd_add(fc, vd_v3(0.04, 0.02, 0)),
+                             0.008);
+  g[2] = vd_collider_capsule(vd_add(fc, vd_v3(-0.02, -0.02, 0)), vd_add(fc, vd_v3(0.04, -0.02, 0)),
+                             0.008);
   vd_pose bp = {vd_add(fc, vd_v3(0.06, 0, 0)), vd_quat_identity()};
   g[3] = vd_collider_box(bp, vd_v3(0.015, 0.05, 0.02));
   vd_pose mp = {vd_add(fc, vd_v3(0.12, 0, 0)), vd_quat_identity()};
@@ -317,7 +330,7 @@ int main(int argc, char** argv) {
   }
   row("colliders (queries/s)", "tomato vs gripper (5 shapes)", reps, t, "per s");
   printf("  %d candidates, %d contacts, %.1f us per query\n", (int)L.ntested, L.n, 1e6 * t / reps);
-  if (sink == 42) printf("\n");  // keep the queries observable
+  if (sink == 42) printf("\n"); // keep the queries observable
   vd_arena_free(&arena);
   vd_collide_exclusion_free(&ex);
   vd_sdf_destroy(grid);
@@ -325,7 +338,8 @@ int main(int argc, char** argv) {
   vd_plant_spec_destroy(spec);
   vd_lsys_destroy(ls);
   free(node), free(cnode), free(crad), free(first), free(snode), free(pa), free(pb);
-  for (int k = 0; k < 2; k++) free(sm[k].v), free(sm[k].t);
+  for (int k = 0; k < 2; k++)
+    free(sm[k].v), free(sm[k].t);
   if (csv) fclose(csv);
   return 0;
 }

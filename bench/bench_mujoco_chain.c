@@ -16,8 +16,8 @@
 //     one (linear Euler-Bernoulli qL^4/8EI, PL^3/3EI, and the nonlinear continuum limit);
 //  2. cantilever dynamics: the largest stable time step with light damping (2 % of critical on
 //     the first mode), steps/s there and at 1 ms, real-time factors;
-//  3. plants (bundled tomato, tree) as body trees resampled to 0.02 m pieces with the sim's
-//     draft materials: the largest stable step, steps/s, real-time factor.
+//  3. plants (the bundled tomato; the tree with --plants) as body trees of 0.02 m pieces with
+//     the sim's draft materials: the largest stable step, steps/s, real-time factor.
 // Results: bench/results/mujoco-chain-<tag>.csv. `--selftest` checks the error trap instead.
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -44,7 +44,8 @@ static double calibration_ns(void) {
   double best = HUGE_VAL;
   for (int b = 0; b < 5; b++) {
     double t0 = now();
-    for (int k = 0; k < 10000000; k++) x += 1e-9;
+    for (int k = 0; k < 10000000; k++)
+      x += 1e-9;
     best = fmin(best, now() - t0);
   }
   return best / 1e7 * 1e9;
@@ -70,7 +71,8 @@ static void put(text* t, const char* fmt, ...) {
       return;
     }
     size_t cap = t->cap ? 2 * t->cap : 1 << 16;
-    while (cap < t->n + (size_t)k + 1) cap *= 2;
+    while (cap < t->n + (size_t)k + 1)
+      cap *= 2;
     char* s = realloc(t->s, cap);
     if (!s) {
       fprintf(stderr, "out of memory\n");
@@ -101,12 +103,16 @@ static mjModel* load_xml(const text* t, char* msg, int cap) {
 // the cantilever
 
 typedef struct beam {
-  double L, r, rho, E, g;  // length (m), radius (m), density (kg/m^3), Young (Pa), gravity
-  double P;                // tip load (N), applied with gravity off
+  double L, r, rho, E, g; // length (m), radius (m), density (kg/m^3), Young (Pa), gravity
+  double P;               // tip load (N), applied with gravity off
 } beam;
 
-static double beam_EI(const beam* b) { return b->E * VD_PI * pow(b->r, 4) / 4; }
-static double beam_q(const beam* b) { return b->rho * VD_PI * b->r * b->r * b->g; }
+static double beam_EI(const beam* b) {
+  return b->E * VD_PI * pow(b->r, 4) / 4;
+}
+static double beam_q(const beam* b) {
+  return b->rho * VD_PI * b->r * b->r * b->g;
+}
 
 // the chain: N capsule bodies along +x, ball joints with stiffness k and damping beta * k
 static mjModel* chain_model(const beam* b, int N, int root2, double beta, double dt, double g,
@@ -121,14 +127,15 @@ static mjModel* chain_model(const beam* b, int N, int root2, double beta, double
     double Iax = 0.5 * m * b->r * b->r, Iperp = m * (3 * b->r * b->r + l * l) / 12;
     put(&t, "<body pos=\"%.17g 0 0\"><joint type=\"ball\" stiffness=\"%.17g\" damping=\"%.17g\"/>",
         i ? l : 0.0, k, beta * k);
-    put(&t, "<inertial pos=\"%.17g 0 0\" mass=\"%.17g\" diaginertia=\"%.17g %.17g %.17g\"/>",
-        l / 2, m, Iax, Iperp, Iperp);
+    put(&t, "<inertial pos=\"%.17g 0 0\" mass=\"%.17g\" diaginertia=\"%.17g %.17g %.17g\"/>", l / 2,
+        m, Iax, Iperp, Iperp);
     put(&t,
         "<geom type=\"capsule\" fromto=\"0 0 0 %.17g 0 0\" size=\"%.17g\" contype=\"0\" "
         "conaffinity=\"0\"/>\n",
         l, b->r);
   }
-  for (int i = 0; i < N; i++) put(&t, "</body>");
+  for (int i = 0; i < N; i++)
+    put(&t, "</body>");
   put(&t, "\n</worldbody>\n</mujoco>\n");
   mjModel* mm = load_xml(&t, msg, cap);
   free(t.s);
@@ -139,7 +146,8 @@ static mjModel* chain_model(const beam* b, int N, int root2, double beta, double
 static void chain_tip(const mjModel* M, const mjData* d, double l, double tip[3]) {
   int b = M->nbody - 1;
   const double* R = d->xmat + 9 * b;
-  for (int a = 0; a < 3; a++) tip[a] = d->xpos[3 * b + a] + R[3 * a] * l;
+  for (int a = 0; a < 3; a++)
+    tip[a] = d->xpos[3 * b + a] + R[3 * a] * l;
 }
 
 // the tip load as a force at the tip: force at the centre of mass plus its moment
@@ -163,14 +171,15 @@ static void apply_tip_load(const mjModel* M, mjData* d, double l, double P) {
 static double discrete_tip(const beam* b, int N, int root2, int selfweight) {
   double l = b->L / N, EI = beam_EI(b), w = selfweight ? beam_q(b) * l : 0;
   double P = selfweight ? 0 : b->P;
-  double* phi = calloc((size_t)N, sizeof(double));  // absolute angle of body i (down positive)
-  double* x = calloc((size_t)N + 1, sizeof(double));  // joint x positions, x[N] the tip
+  double* phi = calloc((size_t)N, sizeof(double));   // absolute angle of body i (down positive)
+  double* x = calloc((size_t)N + 1, sizeof(double)); // joint x positions, x[N] the tip
   double tip = 0;
   for (int it = 0; it < 200; it++) {
     // positions from the angles
     double z = 0;
     x[0] = 0;
-    for (int i = 0; i < N; i++) x[i + 1] = x[i] + l * cos(phi[i]), z += l * sin(phi[i]);
+    for (int i = 0; i < N; i++)
+      x[i + 1] = x[i] + l * cos(phi[i]), z += l * sin(phi[i]);
     // moments about each joint: weights at the body centres, P at the tip
     double S = P, SX = P * x[N], change = 0, ang = 0;
     double* M = calloc((size_t)N, sizeof(double));
@@ -190,7 +199,8 @@ static double discrete_tip(const beam* b, int N, int root2, int selfweight) {
     if (change < 1e-15) break;
   }
   double z = 0;
-  for (int i = 0; i < N; i++) z += l * sin(phi[i]);
+  for (int i = 0; i < N; i++)
+    z += l * sin(phi[i]);
   tip = z;
   free(phi);
   free(x);
@@ -205,10 +215,10 @@ static double continuum_tip(const beam* b, int selfweight) {
 }
 
 typedef struct statics {
-  double tip;        // settled downward tip deflection (m)
-  double settle_s;   // simulated time to settle (s)
-  double steps_s;    // steps per wall-clock second while settling
-  int ok;            // settled without a MuJoCo warning or error
+  double tip;      // settled downward tip deflection (m)
+  double settle_s; // simulated time to settle (s)
+  double steps_s;  // steps per wall-clock second while settling
+  int ok;          // settled without a MuJoCo warning or error
 } statics;
 
 // settle the chain with heavy damping and read the tip
@@ -232,7 +242,8 @@ static statics chain_statics(const beam* b, int N, int root2, int selfweight) {
       mj_step(M, d);
       if (steps > 200 && steps % 50 == 0) {
         double v = 0;
-        for (int i = 0; i < M->nv; i++) v = fmax(v, fabs(d->qvel[i]));
+        for (int i = 0; i < M->nv; i++)
+          v = fmax(v, fabs(d->qvel[i]));
         if (v < 1e-12) break;
       }
     }
@@ -300,7 +311,8 @@ static double steps_per_second(const mjModel* M, mjData* d, double min_s) {
   return rate;
 }
 
-static const double dt_ladder[] = {1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6};
+static const double dt_ladder[] = {1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4,
+                                   5e-5, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6};
 #define NLADDER ((int)(sizeof dt_ladder / sizeof dt_ladder[0]))
 
 // the largest stable step of the ladder (0 when none), for a model built per step by make()
@@ -326,14 +338,14 @@ static double largest_stable_dt(make_fn make, void* user, double seconds, double
 // ---------------------------------------------------------------------------------------------
 // plants as body trees
 
-#define MAX_NEST 95  // deepest body nesting MuJoCo 2.2.2 + tinyxml2 9 accept (with margin)
+#define MAX_NEST 95 // deepest body nesting MuJoCo 2.2.2 + tinyxml2 9 accept (with margin)
 
 typedef struct plant_mj {
   const vd_model* m;
-  double piece;    // target body length (m)
-  double beta;     // damping / stiffness (s)
+  double piece; // target body length (m)
+  double beta;  // damping / stiffness (s)
   int nbody, njoint;
-  const char* save;  // write the MJCF here when not NULL
+  const char* save; // write the MJCF here when not NULL
 } plant_mj;
 
 // the sim's draft materials by organ (wt-sim vd_sim_def_default): E (Pa), rho (kg/m^3)
@@ -341,7 +353,7 @@ static void material(const vd_label* lab, double* E, double* rho, int* clamp) {
   vd_organ o = lab ? lab->organ : VD_ORGAN_OTHER;
   const char* n = lab ? lab->name : "";
   *clamp = 0;
-  *E = 5e7, *rho = 1000;  // green stem
+  *E = 5e7, *rho = 1000; // green stem
   if (o == VD_ORGAN_STEM && (strstr(n, "trunk") || strstr(n, "branch") || strstr(n, "wood") ||
                              strstr(n, "twig") || strstr(n, "bole")))
     *E = 1e10, *rho = 900;
@@ -355,12 +367,14 @@ static void material(const vd_label* lab, double* E, double* rho, int* clamp) {
     *E = 1e10, *rho = 900, *clamp = 1;
 }
 
-static vd_vec3 v3at(const double* a, int i) { return vd_v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
+static vd_vec3 v3at(const double* a, int i) {
+  return vd_v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+}
 
 // pieces of segment s at the target length (0 for a zero-length segment)
 static int pieces(const vd_model* m, int s, double piece) {
-  double len = vd_norm(vd_sub(v3at(m->node_pos0, m->seg_node[2 * s + 1]),
-                              v3at(m->node_pos0, m->seg_node[2 * s])));
+  double len = vd_norm(
+      vd_sub(v3at(m->node_pos0, m->seg_node[2 * s + 1]), v3at(m->node_pos0, m->seg_node[2 * s])));
   return len > 0 ? (int)fmax(1, floor(len / piece + 0.5)) : 0;
 }
 
@@ -369,7 +383,8 @@ static int max_depth(const vd_model* m, double piece) {
   int deepest = 0;
   for (int s = 0; s < m->nseg; s++) {
     int d = 0;
-    for (int q = s; q >= 0; q = m->seg_parent[q]) d += pieces(m, q, piece);
+    for (int q = s; q >= 0; q = m->seg_parent[q])
+      d += pieces(m, q, piece);
     deepest = d > deepest ? d : deepest;
   }
   return deepest;
@@ -380,7 +395,8 @@ static void plant_body(plant_mj* P, text* t, int s, const int* cstart, const int
                        vd_vec3 parent_origin, double parent_len, int welded, double dt) {
   const vd_model* m = P->m;
   (void)dt;
-  vd_vec3 a = v3at(m->node_pos0, m->seg_node[2 * s]), b = v3at(m->node_pos0, m->seg_node[2 * s + 1]);
+  vd_vec3 a = v3at(m->node_pos0, m->seg_node[2 * s]),
+          b = v3at(m->node_pos0, m->seg_node[2 * s + 1]);
   double len = vd_norm(vd_sub(b, a));
   const vd_label* lab = vd_model_find_label(m, m->seg_label[s]);
   double E, rho;
@@ -393,7 +409,8 @@ static void plant_body(plant_mj* P, text* t, int s, const int* cstart, const int
   for (int j = 0; j < n; j++) {
     vd_vec3 p0 = vd_madd(a, vd_sub(b, a), (double)j / n);
     double r0 = m->seg_radius[2 * s] + (m->seg_radius[2 * s + 1] - m->seg_radius[2 * s]) * j / n;
-    double r1 = m->seg_radius[2 * s] + (m->seg_radius[2 * s + 1] - m->seg_radius[2 * s]) * (j + 1) / n;
+    double r1 =
+        m->seg_radius[2 * s] + (m->seg_radius[2 * s + 1] - m->seg_radius[2 * s]) * (j + 1) / n;
     double rm = 0.5 * (r0 + r1), mass = rho * VD_PI * rm * rm * l;
     vd_vec3 rel = vd_sub(p0, origin);
     put(t, "<body pos=\"%.9g %.9g %.9g\">", rel.x, rel.y, rel.z);
@@ -420,8 +437,9 @@ static void plant_body(plant_mj* P, text* t, int s, const int* cstart, const int
     if (m->sphere_parent[i] != s) continue;
     vd_vec3 c = vd_sub(v3at(m->sphere_pos0, i), origin);
     double r = m->sphere_radius[i], mass = 800 * 4.0 / 3 * VD_PI * r * r * r;
-    put(t, "<geom type=\"sphere\" pos=\"%.9g %.9g %.9g\" size=\"%.9g\" mass=\"%.9g\" "
-           "contype=\"0\" conaffinity=\"0\"/>\n",
+    put(t,
+        "<geom type=\"sphere\" pos=\"%.9g %.9g %.9g\" size=\"%.9g\" mass=\"%.9g\" "
+        "contype=\"0\" conaffinity=\"0\"/>\n",
         c.x, c.y, c.z, fmax(r, 1e-4), mass);
   }
   for (int i = 0; i < m->nmesh; i++) {
@@ -430,7 +448,8 @@ static void plant_body(plant_mj* P, text* t, int s, const int* cstart, const int
     double area = 0;
     vd_vec3 cen = vd_v3(0, 0, 0);
     for (int q = m->mesh_tri[2 * i]; q < m->mesh_tri[2 * i] + m->mesh_tri[2 * i + 1]; q++) {
-      vd_vec3 p0 = v3at(m->vert_pos0, m->tri_vert[3 * q]), p1 = v3at(m->vert_pos0, m->tri_vert[3 * q + 1]);
+      vd_vec3 p0 = v3at(m->vert_pos0, m->tri_vert[3 * q]),
+              p1 = v3at(m->vert_pos0, m->tri_vert[3 * q + 1]);
       vd_vec3 p2 = v3at(m->vert_pos0, m->tri_vert[3 * q + 2]);
       double ar = 0.5 * vd_norm(vd_cross(vd_sub(p1, p0), vd_sub(p2, p0)));
       area += ar;
@@ -438,14 +457,16 @@ static void plant_body(plant_mj* P, text* t, int s, const int* cstart, const int
     }
     if (!(area > 0)) continue;
     cen = vd_sub(vd_scale(cen, 1 / area), origin);
-    put(t, "<geom type=\"sphere\" pos=\"%.9g %.9g %.9g\" size=\"0.005\" mass=\"%.9g\" "
-           "contype=\"0\" conaffinity=\"0\"/>\n",
+    put(t,
+        "<geom type=\"sphere\" pos=\"%.9g %.9g %.9g\" size=\"0.005\" mass=\"%.9g\" "
+        "contype=\"0\" conaffinity=\"0\"/>\n",
         cen.x, cen.y, cen.z, 0.22 * area);
   }
   // children continue from the end of this segment's last piece
   for (int e = cstart[s]; e < cstart[s + 1]; e++)
     plant_body(P, t, child[e], cstart, child, origin, last_len, welded && n == 0, dt);
-  for (int j = 0; j < open; j++) put(t, "</body>");
+  for (int j = 0; j < open; j++)
+    put(t, "</body>");
   put(t, "\n");
 }
 
@@ -456,15 +477,18 @@ static mjModel* plant_model(void* user, double dt, char* msg, int cap) {
   // MJCF states the kinematic tree only by nesting, and Debian's MuJoCo 2.2.2 parses it with
   // tinyxml2 9, which rejects elements nested deeper than 100: lengthen the pieces until the
   // deepest path fits
-  while (max_depth(m, P->piece) > MAX_NEST) P->piece *= 1.05;
+  while (max_depth(m, P->piece) > MAX_NEST)
+    P->piece *= 1.05;
   // children of every segment, in index order
   int* cstart = calloc((size_t)m->nseg + 2, sizeof(int));
   int* child = malloc(sizeof(int) * ((size_t)m->nseg + 1));
   for (int s = 0; s < m->nseg; s++)
     if (m->seg_parent[s] >= 0) cstart[m->seg_parent[s] + 1]++;
-  for (int s = 0; s < m->nseg; s++) cstart[s + 1] += cstart[s];
+  for (int s = 0; s < m->nseg; s++)
+    cstart[s + 1] += cstart[s];
   int* fill = malloc(sizeof(int) * ((size_t)m->nseg + 1));
-  for (int s = 0; s <= m->nseg; s++) fill[s] = cstart[s];
+  for (int s = 0; s <= m->nseg; s++)
+    fill[s] = cstart[s];
   for (int s = 0; s < m->nseg; s++)
     if (m->seg_parent[s] >= 0) child[fill[m->seg_parent[s]]++] = s;
   text t = {0};
@@ -590,7 +614,7 @@ static mjModel* chain_make(void* user, double dt, char* msg, int cap) {
 
 int main(int argc, char** argv) {
   int quick = 0;
-  const char* plants = "tomato";  // the tree (13 k bodies) takes MuJoCo minutes to compile
+  const char* plants = "tomato"; // the tree (13 k bodies) takes MuJoCo minutes to compile
   const char* csv_path = NULL;
   const char* xml_dir = NULL;
   for (int i = 1; i < argc; i++) {
@@ -654,8 +678,8 @@ int main(int argc, char** argv) {
         if (csv)
           fprintf(csv, "%s,%s,%d,%d,0.001,0.05,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,\n",
                   sw ? "cantilever_selfweight" : "cantilever_tipload",
-                  root2 ? "root_2EI_l" : "uniform_EI_l", N, N, s.tip, ex, cont[sw], lin[sw], ec,
-                  ed, s.steps_s);
+                  root2 ? "root_2EI_l" : "uniform_EI_l", N, N, s.tip, ex, cont[sw], lin[sw], ec, ed,
+                  s.steps_s);
       }
 
   // 2. dynamics: the largest stable step with light damping, speed there and at 1 ms

@@ -17,13 +17,13 @@ static void on_error(const char* msg) {
     return;
   }
   snprintf(t->error, sizeof t->error, "%s", msg ? msg : "unknown MuJoCo error");
-  open_trap = t->outer;  // closed: an error in the caller's recovery goes to the outer trap
+  open_trap = t->outer; // closed: an error in the caller's recovery goes to the outer trap
   longjmp(t->env, 1);
 }
 
 static void on_warning(const char* msg) {
   vd_mj_trap* t = open_trap;
-  if (!t) return;  // outside a trap a warning is dropped (mjData counts it in d->warning)
+  if (!t) return; // outside a trap a warning is dropped (mjData counts it in d->warning)
   t->nwarning++;
   snprintf(t->warning, sizeof t->warning, "%s", msg ? msg : "");
 }
@@ -49,4 +49,6 @@ vd_status vd_mj_trap_status(const vd_mj_trap* t, vd_error* err) {
   return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "MuJoCo: %s", t->error[0] ? t->error : "error");
 }
 
-vd_mj_trap* vd_mj_trap_current(void) { return open_trap; }
+vd_mj_trap* vd_mj_trap_current(void) {
+  return open_trap;
+}

@@ -27,11 +27,11 @@
 
 // One open trap: where to jump on an error and what MuJoCo said.
 typedef struct vd_mj_trap {
-  jmp_buf env;                // the VD_MJ_TRY point
-  char error[512];            // MuJoCo's error message ("" when none)
-  char warning[512];          // the last warning message ("" when none)
-  int nwarning;               // warnings raised while the trap was open
-  struct vd_mj_trap* outer;   // the trap that was open before this one
+  jmp_buf env;              // the VD_MJ_TRY point
+  char error[512];          // MuJoCo's error message ("" when none)
+  char warning[512];        // the last warning message ("" when none)
+  int nwarning;             // warnings raised while the trap was open
+  struct vd_mj_trap* outer; // the trap that was open before this one
 } vd_mj_trap;
 
 // Point MuJoCo's error and warning hooks at the trap handlers (idempotent).

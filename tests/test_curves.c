@@ -192,7 +192,7 @@ TEST(curves, root_inside_a_curve) {
     down += s->node[s->seg[i].node1].z < s->node[s->seg[i].node0].z - 1e-9;
   }
   CHECK_INT(roots, 3);
-  CHECK_INT(down, 2);  // 0.1 -> 0.05 -> 0
+  CHECK_INT(down, 2); // 0.1 -> 0.05 -> 0
   vd_plant_spec_destroy(s);
 }
 

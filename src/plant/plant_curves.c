@@ -923,7 +923,8 @@ static vd_status connect(build* b, vd_curves_stats* stats) {
     b->parent[i] = i < b->root ? i + 1 : (i > b->root ? i - 1 : -1);
   b->start_rad[rc] = b->rad[b->root];
   b->flag[b->root] |= KEY;
-  for (int k = 0; k < nc; k++) b->depth[k] = -1;
+  for (int k = 0; k < nc; k++)
+    b->depth[k] = -1;
   b->depth[rc] = 0;
   double* gap = vd_malloc((size_t)nc * sizeof(double));
   int* at = vd_malloc((size_t)nc * sizeof(int));
@@ -934,7 +935,8 @@ static vd_status connect(build* b, vd_curves_stats* stats) {
     vd_free(end, (size_t)nc * sizeof(int));
     return bnomem(b);
   }
-  for (int k = 0; k < nc; k++) gap[k] = HUGE_VAL, at[k] = -1, end[k] = 0;
+  for (int k = 0; k < nc; k++)
+    gap[k] = HUGE_VAL, at[k] = -1, end[k] = 0;
   update_gaps(b, rc, gap, at, end);
   for (;;) {
     int k = -1;
@@ -956,8 +958,8 @@ static vd_status connect(build* b, vd_curves_stats* stats) {
       st = vd_error_set(b->err, VD_ERR_VALUE, c->file, 0, 0,
                         "curves[%d]%s%s%s: not connected to the plant: its ends are %g m from the "
                         "nearest connected curve, more than connect = %g m",
-                        k, c->cv[k].name[0] ? " (" : "", c->cv[k].name,
-                        c->cv[k].name[0] ? ")" : "", gap[k], b->def.connect);
+                        k, c->cv[k].name[0] ? " (" : "", c->cv[k].name, c->cv[k].name[0] ? ")" : "",
+                        gap[k], b->def.connect);
   vd_free(gap, (size_t)nc * sizeof(double));
   vd_free(at, (size_t)nc * sizeof(int));
   vd_free(end, (size_t)nc * sizeof(int));
