@@ -679,6 +679,28 @@ TEST(collide, exclusion_topology) {
   CHECK_STATUS(vd_collide_self(&p, NULL, &arena, &L, &err), VD_OK, err);
   CHECK_INT(L.n, 0);
   vd_collide_exclusion_free(&ex);
+  // a fruit on the chain's tip node overlaps the capsule before the last one too: excluded once
+  // it is marked as touching in the modelled shape; contacts that come later are still found
+  s.nsph = 1;
+  s.sph[0] = 0.006, s.sph[1] = 0, s.sph[2] = 0.1, s.sph_r[0] = 0.015;
+  int tip_node[1] = {10};
+  p = prims_of(&s);
+  CHECK_STATUS(vd_collide_exclusion_build(11, 10, s.cap_node, 1, tip_node, 0, &ex, &err), VD_OK,
+               err);
+  vd_collide_prims_set_exclusion(&p, &ex);
+  vd_arena_reset(&arena);
+  CHECK_STATUS(vd_collide_self(&p, NULL, &arena, &L, &err), VD_OK, err);
+  CHECK_INT(L.n, 1); // the fruit against capsule 8 (nodes 8-9)
+  CHECK_STATUS(vd_collide_exclusion_add_touching(&ex, &p, 0.001, &err), VD_OK, err);
+  vd_collide_prims_set_exclusion(&p, &ex);
+  vd_arena_reset(&arena);
+  CHECK_STATUS(vd_collide_self(&p, NULL, &arena, &L, &err), VD_OK, err);
+  CHECK_INT(L.n, 0);
+  s.sph[2] = 0.05; // the fruit swings down onto capsule 4
+  vd_arena_reset(&arena);
+  CHECK_STATUS(vd_collide_self(&p, NULL, &arena, &L, &err), VD_OK, err);
+  CHECK(L.n >= 1 && L.c[0].b == 10);
+  vd_collide_exclusion_free(&ex);
   // bad input
   cap_node[3] = 9;
   CHECK_STATUS(vd_collide_exclusion_build(6, 5, cap_node, 0, NULL, 0, &ex, &err), VD_ERR_ARG, err);
@@ -783,6 +805,20 @@ TEST(collide, out_of_memory) {
     vdt_oom_end();
     CHECK(st == VD_OK || st == VD_ERR_NOMEM);
     vd_arena_free(&arena);
+    CHECK_INT(vd_alloc_bytes(), before);
+  }
+  // extending an exclusion by the touching pairs
+  for (int budget = 0; budget < 10; budget++) {
+    int64_t before = vd_alloc_bytes();
+    vd_collide_exclusion ex;
+    CHECK_STATUS(
+        vd_collide_exclusion_build(p.nnode, p.ncapsule, sp.cap_node, p.nsphere, NULL, 0, &ex, &err),
+        VD_OK, err);
+    vdt_oom_begin(budget);
+    vd_status st = vd_collide_exclusion_add_touching(&ex, &p, 0.001, &err);
+    vdt_oom_end();
+    CHECK(st == VD_OK || st == VD_ERR_NOMEM);
+    vd_collide_exclusion_free(&ex);
     CHECK_INT(vd_alloc_bytes(), before);
   }
   int cap_node[] = {0, 1, 1, 2};

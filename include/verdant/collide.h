@@ -184,6 +184,11 @@ typedef struct vd_collide_exclusion {
 vd_status vd_collide_exclusion_build(int nnode, int ncapsule, const int* capsule_node, int nsphere,
                                      const int* sphere_node, int hops, vd_collide_exclusion* out,
                                      vd_error* err);
+// Also exclude every pair closer than margin (m) in the state rest (the modelled shape, with ex
+// set in it or not): organs that touch by design, a fruit against the pedicel segments around
+// its node, are not collisions. ex is rebuilt in place (one allocation).
+vd_status vd_collide_exclusion_add_touching(vd_collide_exclusion* ex, const vd_collide_prims* rest,
+                                            double margin, vd_error* err);
 // Free an exclusion's arrays and zero it.
 void vd_collide_exclusion_free(vd_collide_exclusion* ex);
 // Point prims' exclude_start / exclude / exclude_rows at an exclusion's arrays.

@@ -1017,6 +1017,70 @@ done:
   return st;
 }
 
+vd_status vd_collide_exclusion_add_touching(vd_collide_exclusion* ex, const vd_collide_prims* rest,
+                                            double margin, vd_error* err) {
+  if (!ex || !rest || !ex->start)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "exclusion: null argument");
+  int n = ex->nprim;
+  if (rest->ncapsule + rest->nsphere != n)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "exclusion: %d rows for %d primitives", n,
+                        rest->ncapsule + rest->nsphere);
+  // the pairs touching in the rest state, the existing exclusion applied
+  vd_collide_prims P = *rest;
+  vd_collide_prims_set_exclusion(&P, ex);
+  vd_collide_def def = vd_collide_def_default();
+  def.margin = margin;
+  vd_arena arena;
+  vd_arena_init(&arena, 0);
+  vd_contact_list L;
+  vd_status st = vd_collide_self(&P, &def, &arena, &L, err);
+  if (st || L.n == 0) {
+    vd_arena_free(&arena);
+    return st;
+  }
+  // the merged rows: old entries plus both directions of every new pair, ascending
+  size_t I = sizeof(int);
+  int* cnt = vd_calloc((size_t)n + 1, I);
+  size_t nall = (size_t)ex->nexclude + 2 * (size_t)L.n;
+  size_t head = (I * ((size_t)n + 1) + 15) & ~(size_t)15;
+  size_t nbytes = head + nall * I + I;
+  char* block = vd_malloc(nbytes);
+  if (!cnt || !block) {
+    vd_free(cnt, ((size_t)n + 1) * I);
+    vd_free(block, nbytes);
+    vd_arena_free(&arena);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory extending the exclusion");
+  }
+  int* start = (int*)block;
+  int* exc = (int*)(block + head);
+  for (int i = 0; i < n; i++)
+    cnt[i] = ex->start[i + 1] - ex->start[i];
+  for (int k = 0; k < L.n; k++)
+    cnt[L.c[k].a]++, cnt[L.c[k].b]++;
+  start[0] = 0;
+  for (int i = 0; i < n; i++)
+    start[i + 1] = start[i] + cnt[i];
+  for (int i = 0; i < n; i++) {
+    int o = start[i];
+    for (int e = ex->start[i]; e < ex->start[i + 1]; e++)
+      exc[o++] = ex->exclude[e];
+    cnt[i] = o; // next free slot of row i
+  }
+  for (int k = 0; k < L.n; k++) {
+    exc[cnt[L.c[k].a]++] = L.c[k].b;
+    exc[cnt[L.c[k].b]++] = L.c[k].a;
+  }
+  for (int i = 0; i < n; i++)
+    qsort(exc + start[i], (size_t)(start[i + 1] - start[i]), I, cmp_int);
+  vd_free(cnt, ((size_t)n + 1) * I);
+  vd_arena_free(&arena);
+  vd_free(ex->start, ex->nbytes);
+  ex->start = start, ex->exclude = exc;
+  ex->nexclude = (int)nall;
+  ex->nbytes = nbytes;
+  return VD_OK;
+}
+
 void vd_collide_exclusion_free(vd_collide_exclusion* ex) {
   if (!ex) return;
   if (ex->start) vd_free(ex->start, ex->nbytes);
