@@ -241,8 +241,8 @@ const char* vd_plant_json_format(const char* text, size_t len, char* buf, size_t
 // ---------------------------------------------------------------------------------------------
 // hand-drawn plants: branch polylines (curves JSON, docs/formats.md) to a plant spec, as Gazebo
 // Plants (Deng et al. 2024, sec. 3.5) builds them: dense sampling of every polyline, branch
-// connections within sigma_connect by breadth-first search from the root, simplification to
-// segments of about sigma_distance keeping junctions, tips, label changes and marked nodes,
+// connections within sigma_connect by a search from the root (nearest gap first), simplification
+// to segments of about sigma_distance keeping junctions, tips, curve joins and marked nodes,
 // leaves from templates and fruits as spheres at marked nodes.
 //
 //   vd_curves* c; vd_curves_read("data/curves_tomato.json", &c, &err);
