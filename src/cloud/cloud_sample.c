@@ -508,7 +508,9 @@ static int sample_chunk(const sampler* s, int64_t c, counters* k) {
         }
         double facing = vd_dot(n, to);
         if (def->occlusion) {
-          if (r->one_sided && facing <= 0) {
+          // back faces by the flat face normal (the smooth normal may lean past the silhouette)
+          vd_vec3 fn = vd_cross(vd_v3(r->e1[0], r->e1[1], r->e1[2]), vd_v3(r->e2[0], r->e2[1], r->e2[2]));
+          if (r->one_sided && vd_dot(fn, to) <= 0) {
             k->backface++;
             continue;
           }
@@ -680,7 +682,7 @@ vd_status vd_cloud_sample(const vd_model* m, const vd_data* d, const vd_cloud_de
   if (!st) pack_tris(&s);
   if (!st && (def.occlusion || def.sensor == VD_SENSOR_SCAN))
     st = vd_bvh_build_mesh(&s.mesh, s.one_sided, NULL, &s.bvh, err);
-  int64_t total = s.views[s.nview - 1].start + s.views[s.nview - 1].count;
+  int64_t total = st ? 0 : s.views[s.nview - 1].start + s.views[s.nview - 1].count;
   s.nchunk = (total + VD_CLOUD_CHUNK - 1) / VD_CLOUD_CHUNK;
   if (!st) {
     s.per_chunk = vd_calloc((size_t)s.nchunk, sizeof(counters));
