@@ -4,8 +4,9 @@
 # otherwise it prints the exact command and fails.
 set -eu
 # build and test: cmake make gcc pkg-config; JSON: libcjson-dev; PNG: libpng-dev;
-# robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3
-need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3)
+# robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3;
+# dataset checksums (SHA-256): nettle-dev
+need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3 nettle-dev)
 missing=()
 for p in "${need[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
