@@ -26,6 +26,7 @@ test: all
 
 bench: all
 	./$(BUILD)/verdant_bench $(BENCH_ARGS)
+	bash bench/cloud_bench.sh ./$(BUILD)/verdant $(BENCH_ARGS)
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant
