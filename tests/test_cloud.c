@@ -320,6 +320,40 @@ TEST(cloud, on_surface_and_not_inside_tomato) {
   CHECK(without > 50);
 }
 
+TEST(cloud, joint_caps_removed) {
+  // two segments in line, same frame: the caps where they meet are inside each other and go;
+  // the outer caps stay
+  vd_plant_spec* s = vd_plant_spec_create();
+  REQUIRE(s);
+  int a = vd_plant_add_node(s, vd_v3(0, 0, 0)), b = vd_plant_add_node(s, vd_v3(0, 0, 0.1));
+  int c = vd_plant_add_node(s, vd_v3(0, 0, 0.2));
+  vd_segment_spec g = vd_segment_spec_default();
+  g.node0 = a, g.node1 = b, g.r0 = g.r1 = 0.02, g.label = 1, g.instance = 1, g.up = vd_v3(1, 0, 0);
+  int s0 = vd_plant_add_segment(s, &g);
+  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
+  vd_plant_add_segment(s, &g);
+  vd_model* m = compile(s);
+  REQUIRE(m);
+  vd_cloud_def def = vd_cloud_def_default();
+  def.points = 20000;
+  vd_cloud cl;
+  vd_cloud_stats st;
+  vd_error err = {0};
+  REQUIRE(vd_cloud_sample(m, NULL, &def, &cl, &st, &err) == VD_OK);
+  int inner = 0, outer = 0;
+  for (int64_t i = 0; i < cl.n; i++) {
+    if (fabs(cl.normal[3 * i + 2]) < 0.99) continue;
+    double z = cl.pos[3 * i + 2];
+    inner += fabs(z - 0.1) < 1e-9;
+    outer += fabs(z) < 1e-9 || fabs(z - 0.2) < 1e-9;
+  }
+  CHECK_INT(inner, 0);
+  CHECK(outer > 500);
+  CHECK(st.rejected_interior > 500);
+  vd_cloud_free(&cl);
+  vd_model_destroy(m);
+}
+
 TEST(cloud, noisy_points_checked) {
   // a leaf through a fruit: noisy leaf points never end inside the fruit
   vd_plant_spec* s = vd_plant_spec_create();

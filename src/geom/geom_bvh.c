@@ -26,10 +26,15 @@ typedef struct bin {
   int count;
 } bin;
 
+// an item being sorted into the tree: its box and centroid move with it, so every pass over a
+// node's range reads memory in order
+typedef struct bitem {
+  double lo[3], hi[3], c[3];
+  int id;
+} bitem;
+
 typedef struct builder {
-  const double* box; // (n x 6)
-  double* cen;       // centroids (n x 3)
-  int* idx;          // item permutation, partitioned in place
+  bitem* it;         // items, partitioned in place (n)
   vd_bvh_node* node; // output nodes
   int nnode;
   vd_bvh_def def;
@@ -39,10 +44,12 @@ static void box_empty(double lo[3], double hi[3]) {
   for (int k = 0; k < 3; k++)
     lo[k] = INFINITY, hi[k] = -INFINITY;
 }
-static void box_grow(double lo[3], double hi[3], const double* b) {
+// grow [lo, hi] by [a, b]; written as selects so the compiler emits minsd/maxsd, not branches
+// (random boxes mispredict every other branch)
+static inline void box_grow2(double lo[3], double hi[3], const double a[3], const double b[3]) {
   for (int k = 0; k < 3; k++) {
-    if (b[k] < lo[k]) lo[k] = b[k];
-    if (b[3 + k] > hi[k]) hi[k] = b[3 + k];
+    lo[k] = a[k] < lo[k] ? a[k] : lo[k];
+    hi[k] = b[k] > hi[k] ? b[k] : hi[k];
   }
 }
 // half the surface area of a box; 0 for an empty box
@@ -52,33 +59,41 @@ static double half_area(const double lo[3], const double hi[3]) {
   return dx * dy + dy * dz + dz * dx;
 }
 
-static int bin_of(double c, double cmin, double scale, int nbin) {
+static inline int bin_of(double c, double cmin, double scale, int nbin) {
   int b = (int)((c - cmin) * scale);
   return b < 0 ? 0 : b >= nbin ? nbin - 1 : b;
 }
 
-// best SAH plane of the range: sets *axis and *plane (items with bin < plane go left); returns
-// 0 when every centroid is the same point
+// best SAH plane of the range over all three axes, binned in one pass: sets *axis and *plane
+// (items with bin < plane go left); returns 0 when every centroid is the same point
 static int best_split(const builder* bd, int start, int count, const double cmin[3],
                       const double cmax[3], int* axis, int* plane) {
   int nbin = bd->def.bins;
+  bin bins[3][MAX_BINS];
+  double scale[3];
+  int live[3];
+  for (int a = 0; a < 3; a++) {
+    double ext = cmax[a] - cmin[a];
+    live[a] = ext > 0;
+    scale[a] = live[a] ? nbin / ext : 0;
+    for (int b = 0; b < nbin; b++) {
+      box_empty(bins[a][b].lo, bins[a][b].hi);
+      bins[a][b].count = 0;
+    }
+  }
+  for (int i = start; i < start + count; i++) {
+    const bitem* it = &bd->it[i];
+    for (int a = 0; a < 3; a++) {
+      if (!live[a]) continue;
+      bin* b = &bins[a][bin_of(it->c[a], cmin[a], scale[a], nbin)];
+      b->count++;
+      box_grow2(b->lo, b->hi, it->lo, it->hi);
+    }
+  }
   double best = INFINITY;
   int found = 0;
   for (int a = 0; a < 3; a++) {
-    double ext = cmax[a] - cmin[a];
-    if (!(ext > 0)) continue;
-    double scale = nbin / ext;
-    bin bins[MAX_BINS];
-    for (int b = 0; b < nbin; b++) {
-      box_empty(bins[b].lo, bins[b].hi);
-      bins[b].count = 0;
-    }
-    for (int i = start; i < start + count; i++) {
-      int it = bd->idx[i];
-      bin* b = &bins[bin_of(bd->cen[3 * it + a], cmin[a], scale, nbin)];
-      b->count++;
-      box_grow(b->lo, b->hi, bd->box + 6 * (size_t)it);
-    }
+    if (!live[a]) continue;
     // sweep from the right, then from the left, costing each plane
     double right_area[MAX_BINS];
     int right_count[MAX_BINS];
@@ -86,24 +101,16 @@ static int best_split(const builder* bd, int start, int count, const double cmin
     box_empty(lo, hi);
     int cnt = 0;
     for (int b = nbin - 1; b > 0; b--) {
-      if (bins[b].count) {
-        double bb[6] = {bins[b].lo[0], bins[b].lo[1], bins[b].lo[2],
-                        bins[b].hi[0], bins[b].hi[1], bins[b].hi[2]};
-        box_grow(lo, hi, bb);
-      }
-      cnt += bins[b].count;
+      if (bins[a][b].count) box_grow2(lo, hi, bins[a][b].lo, bins[a][b].hi);
+      cnt += bins[a][b].count;
       right_area[b] = half_area(lo, hi);
       right_count[b] = cnt;
     }
     box_empty(lo, hi);
     cnt = 0;
     for (int b = 1; b < nbin; b++) {
-      if (bins[b - 1].count) {
-        double bb[6] = {bins[b - 1].lo[0], bins[b - 1].lo[1], bins[b - 1].lo[2],
-                        bins[b - 1].hi[0], bins[b - 1].hi[1], bins[b - 1].hi[2]};
-        box_grow(lo, hi, bb);
-      }
-      cnt += bins[b - 1].count;
+      if (bins[a][b - 1].count) box_grow2(lo, hi, bins[a][b - 1].lo, bins[a][b - 1].hi);
+      cnt += bins[a][b - 1].count;
       if (cnt == 0 || right_count[b] == 0) continue;
       double cost = cnt * half_area(lo, hi) + right_count[b] * right_area[b];
       if (cost < best) {
@@ -117,56 +124,83 @@ static int best_split(const builder* bd, int start, int count, const double cmin
   return found;
 }
 
+// bounds of a range's boxes and centroids
+static void range_bounds(const builder* bd, int start, int count, double lo[3], double hi[3],
+                         double cmin[3], double cmax[3]) {
+  box_empty(lo, hi);
+  box_empty(cmin, cmax);
+  for (int i = start; i < start + count; i++) {
+    const bitem* it = &bd->it[i];
+    box_grow2(lo, hi, it->lo, it->hi);
+    box_grow2(cmin, cmax, it->c, it->c);
+  }
+}
+
+// a pending node: its range and the bounds of its boxes and centroids
+typedef struct task {
+  int node, start, count;
+  double lo[3], hi[3], cmin[3], cmax[3];
+} task;
+
 static void build_tree(builder* bd, int n) {
-  // explicit stack of (node, start, count); children are allocated in pairs
-  int stack[3 * 128];
+  // explicit stack; children are allocated in pairs and get their bounds while partitioning
+  task stack[128];
   int sp = 0;
   bd->nnode = 1;
-  stack[sp++] = 0, stack[sp++] = 0, stack[sp++] = n;
+  task root = {0, 0, n, {0}, {0}, {0}, {0}};
+  range_bounds(bd, 0, n, root.lo, root.hi, root.cmin, root.cmax);
+  stack[sp++] = root;
   while (sp) {
-    int count = stack[--sp], start = stack[--sp], ni = stack[--sp];
-    vd_bvh_node* nd = &bd->node[ni];
-    double cmin[3], cmax[3];
-    box_empty(nd->lo, nd->hi);
-    box_empty(cmin, cmax);
-    for (int i = start; i < start + count; i++) {
-      int it = bd->idx[i];
-      box_grow(nd->lo, nd->hi, bd->box + 6 * (size_t)it);
-      double c[6] = {bd->cen[3 * it], bd->cen[3 * it + 1], bd->cen[3 * it + 2],
-                     bd->cen[3 * it], bd->cen[3 * it + 1], bd->cen[3 * it + 2]};
-      box_grow(cmin, cmax, c);
-    }
+    task tk = stack[--sp];
+    vd_bvh_node* nd = &bd->node[tk.node];
+    memcpy(nd->lo, tk.lo, sizeof nd->lo);
+    memcpy(nd->hi, tk.hi, sizeof nd->hi);
+    int start = tk.start, count = tk.count;
     // small ranges, and a stack about to overflow (never with sane input), become leaves
-    if (count <= bd->def.leaf_size || sp >= 3 * 126) {
+    if (count <= bd->def.leaf_size || sp >= 126) {
       nd->first = start;
       nd->count = count;
       continue;
     }
-    // partition by the best plane, or halve the range when all centroids coincide
+    // partition by the best plane, or halve the range when all centroids coincide; the two
+    // sides' bounds are gathered on the way
     int axis = 0, plane = 0, mid;
-    if (best_split(bd, start, count, cmin, cmax, &axis, &plane)) {
-      double scale = bd->def.bins / (cmax[axis] - cmin[axis]);
+    task l = {0, start, 0, {0}, {0}, {0}, {0}}, r = l;
+    box_empty(l.lo, l.hi), box_empty(l.cmin, l.cmax), box_empty(r.lo, r.hi), box_empty(r.cmin, r.cmax);
+    int split = best_split(bd, start, count, tk.cmin, tk.cmax, &axis, &plane);
+    if (split) {
+      double scale = bd->def.bins / (tk.cmax[axis] - tk.cmin[axis]);
       int i = start, j = start + count - 1;
       while (i <= j) {
-        int it = bd->idx[i];
-        if (bin_of(bd->cen[3 * it + axis], cmin[axis], scale, bd->def.bins) < plane) {
+        bitem* it = &bd->it[i];
+        if (bin_of(it->c[axis], tk.cmin[axis], scale, bd->def.bins) < plane) {
+          box_grow2(l.lo, l.hi, it->lo, it->hi);
+          box_grow2(l.cmin, l.cmax, it->c, it->c);
           i++;
         } else {
-          bd->idx[i] = bd->idx[j];
-          bd->idx[j--] = it;
+          bitem t = *it;
+          *it = bd->it[j];
+          bd->it[j--] = t;
+          box_grow2(r.lo, r.hi, t.lo, t.hi);
+          box_grow2(r.cmin, r.cmax, t.c, t.c);
         }
       }
       mid = i;
-      if (mid == start || mid == start + count) mid = start + count / 2;
-    } else {
+      split = mid > start && mid < start + count;
+    }
+    if (!split) {
       mid = start + count / 2;
+      range_bounds(bd, start, mid - start, l.lo, l.hi, l.cmin, l.cmax);
+      range_bounds(bd, mid, start + count - mid, r.lo, r.hi, r.cmin, r.cmax);
     }
     int left = bd->nnode;
     bd->nnode += 2;
     nd->first = left;
     nd->count = 0;
-    stack[sp++] = left + 1, stack[sp++] = mid, stack[sp++] = start + count - mid;
-    stack[sp++] = left, stack[sp++] = start, stack[sp++] = mid - start;
+    l.node = left, l.start = start, l.count = mid - start;
+    r.node = left + 1, r.start = mid, r.count = start + count - mid;
+    stack[sp++] = r;
+    stack[sp++] = l;
   }
 }
 
@@ -185,10 +219,10 @@ static vd_status build_common(const double* box, int n, const vd_bvh_def* def, i
   size_t nbytes = nnode_max * sizeof(vd_bvh_node) + (with_tri ? (size_t)n * sizeof(vd_bvh_tri) : 0) +
                   (size_t)n * sizeof(int);
   char* block = vd_malloc(nbytes);
-  double* cen = vd_malloc((size_t)n * 3 * sizeof(double));
-  if (!block || !cen) {
+  bitem* items = vd_malloc((size_t)n * sizeof(bitem));
+  if (!block || !items) {
     vd_free(block, nbytes);
-    vd_free(cen, (size_t)n * 3 * sizeof(double));
+    vd_free(items, (size_t)n * sizeof(bitem));
     return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory building a BVH");
   }
   out->nbytes = nbytes;
@@ -201,14 +235,20 @@ static vd_status build_common(const double* box, int n, const vd_bvh_def* def, i
   out->item = (int*)p;
   out->nitem = n;
   for (int i = 0; i < n; i++) {
-    out->item[i] = i;
-    for (int k = 0; k < 3; k++)
-      cen[3 * i + k] = 0.5 * (box[6 * (size_t)i + k] + box[6 * (size_t)i + 3 + k]);
+    bitem* it = &items[i];
+    it->id = i;
+    for (int k = 0; k < 3; k++) {
+      it->lo[k] = box[6 * (size_t)i + k];
+      it->hi[k] = box[6 * (size_t)i + 3 + k];
+      it->c[k] = 0.5 * (it->lo[k] + it->hi[k]);
+    }
   }
-  builder bd = {box, cen, out->item, out->node, 0, d};
+  builder bd = {items, out->node, 0, d};
   build_tree(&bd, n);
   out->nnode = bd.nnode;
-  vd_free(cen, (size_t)n * 3 * sizeof(double));
+  for (int i = 0; i < n; i++)
+    out->item[i] = items[i].id;
+  vd_free(items, (size_t)n * sizeof(bitem));
   return VD_OK;
 }
 
