@@ -833,6 +833,10 @@ TEST(cloud, reader_rejects_bad_files) {
       {"l.csv", "a,b,c\n1,2,3\n", VD_ERR_FORMAT},
       {"m.xyz", "# x y z\n1 2\n", VD_ERR_FORMAT},
       {"n.las", "LASF", VD_ERR_FORMAT},
+      {"o.ply", "ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\n"
+                "property float z\nend_header\n1 2 3\n", VD_ERR_FORMAT},
+      {"p.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1000000000\nDATA ascii\n1 2 3\n",
+       VD_ERR_FORMAT},
   };
   vd_error err = {0};
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {

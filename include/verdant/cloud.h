@@ -87,7 +87,8 @@ typedef struct vd_cloud_def {
   vd_mesh_def mesh;          // tessellation (caps are always closed); default vd_mesh_def_default()
   int threads;               // OpenMP threads, 0 = OpenMP's default; the output never depends
                              // on it; default 0
-  int64_t max_attempts;      // most draws for one point before giving up (>= 1); default 100000
+  int64_t max_attempts;      // most draws for one point, and a hundredth of it per point on
+                             // average over a chunk, before giving up (>= 1); default 100000
 } vd_cloud_def;
 
 // Defaults: points 100000, seed 0, uniform sensor, inverse-square law, no table, no noise

@@ -352,6 +352,10 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
   if (n < 0) return fail(r, t.line, "no vertex element");
   int has[F_COUNT];
   vd_status st = map_fields(r, &cs, has);
+  // every point takes at least its record (binary) or a digit and a separator per value (text)
+  uint64_t least = binary ? (uint64_t)cs.record : 2 * (uint64_t)cs.n;
+  if (!st && (uint64_t)n > (len - t.pos) / least)
+    st = fail(r, t.line, "%lld points do not fit in the file", (long long)n);
   if (!st) st = start_cloud(r, out, n);
   if (st) return st;
   if (binary)
@@ -441,6 +445,9 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
   }
   int has[F_COUNT];
   vd_status st = map_fields(r, &cs, has);
+  uint64_t least = binary ? (uint64_t)cs.record : 2 * (uint64_t)cs.n;
+  if (!st && (uint64_t)points > (len - t.pos) / least)
+    st = fail(r, t.line, "%lld points do not fit in the file", (long long)points);
   if (!st) st = start_cloud(r, out, points);
   if (st) return st;
   if (binary)

@@ -467,11 +467,14 @@ static int sample_chunk(const sampler* s, int64_t c, counters* k) {
   int64_t a = c * VD_CLOUD_CHUNK, b = a + VD_CLOUD_CHUNK;
   if (b > def->points) b = def->points;
   int v = 0;
+  // a budget for the chunk: max_attempts for one point, and max_attempts / 100 per point on
+  // average, so a tiny acceptance rate fails soon instead of running for hours
+  int64_t budget = def->max_attempts + def->max_attempts / 100 * (b - a), used = 0;
   for (int64_t i = a; i < b; i++) {
     while (v + 1 < s->nview && i >= s->views[v + 1].start) v++;
     const view* w = &s->views[v];
     for (int64_t tries = 0;; tries++) {
-      if (tries >= def->max_attempts) return 0;
+      if (tries >= def->max_attempts || used++ >= budget) return 0;
       k->drawn++;
       // a triangle by area, a uniform point in it
       const stri* r = &s->tri[draw_tri(s, &u)];
@@ -744,9 +747,10 @@ vd_status vd_cloud_sample(const vd_model* m, const vd_data* d, const vd_cloud_de
     vd_cloud_free(&big);
     sampler_free(&s);
     return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
-                        "a point found no surviving candidate in %lld draws: interior removal, "
-                        "the density law or occlusion leave (almost) nothing to sample",
-                        (long long)def.max_attempts);
+                        "candidates rarely survive (a point needed more than %lld draws, or more "
+                        "than %lld per point on average): interior removal, the density law or "
+                        "occlusion leave (almost) nothing to sample",
+                        (long long)def.max_attempts, (long long)(def.max_attempts / 100));
   }
   if (def.sensor == VD_SENSOR_SCAN) {
     st = compact(&big, keep, out, err);
