@@ -493,12 +493,12 @@ static int sample_chunk(const sampler* s, int64_t c, counters* k) {
       double sq = sqrt(r1), wa = 1 - sq, wb = sq * (1 - r2), wc = sq * r2;
       vd_vec3 p = vd_v3(r->v0[0] + wb * r->e1[0] + wc * r->e2[0], r->v0[1] + wb * r->e1[1] + wc * r->e2[1],
                         r->v0[2] + wb * r->e1[2] + wc * r->e2[2]);
-      vd_vec3 n = tri_normal(r, wa, wb, wc);
       // inside another closed primitive
       if (def->interior && inside_cand(s, r, p)) {
         k->interior++;
         continue;
       }
+      vd_vec3 n = tri_normal(r, wa, wb, wc);
       double d = 0;
       if (s->scanners) {
         vd_vec3 to = vd_sub(w->pos, p);

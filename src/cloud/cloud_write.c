@@ -80,6 +80,42 @@ static void put_f64(unsigned char* p, double v) {
   put_u64(p, u);
 }
 
+// 1 on a little-endian host: records are then copied field by field with memcpy
+static int host_le(void) {
+  const uint32_t one = 1;
+  unsigned char b;
+  memcpy(&b, &one, 1);
+  return b == 1;
+}
+
+// one PLY/PCD record: six float32, two int32 (+ int32 view, float32 range)
+static void put_record(unsigned char* r, const vd_cloud* c, int64_t i, int views, int le) {
+  if (le) {
+    float f[6] = {(float)c->pos[3 * i], (float)c->pos[3 * i + 1], (float)c->pos[3 * i + 2],
+                  (float)c->normal[3 * i], (float)c->normal[3 * i + 1], (float)c->normal[3 * i + 2]};
+    int32_t id[2] = {c->label[i], c->instance[i]};
+    memcpy(r, f, 24);
+    memcpy(r + 24, id, 8);
+    if (views) {
+      int32_t v = c->view[i];
+      float rg = (float)c->range[i];
+      memcpy(r + 32, &v, 4);
+      memcpy(r + 36, &rg, 4);
+    }
+    return;
+  }
+  for (int k = 0; k < 3; k++) {
+    put_f32(r + 4 * k, c->pos[3 * i + k]);
+    put_f32(r + 12 + 4 * k, c->normal[3 * i + k]);
+  }
+  put_u32(r + 24, (uint32_t)c->label[i]);
+  put_u32(r + 28, (uint32_t)c->instance[i]);
+  if (views) {
+    put_u32(r + 32, (uint32_t)c->view[i]);
+    put_f32(r + 36, c->range[i]);
+  }
+}
+
 // a string into a fixed field of cap bytes, cut, NUL-padded (the field is zeroed before)
 static void put_str(unsigned char* p, const char* str, size_t cap) {
   size_t n = strlen(str);
@@ -139,19 +175,9 @@ static void write_ply(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def
   }
   wb->fp = fp, wb->n = 0;
   size_t rec = views ? 40 : 32;
-  for (int64_t i = 0; i < c->n; i++) {
-    unsigned char* r = wb_take(wb, rec);
-    for (int k = 0; k < 3; k++) {
-      put_f32(r + 4 * k, c->pos[3 * i + k]);
-      put_f32(r + 12 + 4 * k, c->normal[3 * i + k]);
-    }
-    put_u32(r + 24, (uint32_t)c->label[i]);
-    put_u32(r + 28, (uint32_t)c->instance[i]);
-    if (views) {
-      put_u32(r + 32, (uint32_t)c->view[i]);
-      put_f32(r + 36, c->range[i]);
-    }
-  }
+  int le = host_le();
+  for (int64_t i = 0; i < c->n; i++)
+    put_record(wb_take(wb, rec), c, i, views, le);
   wb_flush(wb);
 }
 
@@ -181,19 +207,9 @@ static void write_pcd(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def
   }
   wb->fp = fp, wb->n = 0;
   size_t rec = views ? 40 : 32;
-  for (int64_t i = 0; i < c->n; i++) {
-    unsigned char* r = wb_take(wb, rec);
-    for (int k = 0; k < 3; k++) {
-      put_f32(r + 4 * k, c->pos[3 * i + k]);
-      put_f32(r + 12 + 4 * k, c->normal[3 * i + k]);
-    }
-    put_u32(r + 24, (uint32_t)c->label[i]);
-    put_u32(r + 28, (uint32_t)c->instance[i]);
-    if (views) {
-      put_u32(r + 32, (uint32_t)c->view[i]);
-      put_f32(r + 36, c->range[i]);
-    }
-  }
+  int le = host_le();
+  for (int64_t i = 0; i < c->n; i++)
+    put_record(wb_take(wb, rec), c, i, views, le);
   wb_flush(wb);
 }
 
