@@ -98,6 +98,8 @@ typedef struct cli_cloud_result {
 // Load the plant, sample its cloud, relabel if asked, write it to out (Nullable: no file).
 vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, const char* out,
                          cli_cloud_result* res, vd_error* err);
+// Points per label table entry (count has c->nlabel slots); 0 when out of memory.
+int cli_label_counts(const vd_cloud* c, int64_t* count);
 // The --stats JSON of a result (caller deletes it), NULL when out of memory.
 struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total);
 

@@ -340,6 +340,34 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
 
 static cJSON* vec_json(const double* v) { return cJSON_CreateDoubleArray(v, 3); }
 
+typedef struct id_index {
+  int id, index;
+} id_index;
+
+static int cmp_id(const void* a, const void* b) {
+  int x = ((const id_index*)a)->id, y = ((const id_index*)b)->id;
+  return (x > y) - (x < y);
+}
+
+int cli_label_counts(const vd_cloud* c, int64_t* count) {
+  for (int l = 0; l < c->nlabel; l++)
+    count[l] = 0;
+  if (c->nlabel == 0) return 1;
+  // the table sorted by id, then one binary search per point
+  id_index* ix = vd_malloc((size_t)c->nlabel * sizeof *ix);
+  if (!ix) return 0;
+  for (int l = 0; l < c->nlabel; l++)
+    ix[l] = (id_index){c->labels[l].id, l};
+  qsort(ix, (size_t)c->nlabel, sizeof *ix, cmp_id);
+  for (int64_t i = 0; i < c->n; i++) {
+    id_index key = {c->label[i], 0};
+    const id_index* at = bsearch(&key, ix, (size_t)c->nlabel, sizeof *ix, cmp_id);
+    if (at) count[at->index]++;
+  }
+  vd_free(ix, (size_t)c->nlabel * sizeof *ix);
+  return 1;
+}
+
 cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
   const vd_cloud* c = &r->cloud;
   const vd_cloud_stats* s = &r->stats;
@@ -350,17 +378,11 @@ cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
   cJSON* labels = cJSON_AddObjectToObject(root, "labels");
   int64_t* count = c->nlabel ? vd_calloc((size_t)c->nlabel, sizeof(int64_t)) : NULL;
   int ninst = 0;
-  if (count || !c->nlabel) {
-    for (int64_t i = 0; i < c->n; i++)
-      for (int l = 0; l < c->nlabel; l++)
-        if (c->labels[l].id == c->label[i]) {
-          count[l]++;
-          break;
-        }
+  if (count && cli_label_counts(c, count)) {
     for (int l = 0; l < c->nlabel; l++)
       cJSON_AddNumberToObject(labels, c->labels[l].name, (double)count[l]);
-    vd_free(count, (size_t)c->nlabel * sizeof(int64_t));
   }
+  vd_free(count, (size_t)c->nlabel * sizeof(int64_t));
   int maxi = 0;
   for (int64_t i = 0; i < c->n; i++)
     if (c->instance[i] > maxi) maxi = c->instance[i];

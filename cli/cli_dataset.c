@@ -58,6 +58,7 @@ typedef struct dataset {
   uint64_t master;
   vary vary[MAX_VARY];
   int nvary;
+  int instance_labels; // --labels instance: every item has its own label table
   char params[17];     // hex FNV-1a of the arguments that shape the output
   cJSON* arguments;    // those arguments
 } dataset;
@@ -209,16 +210,21 @@ static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const c
   cJSON_AddNumberToObject(rec, "points", (double)res.cloud.n);
   cJSON* lc = cJSON_AddObjectToObject(rec, "label_points");
   cJSON* lt = cJSON_AddArrayToObject(rec, "labels");
+  int64_t* count = res.cloud.nlabel ? vd_calloc((size_t)res.cloud.nlabel, sizeof(int64_t)) : NULL;
+  if (res.cloud.nlabel && (!count || !cli_label_counts(&res.cloud, count))) {
+    vd_free(count, (size_t)res.cloud.nlabel * sizeof(int64_t));
+    vd_cloud_free(&res.cloud);
+    cJSON_Delete(rec);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
   for (int l = 0; l < res.cloud.nlabel; l++) {
-    int64_t n = 0;
-    for (int64_t p = 0; p < res.cloud.n; p++)
-      n += res.cloud.label[p] == res.cloud.labels[l].id;
-    cJSON_AddNumberToObject(lc, res.cloud.labels[l].name, (double)n);
+    cJSON_AddNumberToObject(lc, res.cloud.labels[l].name, (double)count[l]);
     cJSON* e = cJSON_CreateObject();
     cJSON_AddNumberToObject(e, "id", res.cloud.labels[l].id);
     cJSON_AddStringToObject(e, "name", res.cloud.labels[l].name);
     cJSON_AddItemToArray(lt, e);
   }
+  vd_free(count, (size_t)res.cloud.nlabel * sizeof(int64_t));
   cJSON_AddNumberToObject(rec, "bytes", (double)bytes);
   cJSON_AddStringToObject(rec, "sha256", hex);
   cJSON_AddStringToObject(rec, "parameters", ds->params);
@@ -267,19 +273,26 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
       cJSON_Delete(labels);
       return 1;
     }
-    // the label table: every id once, in order of first appearance
+    // the label table: every id once, in order of first appearance (semantic labels); with
+    // instance labels each item keeps its own table
     const cJSON* lt = cJSON_GetObjectItemCaseSensitive(rec, "labels");
     const cJSON* e;
-    cJSON_ArrayForEach(e, lt) {
-      const cJSON* id = cJSON_GetObjectItemCaseSensitive(e, "id");
-      int seen = 0;
-      const cJSON* o;
-      cJSON_ArrayForEach(o, labels) seen |= cJSON_GetObjectItemCaseSensitive(o, "id")->valuedouble == id->valuedouble;
-      if (!seen) cJSON_AddItemToArray(labels, cJSON_Duplicate(e, 1));
+    if (!ds->instance_labels) {
+      cJSON_ArrayForEach(e, lt) {
+        const cJSON* id = cJSON_GetObjectItemCaseSensitive(e, "id");
+        int seen = 0;
+        const cJSON* o;
+        cJSON_ArrayForEach(o, labels) {
+          const cJSON* oid = cJSON_GetObjectItemCaseSensitive(o, "id");
+          seen |= cJSON_IsNumber(oid) && cJSON_IsNumber(id) && oid->valuedouble == id->valuedouble;
+        }
+        if (!seen) cJSON_AddItemToArray(labels, cJSON_Duplicate(e, 1));
+      }
+      cJSON_DeleteItemFromObjectCaseSensitive(rec, "labels");
     }
-    cJSON_DeleteItemFromObjectCaseSensitive(rec, "labels");
     cJSON_DeleteItemFromObjectCaseSensitive(rec, "parameters");
-    total += (int64_t)cJSON_GetObjectItemCaseSensitive(rec, "points")->valuedouble;
+    const cJSON* pts = cJSON_GetObjectItemCaseSensitive(rec, "points");
+    total += cJSON_IsNumber(pts) ? (int64_t)pts->valuedouble : 0;
     cJSON_AddItemToArray(items, rec);
   }
   cJSON_AddStringToObject(root, "format", DATASET_FORMAT);
@@ -306,7 +319,10 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
   cJSON_AddStringToObject(root, "regenerate",
                           "verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
                           "<parameters.arguments> -o item.<cloud_format>");
-  cJSON_AddItemToObject(root, "labels", labels);
+  if (ds->instance_labels)
+    cJSON_Delete(labels);  // in the items
+  else
+    cJSON_AddItemToObject(root, "labels", labels);
   cJSON_AddItemToObject(root, "items", items);
   char path[4200];
   snprintf(path, sizeof path, "%s/manifest.json", ds->dir);
@@ -415,6 +431,7 @@ int cli_dataset(int argc, char** argv) {
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
   ds.master = po.seed;
+  ds.instance_labels = co.labels_instance;
   ds.progress = po.progress;
   ds.width = 6;
   for (int c = ds.count - 1; c >= 1000000; c /= 10) ds.width++;
