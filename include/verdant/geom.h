@@ -165,6 +165,7 @@ typedef struct vd_solid {
                        // (parent side, child side), -1 when none
   vd_vec3 c;           // frustum start centre or sphere centre (m)
   vd_quat q;           // frustum frame: z along the axis, x toward ring vertex 0
+  double rot[9];       // the same frame as a world-to-frame rotation, rows x, y, z
   double len;          // frustum length (m)
   double r0, r1;       // frustum circumradius at start and end, sphere radius in r0 (m)
   int tri_start, ntri; // closed mesh: range in the solids' triangle array

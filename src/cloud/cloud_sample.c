@@ -102,6 +102,10 @@ typedef struct sampler {
   int failed;
 } sampler;
 
+static vd_vec3 mesh_vert(const vd_mesh* mesh, int v) {
+  return vd_v3(mesh->pos[3 * (size_t)v], mesh->pos[3 * (size_t)v + 1], mesh->pos[3 * (size_t)v + 2]);
+}
+
 // ---------------------------------------------------------------------------------------------
 // checks
 
@@ -294,12 +298,29 @@ static vd_status build_candidates(sampler* s, vd_error* err) {
     }
     int own = vd_solids_own(so, mesh->tri_kind[t], mesh->tri_prim[t]);
     int j0 = own >= 0 ? so->solid[own].joined[0] : -1, j1 = own >= 0 ? so->solid[own].joined[1] : -1;
+    // the triangle's bounding sphere: centroid and farthest vertex
+    vd_vec3 tv[3], cen = vd_v3(0, 0, 0);
+    for (int c = 0; c < 3; c++) {
+      tv[c] = mesh_vert(mesh, mesh->tri[3 * t + c]);
+      cen = vd_madd(cen, tv[c], 1.0 / 3.0);
+    }
+    double rad = 0;
+    for (int c = 0; c < 3; c++)
+      rad = fmax(rad, vd_norm(vd_sub(tv[c], cen)));
     for (int i = 0; i < m; i++) {
       const vd_solid* sd = &so->solid[buf[i]];
       if (buf[i] == own || buf[i] == j0 || buf[i] == j1) continue;
       if (lo[0] > sd->hi[0] || hi[0] < sd->lo[0] || lo[1] > sd->hi[1] || hi[1] < sd->lo[1] ||
           lo[2] > sd->hi[2] || hi[2] < sd->lo[2])
         continue;
+      // boxes of slanted frustums are loose: drop solids whose bounding capsule or sphere the
+      // triangle's bounding sphere misses
+      if (sd->kind == VD_PRIM_SPHERE && vd_norm(vd_sub(cen, sd->c)) > sd->r0 + rad + 2 * so->eps) continue;
+      if (sd->kind == VD_PRIM_SEGMENT) {
+        vd_vec3 ax = vd_v3(sd->rot[6], sd->rot[7], sd->rot[8]), d = vd_sub(cen, sd->c);
+        double z = vd_dot(d, ax), zc = z < 0 ? 0 : z > sd->len ? sd->len : z;
+        if (vd_norm(vd_sub(d, vd_scale(ax, zc))) > fmax(sd->r0, sd->r1) + rad + 2 * so->eps) continue;
+      }
       if (!vd_grow((void**)&s->cand, &s->cand_cap, s->ncand + 1, sizeof(int))) {
         vd_free(buf, (size_t)buf_cap * sizeof(int));
         return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory for interior candidates");
@@ -321,10 +342,6 @@ static inline int inside_cand(const sampler* s, const stri* r, vd_vec3 p) {
 
 // ---------------------------------------------------------------------------------------------
 // views: scanner frames, surface distance range, density peak
-
-static vd_vec3 mesh_vert(const vd_mesh* mesh, int v) {
-  return vd_v3(mesh->pos[3 * (size_t)v], mesh->pos[3 * (size_t)v + 1], mesh->pos[3 * (size_t)v + 2]);
-}
 
 // distance from p to the triangle abc (Ericson, Real-Time Collision Detection, 5.1.5)
 static double dist_tri(vd_vec3 p, vd_vec3 a, vd_vec3 b, vd_vec3 c) {

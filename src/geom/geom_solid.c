@@ -40,6 +40,8 @@ static void solid_init(vd_solid* s, int kind, int prim, int label, int instance)
   s->kind = kind, s->prim = prim, s->label = label, s->instance = instance;
   s->joined[0] = s->joined[1] = -1;
   s->q = vd_quat_identity();
+  for (int k = 0; k < 9; k++)
+    s->rot[k] = k % 4 == 0;
   for (int k = 0; k < 3; k++)
     s->lo[k] = INFINITY, s->hi[k] = -INFINITY;
 }
@@ -115,6 +117,9 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
     vd_vec3 axis = vd_quat_rotate(q, vd_v3(0, 0, 1));
     s->c = c0;
     s->q = q;
+    vd_vec3 ax[3] = {vd_quat_rotate(q, vd_v3(1, 0, 0)), vd_quat_rotate(q, vd_v3(0, 1, 0)), axis};
+    for (int r = 0; r < 3; r++)
+      s->rot[3 * r] = ax[r].x, s->rot[3 * r + 1] = ax[r].y, s->rot[3 * r + 2] = ax[r].z;
     s->len = vd_dot(vd_sub(c1, c0), axis);
     s->r0 = m->seg_radius[2 * i], s->r1 = m->seg_radius[2 * i + 1];
     s->slices = geom_seg_slices(m, md.slices, i);
@@ -190,7 +195,10 @@ static int sector(double y, double x, int n) {
 }
 
 static int in_frustum(const vd_solid* s, vd_vec3 p, double eps) {
-  vd_vec3 v = vd_quat_rotate(vd_quat_conj(s->q), vd_sub(p, s->c));
+  vd_vec3 d = vd_sub(p, s->c);
+  const double* R = s->rot;
+  vd_vec3 v = vd_v3(R[0] * d.x + R[1] * d.y + R[2] * d.z, R[3] * d.x + R[4] * d.y + R[5] * d.z,
+                    R[6] * d.x + R[7] * d.y + R[8] * d.z);
   if (v.z < -eps || v.z > s->len + eps) return 0;
   double f = s->len > 0 ? v.z / s->len : 0.5;
   f = f < 0 ? 0 : f > 1 ? 1 : f;
