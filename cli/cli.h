@@ -59,7 +59,20 @@ int cli_has_ext(const char* path, const char* ext);
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
 
+// A point cloud read from a file (arrays owned, label and instance Nullable).
+typedef struct cli_cloud {
+  int n;          // points
+  double* xyz;    // positions (m) (n x 3)
+  int* label;     // semantic label per point, NULL when the file has none (n)
+  int* instance;  // instance per point, NULL when the file has none (n)
+} cli_cloud;
+// Read x, y, z, label, instance of the vertex element of a PLY file (ASCII or binary).
+vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err);
+// Free what cli_read_ply_cloud allocated.
+void cli_cloud_free(cli_cloud* c);
+
 // Subcommands.
 int cli_grow(int argc, char** argv);
+int cli_render(int argc, char** argv);
 
 #endif

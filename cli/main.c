@@ -17,6 +17,7 @@ static const char* main_help =
     "\n"
     "commands:\n"
     "  grow      L-system (.lpy) or plant file → plant JSON, OBJ or PLY, with --stats\n"
+    "  render    plant or point cloud → PNG colour image, depth, label and instance masks\n"
     "\n"
     "Run 'verdant <command> --help' for the options of a command.\n"
     "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
     return EXIT_OK;
   }
   if (!strcmp(cmd, "grow")) return cli_grow(argc - 1, argv + 1);
+  if (!strcmp(cmd, "render")) return cli_render(argc - 1, argv + 1);
   fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
   fputs(main_help, stderr);
   return EXIT_USAGE;
