@@ -86,31 +86,31 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
       d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 0.5\" material=\"ground\"/>\n" : "");
 }
 
-// load the stage from memory, or the robot from its file; NULL with err set on failure
-static mjModel* load_model(vd_renderer* r, vd_error* err) {
+// load the stage from memory, or the robot from its file; NULL with *st and err set on failure
+static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
   char msg[1000] = "";
   mjModel* m = NULL;
   if (r->def.robot_mjcf) {
     m = mj_loadXML(r->robot_path, NULL, msg, sizeof msg);
-    if (!m) vd_error_set(err, VD_ERR_FORMAT, r->robot_path, 0, 0, "robot MJCF: %s", msg);
+    if (!m) *st = vd_error_set(err, VD_ERR_FORMAT, r->robot_path, 0, 0, "robot MJCF: %s", msg);
     return m;
   }
   char xml[4096];
   int len = stage_xml(&r->def, xml, sizeof xml);
   r->vfs = vd_malloc(sizeof *r->vfs);
   if (!r->vfs) {
-    vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    *st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
     return NULL;
   }
   mj_defaultVFS(r->vfs);
   if (mj_makeEmptyFileVFS(r->vfs, "stage.xml", len) != 0) {
-    vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "MuJoCo's file system refused the stage");
+    *st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "MuJoCo's file system refused the stage");
     return NULL;
   }
   int i = mj_findFileVFS(r->vfs, "stage.xml");
   memcpy(r->vfs->filedata[i], xml, (size_t)len);
   m = mj_loadXML("stage.xml", r->vfs, msg, sizeof msg);
-  if (!m) vd_error_set(err, VD_ERR_FORMAT, "", 0, 0, "stage model: %s", msg);
+  if (!m) *st = vd_error_set(err, VD_ERR_FORMAT, "", 0, 0, "stage model: %s", msg);
   return m;
 }
 
@@ -124,10 +124,8 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
                         mjguard_message());
   }
   vd_status st = VD_OK;
-  r->m = load_model(r, err);
-  if (!r->m) {
-    st = err && err->status ? err->status : VD_ERR_FORMAT;
-  } else {
+  r->m = load_model(r, &st, err);
+  if (r->m) {
     // offscreen buffer for the supersampled colour pass; no multisampling (exact id pass)
     r->m->vis.global.offwidth = r->def.width * r->def.supersample;
     r->m->vis.global.offheight = r->def.height * r->def.supersample;
