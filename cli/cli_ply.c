@@ -96,7 +96,10 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
         goto done;
       }
     } else if (!strcmp(w0, "element")) {
-      if (seen_vertex && !in_vertex) continue;
+      if (seen_vertex) {  // elements after the vertices are not read
+        in_vertex = 0;
+        continue;
+      }
       in_vertex = !strcmp(w1, "vertex");
       if (!in_vertex) {
         st = vd_error_set(err, VD_ERR_UNSUPPORTED, path, line, 9, "the vertex element must come first (found '%s')", w1);

@@ -20,8 +20,8 @@ static const char* render_help =
     "options:\n"
     "  -o, --output OUT.png  colour image; the other files take its name: OUT.depth.png,\n"
     "                        OUT.label.png, OUT.instance.png, OUT.json\n"
-    "      --camera VIEW     front | side | top | orbit[:AZ[:EL]] (degrees; default orbit:-60:20),\n"
-    "                        fitted to the plant; default front\n"
+    "      --camera VIEW     front | side | top | orbit[:AZ[:EL]] (degrees, orbit alone is\n"
+    "                        orbit:-60:20), fitted to the plant; default orbit\n"
     "      --eye X,Y,Z       explicit camera position (m); with --lookat, replaces --camera\n"
     "      --lookat X,Y,Z    point the camera looks at (m)\n"
     "      --up X,Y,Z        image up direction (default 0,0,1)\n"
@@ -103,7 +103,7 @@ int cli_render(int argc, char** argv) {
   cli_plant_opts_init(&po);
   const char* out = NULL;
   const char* robot = NULL;
-  const char* camera_text = "front";
+  const char* camera_text = "orbit";
   vd_vec3 eye, lookat, up = vd_v3(0, 0, 1);
   int has_eye = 0, has_lookat = 0, depth = 0, masks = 0, info = 0;
   double fov = 45, point_size = 0;

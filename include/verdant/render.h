@@ -167,7 +167,7 @@ typedef struct vd_points {
 // Add a point cloud coloured by label or instance (style Nullable: by label).
 vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_render_style* s,
                                vd_error* err);
-// Bounds of everything added (m); 0 when nothing is added.
+// Bounds of everything added and of the robot's geoms (m); 0 when there is nothing.
 int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi);
 
 // ---------------------------------------------------------------------------------------------

@@ -68,7 +68,7 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
       "<mujoco model=\"verdant_stage\">\n"
       "  <visual>\n"
       "    <global offwidth=\"%d\" offheight=\"%d\"/>\n"
-      "    <quality shadowsize=\"4096\" offsamples=\"0\"/>\n"
+      "    <quality shadowsize=\"2048\" offsamples=\"0\"/>\n"
       "  </visual>\n"
       "  <asset>\n"
       "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"%g %g %g\" rgb2=\"%g %g %g\" "
@@ -83,7 +83,7 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
       "</mujoco>\n",
       d->width * d->supersample, d->height * d->supersample, d->sky ? 0.92 : bg[0], d->sky ? 0.95 : bg[1],
       d->sky ? 1.0 : bg[2], d->sky ? 0.55 : bg[0], d->sky ? 0.68 : bg[1], d->sky ? 0.85 : bg[2],
-      d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 0.5\" material=\"ground\"/>\n" : "");
+      d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 3\" material=\"ground\"/>\n" : "");
 }
 
 // load the stage from memory, or the robot from its file; NULL with *st and err set on failure
@@ -130,7 +130,7 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
     r->m->vis.global.offwidth = r->def.width * r->def.supersample;
     r->m->vis.global.offheight = r->def.height * r->def.supersample;
     r->m->vis.quality.offsamples = 0;
-    r->m->vis.quality.shadowsize = 4096;
+    r->m->vis.quality.shadowsize = 2048;
     r->d = mj_makeData(r->m);
     mj_forward(r->m, r->d);
     mjv_defaultOption(&r->opt);

@@ -98,9 +98,21 @@ static void bounds_add(vd_renderer* r, vd_vec3 p) {
 }
 
 int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi) {
-  *lo = r->has_bounds ? r->lo : vd_v3(0, 0, 0);
-  *hi = r->has_bounds ? r->hi : vd_v3(0, 0, 0);
-  return r->has_bounds;
+  int any = r->has_bounds;
+  *lo = any ? r->lo : vd_v3(0, 0, 0);
+  *hi = any ? r->hi : vd_v3(0, 0, 0);
+  // the robot's geoms (bounding spheres), world geoms such as its floor left out
+  if (r->def.robot_mjcf)
+    for (int g = 0; g < r->m->ngeom; g++) {
+      if (r->m->geom_bodyid[g] == 0) continue;
+      const double* p = r->d->geom_xpos + 3 * g;
+      double s = r->m->geom_rbound[g];
+      vd_vec3 a = vd_v3(p[0] - s, p[1] - s, p[2] - s), b = vd_v3(p[0] + s, p[1] + s, p[2] + s);
+      *lo = any ? vd_vmin(*lo, a) : a;
+      *hi = any ? vd_vmax(*hi, b) : b;
+      any = 1;
+    }
+  return any;
 }
 
 void render_items_free(vd_renderer* r) {
