@@ -65,8 +65,11 @@ typedef struct cli_cloud {
   double* xyz;    // positions (m) (n x 3)
   int* label;     // semantic label per point, NULL when the file has none (n)
   int* instance;  // instance per point, NULL when the file has none (n)
+  vd_label* labels;  // label names from "comment label ID NAME" header lines (nlabel), owned
+  int nlabel;
 } cli_cloud;
-// Read x, y, z, label, instance of the vertex element of a PLY file (ASCII or binary).
+// Read x, y, z, label, instance of the vertex element of a PLY file (ASCII or binary), and the
+// label names of "comment label ID NAME" lines (as verdant's PLY writers put them).
 vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err);
 // Free what cli_read_ply_cloud allocated.
 void cli_cloud_free(cli_cloud* c);

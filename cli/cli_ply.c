@@ -53,6 +53,7 @@ void cli_cloud_free(cli_cloud* c) {
   vd_free(c->xyz, sizeof(double) * 3 * (size_t)c->n + 1);
   vd_free(c->label, sizeof(int) * (size_t)c->n + 1);
   vd_free(c->instance, sizeof(int) * (size_t)c->n + 1);
+  vd_free(c->labels, sizeof(vd_label) * (size_t)c->nlabel);
   memset(c, 0, sizeof *c);
 }
 
@@ -62,6 +63,12 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
   size_t len;
   vd_status st = vd_file_read(path, &text, &len, err);
   if (st) return st;
+  // label names go through a plant spec, which gives them their organ colours
+  vd_plant_spec* names = vd_plant_spec_create();
+  if (!names) {
+    vd_free(text, len + 1);
+    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  }
   // header, line by line
   prop props[64];
   int nprop = 0, fmt = -1, line = 0, in_vertex = 0, seen_vertex = 0, have[5] = {0};
@@ -87,6 +94,15 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
     pos = e + 1;
     char w0[32] = "", w1[32] = "", w2[32] = "", w3[32] = "";
     int nw = sscanf(buf, "%31s %31s %31s %31s", w0, w1, w2, w3);
+    int id, at = 0;
+    if (!strcmp(w0, "comment") && sscanf(buf, "comment label %d %n", &id, &at) == 1 && at > 0 && buf[at] &&
+        id >= 0 && id <= 65535) {
+      if (vd_plant_set_label(names, id, buf + at)) {
+        st = vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+        goto done;
+      }
+      continue;
+    }
     if (line == 1 || nw <= 0 || !strcmp(w0, "comment") || !strcmp(w0, "obj_info")) continue;
     if (!strcmp(w0, "end_header")) break;
     if (!strcmp(w0, "format")) {
@@ -194,7 +210,17 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
       dst[i] = (int)v[k];
     }
   }
+  if (names->nlabel) {
+    out->labels = vd_malloc(sizeof(vd_label) * (size_t)names->nlabel);
+    if (!out->labels) {
+      st = vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+      goto done;
+    }
+    memcpy(out->labels, names->label, sizeof(vd_label) * (size_t)names->nlabel);
+    out->nlabel = names->nlabel;
+  }
 done:
+  vd_plant_spec_destroy(names);
   vd_free(text, len + 1);
   if (st) cli_cloud_free(out);
   return st;

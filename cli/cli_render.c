@@ -238,7 +238,7 @@ int cli_render(int argc, char** argv) {
   }
   if (info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
   if (is_cloud) {
-    vd_points pts = {cl.n, cl.xyz, cl.label, cl.instance, point_size, NULL, 0};
+    vd_points pts = {cl.n, cl.xyz, cl.label, cl.instance, point_size, cl.labels, cl.nlabel};
     st = vd_render_add_points(r, &pts, &style, &err);
   } else {
     st = vd_render_add_plant(r, model, NULL, &style, &err);

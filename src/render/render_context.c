@@ -104,6 +104,7 @@ static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
   }
   mj_defaultVFS(r->vfs);
   if (mj_makeEmptyFileVFS(r->vfs, "stage.xml", len) != 0) {
+    mj_deleteVFS(r->vfs);
     *st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "MuJoCo's file system refused the stage");
     return NULL;
   }
@@ -111,6 +112,10 @@ static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
   memcpy(r->vfs->filedata[i], xml, (size_t)len);
   m = mj_loadXML("stage.xml", r->vfs, msg, sizeof msg);
   if (!m) *st = vd_error_set(err, VD_ERR_FORMAT, "", 0, 0, "stage model: %s", msg);
+  // the file system is needed for loading only
+  mj_deleteVFS(r->vfs);
+  vd_free(r->vfs, sizeof *r->vfs);
+  r->vfs = NULL;
   return m;
 }
 
@@ -204,6 +209,7 @@ void vd_render_destroy(vd_renderer* r) {
   }
   if (r->d) mj_deleteData(r->d);
   if (r->m) mj_deleteModel(r->m);
+  if (r->vfs) mj_deleteVFS(r->vfs);
   vd_free(r->vfs, sizeof *r->vfs);
   if (r->have_gl) gl_destroy(&r->gl);
   size_t n = (size_t)r->def.width * (size_t)r->def.height;
