@@ -547,3 +547,46 @@ TEST(render, png_round_trip) {
   CHECK_STATUS(vd_render_read_png(path, &w, &h, &ch, &bits, &pix, &err), VD_ERR_FORMAT, err);
   CHECK(pix == NULL);
 }
+
+TEST(render, out_of_memory) {
+  // every allocation failing in turn: NOMEM (or success), never a crash, nothing leaked; first
+  // while creating a renderer, then while adding a plant and drawing with one
+  vd_vec3 v[4] = {{-0.2, 0, 0.35}, {0.2, 0, 0.35}, {0.2, 0, 0.65}, {-0.2, 0, 0.65}};
+  vd_model* m = quad_plant(v, 2, 5);
+  REQUIRE(m);
+  vd_render_def d = small_def(32, 24);
+  vd_renderer* r = renderer(&d);
+  if (!r) {
+    vd_model_destroy(m);
+    return;
+  }
+  vd_render_destroy(r);
+  r = NULL;
+  vd_error err = {0};
+  for (int budget = 0; budget < 100 && !r; budget++) {
+    vdt_oom_begin(budget);
+    vd_status st = vd_render_create(&d, &r, &err);
+    vdt_oom_end();
+    CHECK(st == VD_OK || st == VD_ERR_NOMEM);
+    CHECK(st == VD_OK || r == NULL);
+  }
+  REQUIRE(r);
+  int done = 0;
+  vd_camera c = cam_y(vd_v3(0, -2, 0.5), 40);
+  for (int budget = 0; budget < 200 && !done; budget++) {
+    vd_render_clear(r);
+    vd_frame f;
+    vdt_oom_begin(budget);
+    vd_status st = vd_render_add_plant(r, m, NULL, NULL, &err);
+    if (!st) st = vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err);
+    vdt_oom_end();
+    CHECK(st == VD_OK || st == VD_ERR_NOMEM);
+    if (st == VD_OK) {
+      done = 1;
+      CHECK_INT(f.label[12 * 32 + 16], 2);
+    }
+  }
+  CHECK(done);
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}
