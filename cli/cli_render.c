@@ -229,6 +229,11 @@ int cli_render(int argc, char** argv) {
     code = cli_report("render", &err, st);
     goto done;
   }
+  // room in the scene for every organ instance (or cloud group) whatever the plant's size
+  {
+    long need = is_cloud ? cl.n : model->ninstance;
+    if (need + 16 > def.max_geoms) def.max_geoms = need + 16 > 10000000 ? 10000000 : (int)need + 16;
+  }
   // the renderer: a missing OpenGL context is a failed run, not bad input
   st = vd_render_create(&def, &r, &err);
   if (st) {

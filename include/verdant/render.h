@@ -100,15 +100,15 @@ typedef struct vd_render_def {
   double headlight;        // light at the camera, diffuse intensity in [0, 1]; default 0.35
   double ambient;          // ambient intensity in [0, 1]; default 0.3
   int legend;              // 1: draw the legend into the colour image; default 1
-  int max_geoms;           // most scene geoms (organ instances, cloud groups, robot geoms);
-                           // default 100000
+  int max_geoms;           // most scene geoms we add (organ instances, cloud groups);
+                           // default 20000
   const char* robot_mjcf;  // Nullable: MJCF file of a robot (with its own world) drawn with the
                            // plants at its reference pose; default NULL
 } vd_render_def;
 
 // Defaults: 640 x 480, supersample 2, shadows 1, floor 1, sky 1, background (1, 1, 1), key light
 // from azimuth -2.0 rad at elevation 1.0 rad with intensity 0.6, headlight 0.35, ambient 0.3,
-// legend 1, max_geoms 100000, robot_mjcf NULL.
+// legend 1, max_geoms 20000, robot_mjcf NULL.
 vd_render_def vd_render_def_default(void);
 
 // An offscreen renderer: OpenGL context, MuJoCo scene and context, image buffers.
@@ -167,7 +167,8 @@ typedef struct vd_points {
 // Add a point cloud coloured by label or instance (style Nullable: by label).
 vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_render_style* s,
                                vd_error* err);
-// Bounds of everything added and of the robot's geoms (m); 0 when there is nothing.
+// Bounds of everything added and of the robot's geoms (m); with the floor on, of what is above
+// it (z >= 0) when anything is. Returns 0 when there is nothing.
 int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi);
 
 // ---------------------------------------------------------------------------------------------

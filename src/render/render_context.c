@@ -25,7 +25,7 @@ vd_render_def vd_render_def_default(void) {
   d.headlight = 0.35;
   d.ambient = 0.3;
   d.legend = 1;
-  d.max_geoms = 100000;
+  d.max_geoms = 20000;
   d.robot_mjcf = NULL;
   return d;
 }

@@ -98,7 +98,7 @@ struct vd_renderer {
   int nitem, cap_item;
   cloud* clouds;               // clouds (ncloud)
   int ncloud, cap_cloud;
-  double cloud_eye[3], cloud_fwd[3];  // camera the cloud lists were built for
+  double cloud_eye[3], cloud_fwd[3], cloud_up[3];  // camera the cloud lists were built for
   int cloud_lists_valid;
   vd_legend_entry* legend;     // labels in use, sorted by id (nlegend)
   int nlegend, cap_legend;
@@ -107,6 +107,8 @@ struct vd_renderer {
   double range_min, range_max; // colour scale of the last value-coloured plant
   vd_vec3 lo, hi;              // bounds of everything added
   int has_bounds;
+  vd_vec3 lo_up, hi_up;        // bounds of what is above the floor (z >= 0)
+  int has_bounds_up;
   // images
   uint8_t* big;                // supersampled colour (kW x kH x 3), bottom row first
   uint8_t* rgb;                // colour (W x H x 3), top row first

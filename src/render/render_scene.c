@@ -86,21 +86,24 @@ static vd_status legend_add(vd_renderer* r, int id, const char* name, const floa
   return VD_OK;
 }
 
-// grow the bounds of everything added
+// grow the bounds of everything added, and of what is above the floor
 static void bounds_add(vd_renderer* r, vd_vec3 p) {
-  if (!r->has_bounds) {
-    r->lo = r->hi = p;
-    r->has_bounds = 1;
-  } else {
-    r->lo = vd_vmin(r->lo, p);
-    r->hi = vd_vmax(r->hi, p);
+  r->lo = r->has_bounds ? vd_vmin(r->lo, p) : p;
+  r->hi = r->has_bounds ? vd_vmax(r->hi, p) : p;
+  r->has_bounds = 1;
+  if (p.z >= 0) {
+    r->lo_up = r->has_bounds_up ? vd_vmin(r->lo_up, p) : p;
+    r->hi_up = r->has_bounds_up ? vd_vmax(r->hi_up, p) : p;
+    r->has_bounds_up = 1;
   }
 }
 
 int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi) {
+  // with a floor, what lies under it (roots) is hidden: the bounds are those of what is above
+  int up = r->def.floor && r->has_bounds_up;
   int any = r->has_bounds;
-  *lo = any ? r->lo : vd_v3(0, 0, 0);
-  *hi = any ? r->hi : vd_v3(0, 0, 0);
+  *lo = up ? r->lo_up : any ? r->lo : vd_v3(0, 0, 0);
+  *hi = up ? r->hi_up : any ? r->hi : vd_v3(0, 0, 0);
   // the robot's geoms (bounding spheres), world geoms such as its floor left out
   if (r->def.robot_mjcf)
     for (int g = 0; g < r->m->ngeom; g++) {
@@ -135,7 +138,7 @@ void vd_render_clear(vd_renderer* r) {
   render_items_free(r);
   r->nlegend = 0;
   r->nadded = 0;
-  r->has_bounds = 0;
+  r->has_bounds = r->has_bounds_up = 0;
   r->range_min = r->range_max = 0;
 }
 
@@ -425,7 +428,7 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
 vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double fwd[3],
                                const double right[3], const double up[3], vd_error* err) {
   if (r->cloud_lists_valid && !memcmp(eye, r->cloud_eye, sizeof r->cloud_eye) &&
-      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd))
+      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd) && !memcmp(up, r->cloud_up, sizeof r->cloud_up))
     return VD_OK;
   // largest group, for one scratch buffer
   int most = 0;
@@ -461,6 +464,7 @@ vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double
   if (!st) {
     memcpy(r->cloud_eye, eye, sizeof r->cloud_eye);
     memcpy(r->cloud_fwd, fwd, sizeof r->cloud_fwd);
+    memcpy(r->cloud_up, up, sizeof r->cloud_up);
     r->cloud_lists_valid = 1;
   }
   return st;
