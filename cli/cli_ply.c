@@ -12,10 +12,11 @@
 
 // PLY scalar types and their sizes
 static int type_size(const char* t) {
-  static const char* names[][2] = {{"char", "1"},   {"int8", "1"},   {"uchar", "1"},  {"uint8", "1"},
-                                   {"short", "2"},  {"int16", "2"},  {"ushort", "2"}, {"uint16", "2"},
-                                   {"int", "4"},    {"int32", "4"},  {"uint", "4"},   {"uint32", "4"},
-                                   {"float", "4"},  {"float32", "4"}, {"double", "8"}, {"float64", "8"}};
+  static const char* names[][2] = {
+      {"char", "1"},  {"int8", "1"},    {"uchar", "1"},  {"uint8", "1"},
+      {"short", "2"}, {"int16", "2"},   {"ushort", "2"}, {"uint16", "2"},
+      {"int", "4"},   {"int32", "4"},   {"uint", "4"},   {"uint32", "4"},
+      {"float", "4"}, {"float32", "4"}, {"double", "8"}, {"float64", "8"}};
   for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
     if (!strcmp(t, names[i][0])) return names[i][1][0] - '0';
   return 0;
@@ -23,15 +24,16 @@ static int type_size(const char* t) {
 
 typedef struct prop {
   char type[16];
-  int size;    // bytes in binary files
+  int size; // bytes in binary files
   int is_float, is_signed;
-  int role;    // 0 x, 1 y, 2 z, 3 label, 4 instance, -1 other
+  int role; // 0 x, 1 y, 2 z, 3 label, 4 instance, -1 other
 } prop;
 
 // one binary scalar as a double
 static double get_bin(const unsigned char* p, const prop* q, int big) {
   unsigned char b[8];
-  for (int i = 0; i < q->size; i++) b[i] = big ? p[q->size - 1 - i] : p[i];
+  for (int i = 0; i < q->size; i++)
+    b[i] = big ? p[q->size - 1 - i] : p[i];
   if (q->is_float) {
     if (q->size == 4) {
       float f;
@@ -43,8 +45,10 @@ static double get_bin(const unsigned char* p, const prop* q, int big) {
     return d;
   }
   uint64_t u = 0;
-  for (int i = q->size - 1; i >= 0; i--) u = u << 8 | b[i];
-  if (q->is_signed && (u >> (8 * q->size - 1)) & 1) return (double)(int64_t)(u | (~(uint64_t)0 << (8 * q->size - 1)));
+  for (int i = q->size - 1; i >= 0; i--)
+    u = u << 8 | b[i];
+  if (q->is_signed && (u >> (8 * q->size - 1)) & 1)
+    return (double)(int64_t)(u | (~(uint64_t)0 << (8 * q->size - 1)));
   return (double)u;
 }
 
@@ -75,13 +79,15 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
   long long n = -1;
   size_t pos = 0;
   if (len < 4 || strncmp(text, "ply", 3) || (text[3] != '\n' && text[3] != '\r')) {
-    st = vd_error_set(err, VD_ERR_FORMAT, path, 1, 1, "not a PLY file (expected 'ply' on the first line)");
+    st = vd_error_set(err, VD_ERR_FORMAT, path, 1, 1,
+                      "not a PLY file (expected 'ply' on the first line)");
     goto done;
   }
   for (;;) {
     line++;
     size_t e = pos;
-    while (e < len && text[e] != '\n') e++;
+    while (e < len && text[e] != '\n')
+      e++;
     if (e >= len) {
       st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "header without end_header");
       goto done;
@@ -95,8 +101,8 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
     char w0[32] = "", w1[32] = "", w2[32] = "", w3[32] = "";
     int nw = sscanf(buf, "%31s %31s %31s %31s", w0, w1, w2, w3);
     int id, at = 0;
-    if (!strcmp(w0, "comment") && sscanf(buf, "comment label %d %n", &id, &at) == 1 && at > 0 && buf[at] &&
-        id >= 0 && id <= 65535) {
+    if (!strcmp(w0, "comment") && sscanf(buf, "comment label %d %n", &id, &at) == 1 && at > 0 &&
+        buf[at] && id >= 0 && id <= 65535) {
       if (vd_plant_set_label(names, id, buf + at)) {
         st = vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
         goto done;
@@ -106,19 +112,23 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
     if (line == 1 || nw <= 0 || !strcmp(w0, "comment") || !strcmp(w0, "obj_info")) continue;
     if (!strcmp(w0, "end_header")) break;
     if (!strcmp(w0, "format")) {
-      fmt = !strcmp(w1, "ascii") ? 0 : !strcmp(w1, "binary_little_endian") ? 1 : !strcmp(w1, "binary_big_endian") ? 2 : -2;
+      fmt = !strcmp(w1, "ascii")                  ? 0
+            : !strcmp(w1, "binary_little_endian") ? 1
+            : !strcmp(w1, "binary_big_endian")    ? 2
+                                                  : -2;
       if (fmt == -2) {
         st = vd_error_set(err, VD_ERR_FORMAT, path, line, 8, "unknown PLY format '%s'", w1);
         goto done;
       }
     } else if (!strcmp(w0, "element")) {
-      if (seen_vertex) {  // elements after the vertices are not read
+      if (seen_vertex) { // elements after the vertices are not read
         in_vertex = 0;
         continue;
       }
       in_vertex = !strcmp(w1, "vertex");
       if (!in_vertex) {
-        st = vd_error_set(err, VD_ERR_UNSUPPORTED, path, line, 9, "the vertex element must come first (found '%s')", w1);
+        st = vd_error_set(err, VD_ERR_UNSUPPORTED, path, line, 9,
+                          "the vertex element must come first (found '%s')", w1);
         goto done;
       }
       seen_vertex = 1;
@@ -131,9 +141,10 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
       }
       in_vertex = 1;
     } else if (!strcmp(w0, "property")) {
-      if (!in_vertex) continue;  // properties of later elements: not read
+      if (!in_vertex) continue; // properties of later elements: not read
       if (!strcmp(w1, "list")) {
-        st = vd_error_set(err, VD_ERR_UNSUPPORTED, path, line, 10, "list properties of vertices are not supported");
+        st = vd_error_set(err, VD_ERR_UNSUPPORTED, path, line, 10,
+                          "list properties of vertices are not supported");
         goto done;
       }
       if (nprop == 64 || !type_size(w1) || nw < 3) {
@@ -155,7 +166,8 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
     }
   }
   if (fmt < 0 || n < 0 || !have[0] || !have[1] || !have[2]) {
-    st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "PLY header needs a format and a vertex element with x, y, z");
+    st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1,
+                      "PLY header needs a format and a vertex element with x, y, z");
     goto done;
   }
   out->n = (int)n;
@@ -168,7 +180,8 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
   }
   // the vertices
   size_t stride = 0;
-  for (int k = 0; k < nprop; k++) stride += (size_t)props[k].size;
+  for (int k = 0; k < nprop; k++)
+    stride += (size_t)props[k].size;
   char* p = text + pos;
   for (long long i = 0; i < n; i++) {
     double v[5] = {0};
@@ -177,7 +190,8 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
         char* end;
         double x = strtod(p, &end);
         if (end == p) {
-          st = vd_error_set(err, VD_ERR_FORMAT, path, line + 1 + (int)i, 0, "vertex %lld: expected %d numbers", i, nprop);
+          st = vd_error_set(err, VD_ERR_FORMAT, path, line + 1 + (int)i, 0,
+                            "vertex %lld: expected %d numbers", i, nprop);
           goto done;
         }
         p = end;
@@ -189,12 +203,14 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
         goto done;
       }
       for (int k = 0, off = 0; k < nprop; off += props[k].size, k++)
-        if (props[k].role >= 0) v[props[k].role] = get_bin((unsigned char*)p + off, &props[k], fmt == 2);
+        if (props[k].role >= 0)
+          v[props[k].role] = get_bin((unsigned char*)p + off, &props[k], fmt == 2);
       p += stride;
     }
     for (int k = 0; k < 3; k++) {
       if (!isfinite(v[k])) {
-        st = vd_error_set(err, VD_ERR_VALUE, path, 0, 0, "vertex %lld: coordinate is not finite", i);
+        st =
+            vd_error_set(err, VD_ERR_VALUE, path, 0, 0, "vertex %lld: coordinate is not finite", i);
         goto done;
       }
       out->xyz[3 * i + k] = v[k];
@@ -203,7 +219,8 @@ vd_status cli_read_ply_cloud(const char* path, cli_cloud* out, vd_error* err) {
       int* dst = k == 3 ? out->label : out->instance;
       if (!dst) continue;
       if (!(v[k] >= 0 && v[k] <= 65535) || v[k] != floor(v[k])) {
-        st = vd_error_set(err, VD_ERR_VALUE, path, 0, 0, "vertex %lld: %s %g is not an integer in 0..65535", i,
+        st = vd_error_set(err, VD_ERR_VALUE, path, 0, 0,
+                          "vertex %lld: %s %g is not an integer in 0..65535", i,
                           k == 3 ? "label" : "instance", v[k]);
         goto done;
       }

@@ -13,7 +13,8 @@
 static const char* render_help =
     "usage: verdant render PLANT|CLOUD -o OUT.png [options]\n"
     "\n"
-    "Draw a plant (an .lpy file, derived on the fly, or a plant .json) or a point cloud (.ply with\n"
+    "Draw a plant (an .lpy file, derived on the fly, or a plant .json) or a point cloud (.ply "
+    "with\n"
     "x y z and optional label, instance) headless with MuJoCo's renderer (EGL; software rendering\n"
     "when there is no GPU) and write a colour PNG with a legend.\n"
     "\n"
@@ -71,9 +72,12 @@ static int parse_num(const char* s, double* out) {
 // --camera VIEW
 static int parse_camera(const char* s, vd_camera_kind* kind, double* az, double* el) {
   *az = -60, *el = 20;
-  if (!strcmp(s, "front")) *kind = VD_CAMERA_FRONT;
-  else if (!strcmp(s, "side")) *kind = VD_CAMERA_SIDE;
-  else if (!strcmp(s, "top")) *kind = VD_CAMERA_TOP;
+  if (!strcmp(s, "front"))
+    *kind = VD_CAMERA_FRONT;
+  else if (!strcmp(s, "side"))
+    *kind = VD_CAMERA_SIDE;
+  else if (!strcmp(s, "top"))
+    *kind = VD_CAMERA_TOP;
   else if (!strncmp(s, "orbit", 5) && (s[5] == 0 || s[5] == ':')) {
     *kind = VD_CAMERA_ORBIT;
     if (s[5] == ':') {
@@ -121,8 +125,9 @@ int cli_render(int argc, char** argv) {
     if (r > 0) continue;
     // options with a value
     const char* val = NULL;
-    static const char* with_value[] = {"-o", "--output", "--camera", "--eye", "--lookat", "--up", "--fov",
-                                       "--size", "--color-by", "--supersample", "--point-size", "--robot"};
+    static const char* with_value[] = {"-o",         "--output",      "--camera",     "--eye",
+                                       "--lookat",   "--up",          "--fov",        "--size",
+                                       "--color-by", "--supersample", "--point-size", "--robot"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
       if (!strcmp(a, with_value[k])) {
         if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
@@ -133,13 +138,16 @@ int cli_render(int argc, char** argv) {
     } else if (!strcmp(a, "--camera")) {
       camera_text = val;
     } else if (!strcmp(a, "--eye")) {
-      if (!parse_vec(val, &eye)) return cli_usage_error("render", "--eye expects X,Y,Z in metres, got '%s'", val);
+      if (!parse_vec(val, &eye))
+        return cli_usage_error("render", "--eye expects X,Y,Z in metres, got '%s'", val);
       has_eye = 1;
     } else if (!strcmp(a, "--lookat")) {
-      if (!parse_vec(val, &lookat)) return cli_usage_error("render", "--lookat expects X,Y,Z in metres, got '%s'", val);
+      if (!parse_vec(val, &lookat))
+        return cli_usage_error("render", "--lookat expects X,Y,Z in metres, got '%s'", val);
       has_lookat = 1;
     } else if (!strcmp(a, "--up")) {
-      if (!parse_vec(val, &up)) return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
+      if (!parse_vec(val, &up))
+        return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
     } else if (!strcmp(a, "--fov")) {
       if (!parse_num(val, &fov) || fov <= 0 || fov >= 180)
         return cli_usage_error("render", "--fov expects degrees in (0, 180), got '%s'", val);
@@ -147,14 +155,21 @@ int cli_render(int argc, char** argv) {
       int w, h;
       char tail;
       if (sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-        return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'", val);
+        return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'",
+                               val);
       def.width = w, def.height = h;
     } else if (!strcmp(a, "--color-by")) {
-      if (!strcmp(val, "label")) style.color_by = VD_COLOR_LABEL;
-      else if (!strcmp(val, "instance")) style.color_by = VD_COLOR_INSTANCE;
-      else if (!strcmp(val, "stress")) style.color_by = VD_COLOR_STRESS;
-      else if (!strcmp(val, "displacement")) style.color_by = VD_COLOR_DISPLACEMENT;
-      else return cli_usage_error("render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
+      if (!strcmp(val, "label"))
+        style.color_by = VD_COLOR_LABEL;
+      else if (!strcmp(val, "instance"))
+        style.color_by = VD_COLOR_INSTANCE;
+      else if (!strcmp(val, "stress"))
+        style.color_by = VD_COLOR_STRESS;
+      else if (!strcmp(val, "displacement"))
+        style.color_by = VD_COLOR_DISPLACEMENT;
+      else
+        return cli_usage_error(
+            "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
     } else if (!strcmp(a, "--supersample")) {
       double k;
       if (!parse_num(val, &k) || k != floor(k) || k < 1 || k > 4)
@@ -162,7 +177,8 @@ int cli_render(int argc, char** argv) {
       def.supersample = (int)k;
     } else if (!strcmp(a, "--point-size")) {
       if (!parse_num(val, &point_size) || point_size <= 0)
-        return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'", val);
+        return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'",
+                               val);
     } else if (!strcmp(a, "--robot")) {
       robot = val;
     } else if (!strcmp(a, "--depth")) {
@@ -188,24 +204,31 @@ int cli_render(int argc, char** argv) {
     }
   }
   // check the whole command line before doing any work
-  if (!po.path) return cli_usage_error("render", "missing PLANT or CLOUD (.lpy, plant .json or .ply)");
+  if (!po.path)
+    return cli_usage_error("render", "missing PLANT or CLOUD (.lpy, plant .json or .ply)");
   if (!out) return cli_usage_error("render", "missing -o OUT.png");
-  if (!cli_has_ext(out, ".png")) return cli_usage_error("render", "output '%s' must end in .png", out);
+  if (!cli_has_ext(out, ".png"))
+    return cli_usage_error("render", "output '%s' must end in .png", out);
   vd_camera_kind kind = VD_CAMERA_FRONT;
   double az = 0, el = 0;
   if (!parse_camera(camera_text, &kind, &az, &el))
-    return cli_usage_error("render", "--camera expects front, side, top or orbit[:AZ[:EL]] (degrees), got '%s'",
-                           camera_text);
+    return cli_usage_error(
+        "render", "--camera expects front, side, top or orbit[:AZ[:EL]] (degrees), got '%s'",
+        camera_text);
   if (has_eye != has_lookat) return cli_usage_error("render", "--eye and --lookat go together");
   struct stat sb;
   if (stat(po.path, &sb) == 0 && S_ISDIR(sb.st_mode))
-    return cli_usage_error("render", "'%s' is a folder: rendering simulation runs waits for the run format of "
-                           "'verdant sim' (not yet available)", po.path);
+    return cli_usage_error(
+        "render",
+        "'%s' is a folder: rendering simulation runs waits for the run format of "
+        "'verdant sim' (not yet available)",
+        po.path);
   int is_cloud = cli_has_ext(po.path, ".ply");
   if (is_cloud && style.color_by != VD_COLOR_LABEL && style.color_by != VD_COLOR_INSTANCE)
     return cli_usage_error("render", "a point cloud is coloured by label or instance");
   if (!is_cloud && style.color_by == VD_COLOR_STRESS)
-    return cli_usage_error("render", "--color-by stress needs a simulation state (a run of 'verdant sim'); "
+    return cli_usage_error("render",
+                           "--color-by stress needs a simulation state (a run of 'verdant sim'); "
                            "a plant at rest carries no stress");
   def.robot_mjcf = robot;
   // load what is drawn
@@ -266,14 +289,16 @@ int cli_render(int argc, char** argv) {
     cam = vd_camera_preset(kind, az * VD_PI / 180, el * VD_PI / 180, lo, hi, def.width, def.height);
     if (fov != 45) {
       // keep the fitted view, narrow or widen the lens: move along the axis to keep the framing
-      double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2), f1 = tan(fov * VD_PI / 360);
+      double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2),
+             f1 = tan(fov * VD_PI / 360);
       vd_vec3 dir = vd_normalize(vd_sub(cam.eye, cam.lookat));
       cam.eye = vd_madd(cam.lookat, dir, d * f0 / f1);
       cam.fovy = fov * VD_PI / 180;
       cam.zfar += d * f0 / f1;
     }
   }
-  unsigned layers = VD_LAYER_COLOR | (depth ? VD_LAYER_DEPTH : 0) | (masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
+  unsigned layers = VD_LAYER_COLOR | (depth ? VD_LAYER_DEPTH : 0) |
+                    (masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
   vd_frame f;
   st = vd_render_draw(r, &cam, layers, &f, &err);
   if (st) {
@@ -295,11 +320,14 @@ int cli_render(int argc, char** argv) {
     int nf = 0;
     files[nf++] = "color", files[nf++] = out;
     if (depth) files[nf++] = "depth", files[nf++] = p_depth;
-    if (masks) files[nf++] = "label", files[nf++] = p_label, files[nf++] = "instance", files[nf++] = p_inst;
+    if (masks)
+      files[nf++] = "label", files[nf++] = p_label, files[nf++] = "instance", files[nf++] = p_inst;
     files[nf] = NULL;
     st = vd_render_write_json(&f, files, p_json, &err);
   }
-  if (st) code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL) : cli_report("render", &err, st);
+  if (st)
+    code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL)
+                           : cli_report("render", &err, st);
 done:
   vd_render_destroy(r);
   vd_model_destroy(model);

@@ -175,9 +175,12 @@ TEST(render, one_leaf_mask) {
       int in_rect = x > u0 + 0.5 && x < u1 - 0.5 && y > v0 + 0.5 && y < v1 - 0.5;
       int out_rect = x < u0 - 0.5 || x > u1 + 0.5 || y < v0 - 0.5 || y > v1 + 0.5;
       if (l) area++;
-      if (in_rect) inside++, wrong += !(l == 2 && in == 5);
-      else if (out_rect) wrong += l != 0 || in != 0;
-      else edge += l != 0 && !(l == 2 && in == 5);  // no mixed ids on the edge either
+      if (in_rect)
+        inside++, wrong += !(l == 2 && in == 5);
+      else if (out_rect)
+        wrong += l != 0 || in != 0;
+      else
+        edge += l != 0 && !(l == 2 && in == 5); // no mixed ids on the edge either
     }
   CHECK(inside > 1000);
   CHECK_INT(wrong, 0);
@@ -200,7 +203,7 @@ static double ray_plane(const vd_intrinsics* K, double u, double v, vd_vec3 p0, 
                       K->R[6] * X + K->R[7] * Y + K->R[8]);
   double den = vd_dot(dir, n);
   if (fabs(den) < 1e-12) return 0;
-  return vd_dot(vd_sub(p0, K->t), n) / den;  // dir has camera z = 1, so t is the depth
+  return vd_dot(vd_sub(p0, K->t), n) / den; // dir has camera z = 1, so t is the depth
 }
 
 TEST(render, depth_of_planes) {
@@ -213,7 +216,9 @@ TEST(render, depth_of_planes) {
   double dist = 1.2345;
   vd_vec3 a[4] = {{-3, dist, -3}, {3, dist, -3}, {3, dist, 3}, {-3, dist, 3}};
   double s = sin(50 * VD_PI / 180), co = cos(50 * VD_PI / 180);
-  vd_vec3 b[4] = {{-3, 2.5 - 3 * s, -3 * co}, {3, 2.5 - 3 * s, -3 * co}, {3, 2.5 + 3 * s, 3 * co},
+  vd_vec3 b[4] = {{-3, 2.5 - 3 * s, -3 * co},
+                  {3, 2.5 - 3 * s, -3 * co},
+                  {3, 2.5 + 3 * s, 3 * co},
                   {-3, 2.5 + 3 * s, 3 * co}};
   vd_vec3 nb = vd_normalize(vd_cross(vd_sub(b[1], b[0]), vd_sub(b[3], b[0])));
   for (int k = 0; k < 2; k++) {
@@ -237,7 +242,7 @@ TEST(render, depth_of_planes) {
         worst = fmax(worst, fabs(got - want));
         n++;
       }
-    CHECK(n > f.width * f.height * 9 / 10);  // the planes (nearly) fill the view
+    CHECK(n > f.width * f.height * 9 / 10); // the planes (nearly) fill the view
     CHECK(worst < 1e-3);
     if (k == 0) {
       // the 16-bit PNG holds millimetres
@@ -251,7 +256,7 @@ TEST(render, depth_of_planes) {
         CHECK_INT(w * h, f.width * f.height);
         CHECK_INT(ch, 1);
         CHECK_INT(bits, 16);
-        CHECK(abs((int)pix[0] - 1235) <= 1);  // 1234.5 mm, rounded
+        CHECK(abs((int)pix[0] - 1235) <= 1); // 1234.5 mm, rounded
         CHECK(abs((int)pix[w * h / 2 + w / 2] - 1235) <= 1);
         vd_free(pix, (size_t)w * h * ch * sizeof(uint16_t));
       }
@@ -278,9 +283,12 @@ TEST(render, tomato_masks_consistent) {
   // but have depth; sky pixels have no depth
   int* inst_label = calloc((size_t)m->ninstance + 1, sizeof(int));
   REQUIRE(inst_label);
-  for (int i = 0; i < m->nseg; i++) inst_label[m->seg_instance[i]] = m->seg_label[i];
-  for (int i = 0; i < m->nsphere; i++) inst_label[m->sphere_instance[i]] = m->sphere_label[i];
-  for (int i = 0; i < m->nmesh; i++) inst_label[m->mesh_instance[i]] = m->mesh_label[i];
+  for (int i = 0; i < m->nseg; i++)
+    inst_label[m->seg_instance[i]] = m->seg_label[i];
+  for (int i = 0; i < m->nsphere; i++)
+    inst_label[m->sphere_instance[i]] = m->sphere_label[i];
+  for (int i = 0; i < m->nmesh; i++)
+    inst_label[m->mesh_instance[i]] = m->mesh_label[i];
   int plant = 0, bad = 0, floor_px = 0, sky = 0, labels_seen = 0;
   for (int i = 0; i < f.width * f.height; i++) {
     int in = f.instance[i], l = f.label[i];
@@ -290,16 +298,18 @@ TEST(render, tomato_masks_consistent) {
       labels_seen |= 1 << (l & 31);
     } else {
       bad += l != 0;
-      if (f.depth[i] > 0) floor_px++;
-      else sky++;
+      if (f.depth[i] > 0)
+        floor_px++;
+      else
+        sky++;
     }
   }
   free(inst_label);
   CHECK_INT(bad, 0);
   CHECK(plant > 1000);
   CHECK(floor_px > 1000 && sky > 1000);
-  CHECK(labels_seen & (1 << 2));  // leaves
-  CHECK(labels_seen & (1 << 1));  // stem
+  CHECK(labels_seen & (1 << 2)); // leaves
+  CHECK(labels_seen & (1 << 1)); // stem
   vd_render_destroy(r);
   vd_model_destroy(m);
 }
@@ -326,7 +336,8 @@ TEST(render, deterministic) {
     CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR | VD_LAYER_LABEL, &f, &err), VD_OK, err);
     rgb[k] = malloc(3 * n);
     lab[k] = malloc(2 * n);
-    if (rgb[k] && lab[k] && f.rgb && f.label) memcpy(rgb[k], f.rgb, 3 * n), memcpy(lab[k], f.label, 2 * n);
+    if (rgb[k] && lab[k] && f.rgb && f.label)
+      memcpy(rgb[k], f.rgb, 3 * n), memcpy(lab[k], f.label, 2 * n);
     vd_render_destroy(r);
     vd_model_destroy(m);
     ran++;
@@ -336,7 +347,8 @@ TEST(render, deterministic) {
     CHECK(memcmp(lab[0], lab[1], 2 * n) == 0);
     CHECK(memcmp(lab[0], lab[2], 2 * n) != 0);
   }
-  for (int k = 0; k < 3; k++) free(rgb[k]), free(lab[k]);
+  for (int k = 0; k < 3; k++)
+    free(rgb[k]), free(lab[k]);
 }
 
 TEST(render, colour_modes_and_legend) {
@@ -350,9 +362,12 @@ TEST(render, colour_modes_and_legend) {
   REQUIRE(st);
   vd_error err = {0};
   // displacement: move the whole plant by 3 cm, every primitive has moved 3 cm
-  for (int i = 0; i < 3 * m->nnode; i += 3) st->node_pos[i] += 0.03;
-  for (int i = 0; i < 3 * m->nsphere; i += 3) st->sphere_pos[i] += 0.03;
-  for (int i = 0; i < 3 * m->nvert; i += 3) st->vert_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nnode; i += 3)
+    st->node_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nsphere; i += 3)
+    st->sphere_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nvert; i += 3)
+    st->vert_pos[i] += 0.03;
   vd_render_style s = vd_render_style_default();
   s.color_by = VD_COLOR_DISPLACEMENT;
   CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
@@ -371,7 +386,8 @@ TEST(render, colour_modes_and_legend) {
   CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_ERR_ARG, err);
   double* stress = malloc(sizeof(double) * (size_t)m->nseg);
   REQUIRE(stress);
-  for (int i = 0; i < m->nseg; i++) stress[i] = 1e5 * i;
+  for (int i = 0; i < m->nseg; i++)
+    stress[i] = 1e5 * i;
   s.seg_stress = stress;
   CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
   CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
@@ -385,7 +401,8 @@ TEST(render, colour_modes_and_legend) {
   CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
   CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
   CHECK(f.nlegend >= 4);
-  for (int i = 1; i < f.nlegend; i++) CHECK(f.legend[i].id > f.legend[i - 1].id);
+  for (int i = 1; i < f.nlegend; i++)
+    CHECK(f.legend[i].id > f.legend[i - 1].id);
   CHECK(vd_model_find_label(m, f.legend[0].id) != NULL);
   if (f.nlegend) CHECK_STR(f.legend[0].name, vd_model_find_label(m, f.legend[0].id)->name);
   // a layer that was not drawn cannot be written; a bad layer mask is refused
@@ -416,7 +433,8 @@ TEST(render, point_splats) {
     lab[i] = right ? 4 : 3;
     inst[i] = right ? 9 : 7;
   }
-  vd_label names[2] = {{3, "fruit", VD_ORGAN_FRUIT, {1, 0, 0}}, {4, "leaf", VD_ORGAN_LEAF, {0, 1, 0}}};
+  vd_label names[2] = {{3, "fruit", VD_ORGAN_FRUIT, {1, 0, 0}},
+                       {4, "leaf", VD_ORGAN_LEAF, {0, 1, 0}}};
   vd_points p = {N, xyz, lab, inst, 0.01, names, 2};
   vd_error err = {0};
   CHECK_STATUS(vd_render_add_points(r, &p, NULL, &err), VD_OK, err);
@@ -438,10 +456,11 @@ TEST(render, point_splats) {
   CHECK_STR(f.legend[1].name, "leaf");
   // a second camera rebuilds the splats to face it
   vd_camera c2 = c;
-  c2.eye = vd_v3(-2, 0.03, 0.51), c2.lookat = vd_v3(0, 0.03, 0.51);  // label 3 in front
+  c2.eye = vd_v3(-2, 0.03, 0.51), c2.lookat = vd_v3(0, 0.03, 0.51); // label 3 in front
   CHECK_STATUS(vd_render_draw(r, &c2, VD_LAYER_LABEL, &f, &err), VD_OK, err);
   int n3 = 0;
-  for (int i = 0; i < f.width * f.height; i++) n3 += f.label[i] == 3;
+  for (int i = 0; i < f.width * f.height; i++)
+    n3 += f.label[i] == 3;
   CHECK(n3 > 20);
   // bad points
   xyz[5] = NAN;
@@ -511,8 +530,9 @@ TEST(render, png_round_trip) {
   enum { W = 37, H = 23 };
   uint16_t lab[W * H], inst[W * H];
   uint8_t rgb[W * H * 3];
-  for (int i = 0; i < W * H; i++) lab[i] = (uint16_t)(i * 97), inst[i] = (uint16_t)(65535 - i), rgb[3 * i] = (uint8_t)i,
-                                  rgb[3 * i + 1] = (uint8_t)(i >> 3), rgb[3 * i + 2] = 7;
+  for (int i = 0; i < W * H; i++)
+    lab[i] = (uint16_t)(i * 97), inst[i] = (uint16_t)(65535 - i), rgb[3 * i] = (uint8_t)i,
+    rgb[3 * i + 1] = (uint8_t)(i >> 3), rgb[3 * i + 2] = 7;
   vd_frame f;
   memset(&f, 0, sizeof f);
   f.width = W, f.height = H, f.rgb = rgb, f.label = lab, f.instance = inst;
@@ -533,12 +553,14 @@ TEST(render, png_round_trip) {
   if (pix) {
     CHECK(ch == 3 && bits == 8);
     int same = 1;
-    for (int i = 0; i < W * H * 3; i++) same &= pix[i] == rgb[i];
+    for (int i = 0; i < W * H * 3; i++)
+      same &= pix[i] == rgb[i];
     CHECK(same);
     vd_free(pix, (size_t)w * h * ch * 2);
   }
   // an unwritable path fails with nothing left behind; garbage is not a PNG
-  CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_LABEL, "/nonexistent-dir/x.png", &err), VD_ERR_IO, err);
+  CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_LABEL, "/nonexistent-dir/x.png", &err), VD_ERR_IO,
+               err);
   snprintf(path, sizeof path, "%s/garbage.png", vdt_tmpdir());
   FILE* fp = fopen(path, "w");
   REQUIRE(fp);

@@ -20,14 +20,15 @@ static double now(void) {
 
 typedef struct bench_case {
   const char* name;
-  int robot;         // draw data/robots/arm6.xml
-  int plant;         // draw the tomato (0: the peer, MuJoCo's stage or robot alone)
-  int supersample;   // colour anti-aliasing
-  unsigned layers;   // what is drawn per frame
+  int robot;       // draw data/robots/arm6.xml
+  int plant;       // draw the tomato (0: the peer, MuJoCo's stage or robot alone)
+  int supersample; // colour anti-aliasing
+  unsigned layers; // what is drawn per frame
 } bench_case;
 
 // seconds per frame of a case, mean over frames after one warm-up frame; -1 on failure
-static double run_case(const bench_case* c, const vd_model* m, int frames, double* setup_s, const char** info) {
+static double run_case(const bench_case* c, const vd_model* m, int frames, double* setup_s,
+                       const char** info) {
   vd_render_def def = vd_render_def_default();
   def.supersample = c->supersample;
   char robot[4200];
@@ -57,7 +58,8 @@ static double run_case(const bench_case* c, const vd_model* m, int frames, doubl
   vd_frame f;
   double total = 0;
   for (int i = 0; i <= frames; i++) {
-    vd_camera cam = vd_camera_preset(VD_CAMERA_ORBIT, -1.0 + 0.02 * i, 0.35, lo, hi, def.width, def.height);
+    vd_camera cam =
+        vd_camera_preset(VD_CAMERA_ORBIT, -1.0 + 0.02 * i, 0.35, lo, hi, def.width, def.height);
     double a = now();
     if (vd_render_draw(r, &cam, c->layers, &f, &err)) {
       fprintf(stderr, "%s: %s\n", c->name, err.msg);
@@ -74,8 +76,10 @@ int main(int argc, char** argv) {
   int frames = 20;
   const char* csv_path = NULL;
   for (int i = 1; i < argc; i++) {
-    if (!strcmp(argv[i], "--quick")) frames = 5;
-    else if (!strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
+    if (!strcmp(argv[i], "--quick"))
+      frames = 5;
+    else if (!strcmp(argv[i], "--csv") && i + 1 < argc)
+      csv_path = argv[++i];
   }
   char defpath[512];
   if (!csv_path) {
@@ -110,13 +114,18 @@ int main(int argc, char** argv) {
   }
   const unsigned C = VD_LAYER_COLOR, ALL = VD_LAYER_ALL;
   const bench_case cases[] = {
-      {"stage alone (peer)", 0, 0, 1, C},        {"tomato", 0, 1, 1, C},
-      {"tomato, supersample 2", 0, 1, 2, C},     {"tomato + depth + masks", 0, 1, 1, ALL},
-      {"arm alone (peer)", 1, 0, 1, C},          {"tomato + arm", 1, 1, 1, C},
+      {"stage alone (peer)", 0, 0, 1, C},
+      {"tomato", 0, 1, 1, C},
+      {"tomato, supersample 2", 0, 1, 2, C},
+      {"tomato + depth + masks", 0, 1, 1, ALL},
+      {"arm alone (peer)", 1, 0, 1, C},
+      {"tomato + arm", 1, 1, 1, C},
       {"tomato + arm + depth + masks", 1, 1, 1, ALL},
   };
-  fprintf(csv, "bench,case,width,height,supersample,layers,plant_triangles,frames,ms_per_frame,frames_per_s,"
-               "setup_s,ratio_vs_peer\n");
+  fprintf(
+      csv,
+      "bench,case,width,height,supersample,layers,plant_triangles,frames,ms_per_frame,frames_per_s,"
+      "setup_s,ratio_vs_peer\n");
   printf("tomato seed 1: %d triangles, 640 x 480, %d frames per case\n", ntri, frames);
   printf("%-32s %10s %8s %10s %8s\n", "case", "ms/frame", "fps", "setup_s", "x peer");
   double peer = 0;
@@ -127,8 +136,8 @@ int main(int argc, char** argv) {
     if (t < 0) return 1;
     if (!c->plant) peer = t;
     printf("%-32s %10.1f %8.1f %10.3f %8.2f\n", c->name, 1e3 * t, 1 / t, setup, t / peer);
-    fprintf(csv, "render,%s,640,480,%d,%u,%d,%d,%.2f,%.2f,%.4f,%.3f\n", c->name, c->supersample, c->layers,
-            c->plant ? ntri : 0, frames, 1e3 * t, 1 / t, setup, t / peer);
+    fprintf(csv, "render,%s,640,480,%d,%u,%d,%d,%.2f,%.2f,%.4f,%.3f\n", c->name, c->supersample,
+            c->layers, c->plant ? ntri : 0, frames, 1e3 * t, 1 / t, setup, t / peer);
     fflush(stdout);
   }
   printf("context: %s\nresults: %s\n", info, csv_path);

@@ -44,29 +44,29 @@ extern "C" {
 
 // Camera presets, each fitted to a box so that all of it is in view.
 typedef enum vd_camera_kind {
-  VD_CAMERA_FRONT = 0,  // from -Y looking toward +Y, Z up
-  VD_CAMERA_SIDE,       // from +X looking toward -X, Z up
-  VD_CAMERA_TOP,        // from +Z looking down, Y up in the image
-  VD_CAMERA_ORBIT,      // from azimuth/elevation around the box centre, Z up
+  VD_CAMERA_FRONT = 0, // from -Y looking toward +Y, Z up
+  VD_CAMERA_SIDE,      // from +X looking toward -X, Z up
+  VD_CAMERA_TOP,       // from +Z looking down, Y up in the image
+  VD_CAMERA_ORBIT,     // from azimuth/elevation around the box centre, Z up
 } vd_camera_kind;
 
 // A pinhole camera.
 typedef struct vd_camera {
-  vd_vec3 eye;     // optical centre (m)
-  vd_vec3 lookat;  // a point on the optical axis in front of the camera (m)
-  vd_vec3 up;      // image up direction (need not be orthogonal to the axis, not parallel to it)
-  double fovy;     // vertical field of view (rad), in (0, pi)
-  double znear;    // near clip distance (m), > 0
-  double zfar;     // far clip distance (m), > znear
+  vd_vec3 eye;    // optical centre (m)
+  vd_vec3 lookat; // a point on the optical axis in front of the camera (m)
+  vd_vec3 up;     // image up direction (need not be orthogonal to the axis, not parallel to it)
+  double fovy;    // vertical field of view (rad), in (0, pi)
+  double znear;   // near clip distance (m), > 0
+  double zfar;    // far clip distance (m), > znear
 } vd_camera;
 
 // Camera intrinsics (OpenCV convention, pixels) and pose.
 typedef struct vd_intrinsics {
-  int width, height;  // image size (pixels)
-  double fx, fy;      // focal lengths (pixels)
-  double cx, cy;      // principal point (pixels, pixel centres at integers)
-  double R[9];        // rotation camera → world, row-major; columns are the camera X, Y, Z axes
-  vd_vec3 t;          // camera centre in the world (m)
+  int width, height; // image size (pixels)
+  double fx, fy;     // focal lengths (pixels)
+  double cx, cy;     // principal point (pixels, pixel centres at integers)
+  double R[9];       // rotation camera → world, row-major; columns are the camera X, Y, Z axes
+  vd_vec3 t;         // camera centre in the world (m)
 } vd_intrinsics;
 
 // Camera of a preset fitted to the box lo..hi (m) for a width x height image, fovy 45 degrees.
@@ -86,24 +86,24 @@ vd_status vd_camera_check(const vd_camera* c, vd_error* err);
 
 // Settings of a renderer (fixed for its lifetime).
 typedef struct vd_render_def {
-  int width, height;       // image size (pixels), 1..8192; default 640 x 480
-  int supersample;         // colour anti-aliasing: k x k samples per pixel, 1..4; default 2
-  int shadows;             // 1: the key light casts shadows; default 1
-  int floor;               // 1: a checkered ground plane at z = 0 (in colour and depth, 0 in
-                           // masks); default 1
-  int sky;                 // 1: a gradient sky, 0: a flat background colour; default 1
-  float background[3];     // background colour with sky 0, in [0, 1]; default white (1, 1, 1)
-  double light_azimuth;    // key light direction: azimuth it comes from, from +X toward +Y (rad);
-                           // default -2.0 (front left)
-  double light_elevation;  // key light elevation above the horizon (rad), (0, pi/2]; default 1.0
-  double light;            // key light diffuse intensity in [0, 1]; default 0.6
-  double headlight;        // light at the camera, diffuse intensity in [0, 1]; default 0.35
-  double ambient;          // ambient intensity in [0, 1]; default 0.3
-  int legend;              // 1: draw the legend into the colour image; default 1
-  int max_geoms;           // most scene geoms we add (organ instances, cloud groups);
-                           // default 20000
-  const char* robot_mjcf;  // Nullable: MJCF file of a robot (with its own world) drawn with the
-                           // plants at its reference pose; default NULL
+  int width, height;      // image size (pixels), 1..8192; default 640 x 480
+  int supersample;        // colour anti-aliasing: k x k samples per pixel, 1..4; default 2
+  int shadows;            // 1: the key light casts shadows; default 1
+  int floor;              // 1: a checkered ground plane at z = 0 (in colour and depth, 0 in
+                          // masks); default 1
+  int sky;                // 1: a gradient sky, 0: a flat background colour; default 1
+  float background[3];    // background colour with sky 0, in [0, 1]; default white (1, 1, 1)
+  double light_azimuth;   // key light direction: azimuth it comes from, from +X toward +Y (rad);
+                          // default -2.0 (front left)
+  double light_elevation; // key light elevation above the horizon (rad), (0, pi/2]; default 1.0
+  double light;           // key light diffuse intensity in [0, 1]; default 0.6
+  double headlight;       // light at the camera, diffuse intensity in [0, 1]; default 0.35
+  double ambient;         // ambient intensity in [0, 1]; default 0.3
+  int legend;             // 1: draw the legend into the colour image; default 1
+  int max_geoms;          // most scene geoms we add (organ instances, cloud groups);
+                          // default 20000
+  const char* robot_mjcf; // Nullable: MJCF file of a robot (with its own world) drawn with the
+                          // plants at its reference pose; default NULL
 } vd_render_def;
 
 // Defaults: 640 x 480, supersample 2, shadows 1, floor 1, sky 1, background (1, 1, 1), key light
@@ -129,10 +129,10 @@ vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, v
 
 // How plants and clouds are coloured.
 typedef enum vd_color_by {
-  VD_COLOR_LABEL = 0,     // the label table's colour (fruit red, leaf green, ...)
-  VD_COLOR_INSTANCE,      // a distinct colour per organ instance
-  VD_COLOR_STRESS,        // a colour scale of a per-segment stress given by the caller (Pa)
-  VD_COLOR_DISPLACEMENT,  // a colour scale of the distance from the rest shape (m)
+  VD_COLOR_LABEL = 0,    // the label table's colour (fruit red, leaf green, ...)
+  VD_COLOR_INSTANCE,     // a distinct colour per organ instance
+  VD_COLOR_STRESS,       // a colour scale of a per-segment stress given by the caller (Pa)
+  VD_COLOR_DISPLACEMENT, // a colour scale of the distance from the rest shape (m)
 } vd_color_by;
 
 // Look of one plant or cloud.
@@ -155,13 +155,13 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
 
 // A point cloud to splat: arrays owned by the caller.
 typedef struct vd_points {
-  int n;                   // number of points
-  const double* xyz;       // positions (m) (n x 3)
-  const int* label;        // Nullable: semantic label per point (n); NULL: all label 0
-  const int* instance;     // Nullable: instance per point (n); NULL: all instance 0
-  double radius;           // splat half-size (m), > 0, or 0 for 0.4% of the cloud's extent
-  const vd_label* labels;  // Nullable: label names and colours (nlabel), for colours and legend
-  int nlabel;              // entries in labels
+  int n;                  // number of points
+  const double* xyz;      // positions (m) (n x 3)
+  const int* label;       // Nullable: semantic label per point (n); NULL: all label 0
+  const int* instance;    // Nullable: instance per point (n); NULL: all instance 0
+  double radius;          // splat half-size (m), > 0, or 0 for 0.4% of the cloud's extent
+  const vd_label* labels; // Nullable: label names and colours (nlabel), for colours and legend
+  int nlabel;             // entries in labels
 } vd_points;
 
 // Add a point cloud coloured by label or instance (style Nullable: by label).
@@ -175,33 +175,33 @@ int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi);
 // frames
 
 // layers of a frame
-#define VD_LAYER_COLOR 1u     // colour image (RGB, 8 bits)
-#define VD_LAYER_DEPTH 2u     // depth along the optical axis (m)
-#define VD_LAYER_LABEL 4u     // semantic label of the front surface
-#define VD_LAYER_INSTANCE 8u  // organ instance of the front surface
+#define VD_LAYER_COLOR 1u    // colour image (RGB, 8 bits)
+#define VD_LAYER_DEPTH 2u    // depth along the optical axis (m)
+#define VD_LAYER_LABEL 4u    // semantic label of the front surface
+#define VD_LAYER_INSTANCE 8u // organ instance of the front surface
 #define VD_LAYER_ALL 15u
 
 // One entry of a frame's legend.
 typedef struct vd_legend_entry {
-  int id;                        // label id (by label) or 0
-  char name[VD_LABEL_NAME_MAX];  // what it names
-  float rgb[3];                  // its colour in [0, 1]
+  int id;                       // label id (by label) or 0
+  char name[VD_LABEL_NAME_MAX]; // what it names
+  float rgb[3];                 // its colour in [0, 1]
 } vd_legend_entry;
 
 // A rendered frame; arrays belong to the renderer and stay valid until its next draw.
 typedef struct vd_frame {
-  int width, height;          // size (pixels)
-  unsigned layers;            // VD_LAYER_* present
-  const uint8_t* rgb;         // colour, top row first (height x width x 3)
-  const double* depth;        // depth along the optical axis (m), 0 where nothing (height x width)
-  const uint16_t* label;      // label id, 0 background (height x width)
-  const uint16_t* instance;   // instance id, 0 background (height x width)
-  vd_intrinsics K;            // camera intrinsics and pose
-  vd_camera camera;           // the camera drawn from
-  vd_color_by color_by;       // colouring of the first plant or cloud
-  int nlegend;                // legend entries (labels by label; none by instance)
-  const vd_legend_entry* legend;  // (nlegend)
-  double range_min, range_max;    // colour scale of stress (Pa) or displacement (m)
+  int width, height;        // size (pixels)
+  unsigned layers;          // VD_LAYER_* present
+  const uint8_t* rgb;       // colour, top row first (height x width x 3)
+  const double* depth;      // depth along the optical axis (m), 0 where nothing (height x width)
+  const uint16_t* label;    // label id, 0 background (height x width)
+  const uint16_t* instance; // instance id, 0 background (height x width)
+  vd_intrinsics K;          // camera intrinsics and pose
+  vd_camera camera;         // the camera drawn from
+  vd_color_by color_by;     // colouring of the first plant or cloud
+  int nlegend;              // legend entries (labels by label; none by instance)
+  const vd_legend_entry* legend; // (nlegend)
+  double range_min, range_max;   // colour scale of stress (Pa) or displacement (m)
 } vd_frame;
 
 // Render the scene from camera c; layers is a mask of VD_LAYER_*.

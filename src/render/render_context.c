@@ -38,22 +38,33 @@ vd_render_style vd_render_style_default(void) {
 }
 
 // is x a finite number in [lo, hi]?
-static int in_range(double x, double lo, double hi) { return isfinite(x) && x >= lo && x <= hi; }
+static int in_range(double x, double lo, double hi) {
+  return isfinite(x) && x >= lo && x <= hi;
+}
 
 // check the settings, naming the first bad field
 static vd_status check_def(const vd_render_def* d, vd_error* err) {
   const char* bad = NULL;
-  if (d->width < 1 || d->width > 8192) bad = "width (1..8192 pixels)";
-  else if (d->height < 1 || d->height > 8192) bad = "height (1..8192 pixels)";
-  else if (d->supersample < 1 || d->supersample > 4) bad = "supersample (1..4)";
+  if (d->width < 1 || d->width > 8192)
+    bad = "width (1..8192 pixels)";
+  else if (d->height < 1 || d->height > 8192)
+    bad = "height (1..8192 pixels)";
+  else if (d->supersample < 1 || d->supersample > 4)
+    bad = "supersample (1..4)";
   else if ((long)d->width * d->supersample > 16384 || (long)d->height * d->supersample > 16384)
     bad = "width or height x supersample (at most 16384 pixels)";
-  else if (!in_range(d->light_azimuth, -1e3, 1e3)) bad = "light_azimuth (finite, rad)";
-  else if (!in_range(d->light_elevation, 1e-3, VD_PI / 2 + 1e-9)) bad = "light_elevation (0..pi/2 rad)";
-  else if (!in_range(d->light, 0, 1)) bad = "light (0..1)";
-  else if (!in_range(d->headlight, 0, 1)) bad = "headlight (0..1)";
-  else if (!in_range(d->ambient, 0, 1)) bad = "ambient (0..1)";
-  else if (d->max_geoms < 1 || d->max_geoms > 10000000) bad = "max_geoms (1..10000000)";
+  else if (!in_range(d->light_azimuth, -1e3, 1e3))
+    bad = "light_azimuth (finite, rad)";
+  else if (!in_range(d->light_elevation, 1e-3, VD_PI / 2 + 1e-9))
+    bad = "light_elevation (0..pi/2 rad)";
+  else if (!in_range(d->light, 0, 1))
+    bad = "light (0..1)";
+  else if (!in_range(d->headlight, 0, 1))
+    bad = "headlight (0..1)";
+  else if (!in_range(d->ambient, 0, 1))
+    bad = "ambient (0..1)";
+  else if (d->max_geoms < 1 || d->max_geoms > 10000000)
+    bad = "max_geoms (1..10000000)";
   for (int k = 0; !bad && k < 3; k++)
     if (!in_range(d->background[k], 0, 1)) bad = "background (each in 0..1)";
   if (bad) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad render setting: %s", bad);
@@ -71,7 +82,8 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
       "    <quality shadowsize=\"2048\" offsamples=\"0\"/>\n"
       "  </visual>\n"
       "  <asset>\n"
-      "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"%g %g %g\" rgb2=\"%g %g %g\" "
+      "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"%g %g %g\" rgb2=\"%g "
+      "%g %g\" "
       "width=\"256\" height=\"1536\"/>\n"
       "    <texture name=\"ground\" type=\"2d\" builtin=\"checker\" rgb1=\"0.62 0.57 0.50\" "
       "rgb2=\"0.55 0.50 0.43\" width=\"256\" height=\"256\"/>\n"
@@ -81,9 +93,11 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
       "%s"
       "  </worldbody>\n"
       "</mujoco>\n",
-      d->width * d->supersample, d->height * d->supersample, d->sky ? 0.92 : bg[0], d->sky ? 0.95 : bg[1],
-      d->sky ? 1.0 : bg[2], d->sky ? 0.55 : bg[0], d->sky ? 0.68 : bg[1], d->sky ? 0.85 : bg[2],
-      d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 3\" material=\"ground\"/>\n" : "");
+      d->width * d->supersample, d->height * d->supersample, d->sky ? 0.92 : bg[0],
+      d->sky ? 0.95 : bg[1], d->sky ? 1.0 : bg[2], d->sky ? 0.55 : bg[0], d->sky ? 0.68 : bg[1],
+      d->sky ? 0.85 : bg[2],
+      d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 3\" material=\"ground\"/>\n"
+               : "");
 }
 
 // load the stage from memory, or the robot from its file; NULL with *st and err set on failure
@@ -125,8 +139,8 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
   jmp_buf* prev = mjguard_push(&jb);
   if (setjmp(jb)) {
     mjguard_pop(prev);
-    return vd_error_set(err, VD_ERR_FORMAT, r->def.robot_mjcf ? r->robot_path : "", 0, 0, "MuJoCo: %s",
-                        mjguard_message());
+    return vd_error_set(err, VD_ERR_FORMAT, r->def.robot_mjcf ? r->robot_path : "", 0, 0,
+                        "MuJoCo: %s", mjguard_message());
   }
   vd_status st = VD_OK;
   r->m = load_model(r, &st, err);
@@ -145,11 +159,15 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
     mjv_makeScene(r->m, &r->scn, r->m->ngeom + 16 + r->def.max_geoms);
     mjr_defaultContext(&r->con);
     int k = r->def.supersample;
-    mjr_makeContext(r->m, &r->con, k >= 3 ? mjFONTSCALE_300 : k == 2 ? mjFONTSCALE_200 : mjFONTSCALE_100);
+    mjr_makeContext(r->m, &r->con,
+                    k >= 3   ? mjFONTSCALE_300
+                    : k == 2 ? mjFONTSCALE_200
+                             : mjFONTSCALE_100);
     r->have_mj = 1;
     mjr_setBuffer(mjFB_OFFSCREEN, &r->con);
     if (r->con.currentBuffer != mjFB_OFFSCREEN)
-      st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: MuJoCo has no offscreen buffer");
+      st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                        "no OpenGL context: MuJoCo has no offscreen buffer");
   }
   mjguard_pop(prev);
   return st;
@@ -176,7 +194,8 @@ vd_status vd_render_create(const vd_render_def* def, vd_renderer** out, vd_error
   if (!st) st = make_mujoco(r, err);
   // image buffers
   if (!st) {
-    size_t n = (size_t)d.width * (size_t)d.height, k2 = (size_t)d.supersample * (size_t)d.supersample;
+    size_t n = (size_t)d.width * (size_t)d.height,
+           k2 = (size_t)d.supersample * (size_t)d.supersample;
     r->big = vd_malloc(3 * n * k2);
     r->rgb = vd_malloc(3 * n);
     r->ids = vd_malloc(3 * n);
@@ -224,14 +243,19 @@ void vd_render_destroy(vd_renderer* r) {
   vd_free(r, sizeof *r);
 }
 
-const char* vd_render_info(const vd_renderer* r) { return r->gl.info; }
+const char* vd_render_info(const vd_renderer* r) {
+  return r->gl.info;
+}
 
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err) {
-  if (!r->def.robot_mjcf) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the renderer has no robot");
+  if (!r->def.robot_mjcf)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the renderer has no robot");
   if (nq != r->m->nq)
-    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "robot qpos has %d values, the model needs %d", nq, r->m->nq);
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "robot qpos has %d values, the model needs %d",
+                        nq, r->m->nq);
   for (int i = 0; i < nq; i++)
-    if (!isfinite(qpos[i])) return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "robot qpos[%d] is not finite", i);
+    if (!isfinite(qpos[i]))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "robot qpos[%d] is not finite", i);
   jmp_buf jb;
   jmp_buf* prev = mjguard_push(&jb);
   if (setjmp(jb)) {

@@ -21,17 +21,21 @@ static void cam_axes(const vd_camera* c, vd_vec3* f, vd_vec3* rt, vd_vec3* up) {
 
 vd_status vd_camera_check(const vd_camera* c, vd_error* err) {
   const double v[] = {c->eye.x, c->eye.y, c->eye.z, c->lookat.x, c->lookat.y, c->lookat.z,
-                      c->up.x, c->up.y, c->up.z, c->fovy, c->znear, c->zfar};
+                      c->up.x,  c->up.y,  c->up.z,  c->fovy,     c->znear,    c->zfar};
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++)
-    if (!isfinite(v[i])) return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera has a value that is not finite");
+    if (!isfinite(v[i]))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera has a value that is not finite");
   if (!(c->fovy > 0 && c->fovy < VD_PI))
-    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera field of view must be in (0, 180) degrees");
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
+                        "camera field of view must be in (0, 180) degrees");
   if (!(c->znear > 0 && c->zfar > c->znear))
     return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera clip distances need 0 < near < far");
   vd_vec3 f = vd_sub(c->lookat, c->eye);
-  if (vd_norm(f) < 1e-9) return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera eye and look-at point coincide");
+  if (vd_norm(f) < 1e-9)
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera eye and look-at point coincide");
   if (vd_norm(vd_cross(vd_normalize(f), vd_normalize(c->up))) < 1e-6)
-    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "camera up direction is along the viewing direction");
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
+                        "camera up direction is along the viewing direction");
   return VD_OK;
 }
 
@@ -41,13 +45,19 @@ vd_camera vd_camera_preset(vd_camera_kind kind, double azimuth, double elevation
   c.fovy = 45.0 * VD_PI / 180.0;
   vd_vec3 f, up = vd_v3(0, 0, 1);
   switch (kind) {
-    case VD_CAMERA_SIDE: f = vd_v3(-1, 0, 0); break;
-    case VD_CAMERA_TOP: f = vd_v3(0, 0, -1), up = vd_v3(0, 1, 0); break;
-    case VD_CAMERA_ORBIT:
-      f = vd_v3(-cos(elevation) * cos(azimuth), -cos(elevation) * sin(azimuth), -sin(elevation));
-      if (fabs(sin(elevation)) > 0.999) up = vd_v3(-cos(azimuth), -sin(azimuth), 0);
-      break;
-    default: f = vd_v3(0, 1, 0); break;
+  case VD_CAMERA_SIDE:
+    f = vd_v3(-1, 0, 0);
+    break;
+  case VD_CAMERA_TOP:
+    f = vd_v3(0, 0, -1), up = vd_v3(0, 1, 0);
+    break;
+  case VD_CAMERA_ORBIT:
+    f = vd_v3(-cos(elevation) * cos(azimuth), -cos(elevation) * sin(azimuth), -sin(elevation));
+    if (fabs(sin(elevation)) > 0.999) up = vd_v3(-cos(azimuth), -sin(azimuth), 0);
+    break;
+  default:
+    f = vd_v3(0, 1, 0);
+    break;
   }
   // a tiny box still gets a picture
   vd_vec3 ctr = vd_scale(vd_add(lo, hi), 0.5);
@@ -83,7 +93,7 @@ vd_intrinsics vd_camera_intrinsics(const vd_camera* c, int width, int height) {
   k.width = width;
   k.height = height;
   k.fy = 0.5 * height / tan(0.5 * c->fovy);
-  k.fx = k.fy;  // square pixels: OpenGL's frustum keeps the aspect ratio of the image
+  k.fx = k.fy; // square pixels: OpenGL's frustum keeps the aspect ratio of the image
   k.cx = 0.5 * width - 0.5;
   k.cy = 0.5 * height - 0.5;
   // camera X right, Y down, Z forward as columns of R
@@ -116,7 +126,8 @@ int vd_camera_project(const vd_intrinsics* k, vd_vec3 p, double* u, double* v, d
 // width in pixels of text in MuJoCo's normal font
 static int text_width(const mjrContext* con, const char* s) {
   int w = 0;
-  for (; *s; s++) w += con->charWidth[(unsigned char)*s & 127];
+  for (; *s; s++)
+    w += con->charWidth[(unsigned char)*s & 127];
   return w;
 }
 
@@ -143,12 +154,14 @@ static void draw_legend(vd_renderer* r, int w, int h, int k) {
     if (!rows) return;
   } else if (r->color_by == VD_COLOR_INSTANCE) {
     int n = 0;
-    for (int i = 0; i < r->nitem; i++) n += r->items[i].kind >= ITEM_PLANT;
+    for (int i = 0; i < r->nitem; i++)
+      n += r->items[i].kind >= ITEM_PLANT;
     snprintf(title, sizeof title, "colour: organ instance (%d)", n);
     rows = 1;
     width = text_width(con, title);
   } else {
-    snprintf(title, sizeof title, "%s (%s)", r->color_by == VD_COLOR_STRESS ? "stress" : "displacement", unit);
+    snprintf(title, sizeof title, "%s (%s)",
+             r->color_by == VD_COLOR_STRESS ? "stress" : "displacement", unit);
     snprintf(lo_txt, sizeof lo_txt, "%.3g", r->range_min);
     snprintf(hi_txt, sizeof hi_txt, "%.3g", r->range_max);
     rows = 3;
@@ -211,7 +224,8 @@ static void set_lights(vd_renderer* r, const vd_camera* c, vd_vec3 ctr, double r
     l->cutoff = 180;
     l->directional = 1;
     l->castshadow = i == 1 && r->def.shadows;
-    for (int k = 0; k < 3; k++) l->ambient[k] = amb, l->diffuse[k] = dif, l->specular[k] = spec;
+    for (int k = 0; k < 3; k++)
+      l->ambient[k] = amb, l->diffuse[k] = dif, l->specular[k] = spec;
   }
 }
 
@@ -248,18 +262,22 @@ static vd_status fill_scene(vd_renderer* r, vd_error* err) {
   // segmentation ids: 0 background (floor, world geoms), 1 robot, 2 + i item i
   for (int i = 0; i < scn->ngeom; i++) {
     mjvGeom* g = &scn->geoms[i];
-    int robot = r->def.robot_mjcf && g->objtype == mjOBJ_GEOM && g->objid >= 0 && r->m->geom_bodyid[g->objid] > 0;
+    int robot = r->def.robot_mjcf && g->objtype == mjOBJ_GEOM && g->objid >= 0 &&
+                r->m->geom_bodyid[g->objid] > 0;
     g->segid = robot ? 1 : 0;
   }
   r->nmodel_geom = scn->ngeom;
   if (scn->ngeom + r->nitem > scn->maxgeom)
-    return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0, "the scene holds %d geoms; %d organ instances and cloud groups "
-                        "need more (raise max_geoms)", scn->maxgeom - scn->ngeom, r->nitem);
+    return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                        "the scene holds %d geoms; %d organ instances and cloud groups "
+                        "need more (raise max_geoms)",
+                        scn->maxgeom - scn->ngeom, r->nitem);
   const mjtNum zero[3] = {0, 0, 0}, eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   for (int i = 0; i < r->nitem; i++) {
     const item* it = &r->items[i];
     if (it->list < r->con.baseMesh)
-      return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "OpenGL display list %u below MuJoCo's mesh lists", it->list);
+      return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                          "OpenGL display list %u below MuJoCo's mesh lists", it->list);
     mjvGeom* g = &scn->geoms[scn->ngeom++];
     mjv_initGeom(g, mjGEOM_MESH, NULL, zero, eye, it->rgba);
     g->category = mjCAT_DYNAMIC;
@@ -283,7 +301,8 @@ static void downsample(const uint8_t* big, uint8_t* rgb, int w, int h, int k) {
       for (int c = 0; c < 3; c++) {
         unsigned sum = 0;
         for (int j = 0; j < k; j++)
-          for (int i = 0; i < k; i++) sum += big[((size_t)(y * k + j) * bw + (x * k + i)) * 3 + c];
+          for (int i = 0; i < k; i++)
+            sum += big[((size_t)(y * k + j) * bw + (x * k + i)) * 3 + c];
         out[3 * x + c] = (uint8_t)((sum + (unsigned)(k * k) / 2) / (unsigned)(k * k));
       }
   }
@@ -305,8 +324,10 @@ static void decode_ids(vd_renderer* r, const vd_camera* c) {
         double d = r->zbuf[src];
         z = n * f / (f - d * (f - n));
         int seg = v - 1;
-        if (seg == 1) lab = VD_RENDER_ROBOT_LABEL;
-        else if (seg >= 2 && seg - 2 < r->nitem) lab = r->items[seg - 2].label, inst = r->items[seg - 2].instance;
+        if (seg == 1)
+          lab = VD_RENDER_ROBOT_LABEL;
+        else if (seg >= 2 && seg - 2 < r->nitem)
+          lab = r->items[seg - 2].label, inst = r->items[seg - 2].instance;
       }
       r->depth[dst] = z;
       r->label[dst] = (uint16_t)lab;
@@ -319,14 +340,15 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   memset(out, 0, sizeof *out);
   vd_status st = vd_camera_check(cam, err);
   if (st) return st;
-  if (!layers || (layers & ~VD_LAYER_ALL)) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad layer mask %u", layers);
+  if (!layers || (layers & ~VD_LAYER_ALL))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad layer mask %u", layers);
   if ((st = gl_current(&r->gl, err))) return st;
   // splats face this camera
   vd_vec3 f, rt, up;
   cam_axes(cam, &f, &rt, &up);
   {
-    double e[3] = {cam->eye.x, cam->eye.y, cam->eye.z}, fw[3] = {f.x, f.y, f.z}, ri[3] = {rt.x, rt.y, rt.z},
-           u[3] = {up.x, up.y, up.z};
+    double e[3] = {cam->eye.x, cam->eye.y, cam->eye.z}, fw[3] = {f.x, f.y, f.z},
+           ri[3] = {rt.x, rt.y, rt.z}, u[3] = {up.x, up.y, up.z};
     if ((st = render_clouds_update(r, e, fw, ri, u, err))) return st;
   }
   int w = r->def.width, h = r->def.height, k = r->def.supersample;

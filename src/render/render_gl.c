@@ -46,7 +46,9 @@ struct gl_api {
 };
 
 // a symbol of libEGL
-static void* sym(gl_ctx* g, const char* name) { return dlsym(g->lib, name); }
+static void* sym(gl_ctx* g, const char* name) {
+  return dlsym(g->lib, name);
+}
 
 // load libEGL and its entry points
 static vd_status load_egl(gl_ctx* g, vd_error* err) {
@@ -62,8 +64,8 @@ static vd_status load_egl(gl_ctx* g, vd_error* err) {
   do {                                                                                             \
     *(void**)&a->field = sym(g, name);                                                             \
     if (!a->field)                                                                                 \
-      return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,                                       \
-                          "no OpenGL context: libEGL lacks %s", name);                             \
+      return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: libEGL lacks %s", \
+                          name);                                                                   \
   } while (0)
   LOAD(GetProcAddress, "eglGetProcAddress");
   LOAD(GetDisplay, "eglGetDisplay");
@@ -80,7 +82,8 @@ static vd_status load_egl(gl_ctx* g, vd_error* err) {
   LOAD(QueryString, "eglQueryString");
   LOAD(ReleaseThread, "eglReleaseThread");
 #undef LOAD
-  a->GetPlatformDisplayEXT = (PFNEGLGETPLATFORMDISPLAYEXTPROC)a->GetProcAddress("eglGetPlatformDisplayEXT");
+  a->GetPlatformDisplayEXT =
+      (PFNEGLGETPLATFORMDISPLAYEXTPROC)a->GetProcAddress("eglGetPlatformDisplayEXT");
   a->QueryDevicesEXT = (PFNEGLQUERYDEVICESEXTPROC)a->GetProcAddress("eglQueryDevicesEXT");
   return VD_OK;
 }
@@ -122,37 +125,56 @@ vd_status gl_create(gl_ctx* g, vd_error* err) {
   const char* client = a->QueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   int ok = 0;
   if (a->GetPlatformDisplayEXT && has_ext(client, "EGL_MESA_platform_surfaceless"))
-    ok = try_display(g, a->GetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL),
-                     "surfaceless", tried, sizeof tried);
-  if (!ok && a->GetPlatformDisplayEXT && a->QueryDevicesEXT && has_ext(client, "EGL_EXT_platform_device")) {
+    ok = try_display(
+        g, a->GetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL),
+        "surfaceless", tried, sizeof tried);
+  if (!ok && a->GetPlatformDisplayEXT && a->QueryDevicesEXT &&
+      has_ext(client, "EGL_EXT_platform_device")) {
     EGLDeviceEXT dev[4];
     EGLint ndev = 0;
     if (a->QueryDevicesEXT(4, dev, &ndev) && ndev > 0)
       ok = try_display(g, a->GetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, dev[0], NULL), "device",
                        tried, sizeof tried);
   }
-  if (!ok) ok = try_display(g, a->GetDisplay(EGL_DEFAULT_DISPLAY), "default display", tried, sizeof tried);
+  if (!ok)
+    ok = try_display(g, a->GetDisplay(EGL_DEFAULT_DISPLAY), "default display", tried, sizeof tried);
   if (!ok)
     return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
                         "no OpenGL context: no EGL display could be initialised (%s); install "
                         "libegl-mesa0 and libgl1-mesa-dri for software rendering",
                         tried);
   // a desktop OpenGL config with depth and stencil (MuJoCo's needs), then the context
-  const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8,
-                             EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8, EGL_DEPTH_SIZE, 24, EGL_STENCIL_SIZE, 8,
-                             EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+  const EGLint cfg_attr[] = {EGL_SURFACE_TYPE,
+                             EGL_PBUFFER_BIT,
+                             EGL_RED_SIZE,
+                             8,
+                             EGL_GREEN_SIZE,
+                             8,
+                             EGL_BLUE_SIZE,
+                             8,
+                             EGL_ALPHA_SIZE,
+                             8,
+                             EGL_DEPTH_SIZE,
+                             24,
+                             EGL_STENCIL_SIZE,
+                             8,
+                             EGL_RENDERABLE_TYPE,
+                             EGL_OPENGL_BIT,
+                             EGL_NONE};
   EGLConfig cfg;
   EGLint ncfg = 0;
   if (!a->ChooseConfig(g->dpy, cfg_attr, &cfg, 1, &ncfg) || ncfg < 1)
     return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
                         "no OpenGL context: %s has no RGBA8 + depth 24 + stencil 8 OpenGL config "
-                        "(EGL error 0x%x)", g->info, (unsigned)a->GetError());
+                        "(EGL error 0x%x)",
+                        g->info, (unsigned)a->GetError());
   if (!a->BindAPI(EGL_OPENGL_API))
-    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: %s cannot bind desktop OpenGL",
-                        g->info);
+    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                        "no OpenGL context: %s cannot bind desktop OpenGL", g->info);
   g->ctx = a->CreateContext(g->dpy, cfg, EGL_NO_CONTEXT, NULL);
   if (g->ctx == EGL_NO_CONTEXT)
-    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: eglCreateContext failed (0x%x)",
+    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                        "no OpenGL context: eglCreateContext failed (0x%x)",
                         (unsigned)a->GetError());
   // current without a surface when the display allows it, else on a 1x1 pbuffer
   const char* dext = a->QueryString(g->dpy, EGL_EXTENSIONS);
@@ -160,15 +182,15 @@ vd_status gl_create(gl_ctx* g, vd_error* err) {
     const EGLint pb[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
     g->surf = a->CreatePbufferSurface(g->dpy, cfg, pb);
     if (g->surf == EGL_NO_SURFACE)
-      return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: no pbuffer surface (0x%x)",
-                          (unsigned)a->GetError());
+      return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                          "no OpenGL context: no pbuffer surface (0x%x)", (unsigned)a->GetError());
   }
   st = gl_current(g, err);
   if (st) return st;
-  // GL 1.x entry points (display lists, immediate mode) for the plant and cloud geometry
+    // GL 1.x entry points (display lists, immediate mode) for the plant and cloud geometry
 #define GLFN(field, name)                                                                          \
   do {                                                                                             \
-    a->field = (__typeof__(a->field))a->GetProcAddress(name);                                         \
+    a->field = (__typeof__(a->field))a->GetProcAddress(name);                                      \
     if (!a->field)                                                                                 \
       return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: %s not found",    \
                           name);                                                                   \
@@ -188,7 +210,8 @@ vd_status gl_create(gl_ctx* g, vd_error* err) {
   const char* ver = (const char*)a->GetString(GL_VERSION);
   const char* ren = (const char*)a->GetString(GL_RENDERER);
   size_t len = strlen(g->info);
-  snprintf(g->info + len, sizeof g->info - len, ", OpenGL %s, %s", ver ? ver : "?", ren ? ren : "?");
+  snprintf(g->info + len, sizeof g->info - len, ", OpenGL %s, %s", ver ? ver : "?",
+           ren ? ren : "?");
   return VD_OK;
 }
 
@@ -196,8 +219,8 @@ vd_status gl_current(gl_ctx* g, vd_error* err) {
   gl_api* a = g->api;
   EGLSurface s = g->surf ? g->surf : EGL_NO_SURFACE;
   if (!a->MakeCurrent(g->dpy, s, s, g->ctx))
-    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "no OpenGL context: eglMakeCurrent failed (0x%x)",
-                        (unsigned)a->GetError());
+    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                        "no OpenGL context: eglMakeCurrent failed (0x%x)", (unsigned)a->GetError());
   return VD_OK;
 }
 

@@ -23,14 +23,18 @@ static void on_error(const char* msg) {
   abort();
 }
 
-static void on_warning(const char* msg) { vd_log(1, "MuJoCo: %s", msg ? msg : "warning"); }
+static void on_warning(const char* msg) {
+  vd_log(1, "MuJoCo: %s", msg ? msg : "warning");
+}
 
 static void install(void) {
   mju_user_error = on_error;
   mju_user_warning = on_warning;
 }
 
-void mjguard_install(void) { call_once(&guard_once, install); }
+void mjguard_install(void) {
+  call_once(&guard_once, install);
+}
 
 jmp_buf* mjguard_push(jmp_buf* jb) {
   jmp_buf* prev = guard_target;
@@ -39,6 +43,10 @@ jmp_buf* mjguard_push(jmp_buf* jb) {
   return prev;
 }
 
-void mjguard_pop(jmp_buf* prev) { guard_target = prev; }
+void mjguard_pop(jmp_buf* prev) {
+  guard_target = prev;
+}
 
-const char* mjguard_message(void) { return guard_msg; }
+const char* mjguard_message(void) {
+  return guard_msg;
+}

@@ -44,7 +44,8 @@ static vd_status write_png(const char* path, int w, int h, int channels, int bit
   }
   png_err pe;
   pe.msg[0] = 0;
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &pe, on_png_error, on_png_warning);
+  png_structp png =
+      png_create_write_struct(PNG_LIBPNG_VER_STRING, &pe, on_png_error, on_png_warning);
   png_infop info = png ? png_create_info_struct(png) : NULL;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
@@ -59,8 +60,9 @@ static vd_status write_png(const char* path, int w, int h, int channels, int bit
     return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot write PNG: %s", pe.msg);
   }
   png_init_io(png, f.fp);
-  png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, bits, channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, bits,
+               channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   // a fixed compression level: same pixels, same bytes
   png_set_compression_level(png, 6);
   png_write_info(png, info);
@@ -69,7 +71,8 @@ static vd_status write_png(const char* path, int w, int h, int channels, int bit
       memcpy(row, (const uint8_t*)pix + (size_t)y * row_bytes, row_bytes);
     } else {
       const uint16_t* src = (const uint16_t*)pix + (size_t)y * w * channels;
-      for (size_t i = 0; i < (size_t)w * channels; i++) row[2 * i] = (uint8_t)(src[i] >> 8), row[2 * i + 1] = (uint8_t)src[i];
+      for (size_t i = 0; i < (size_t)w * channels; i++)
+        row[2 * i] = (uint8_t)(src[i] >> 8), row[2 * i + 1] = (uint8_t)src[i];
     }
     png_write_row(png, row);
   }
@@ -83,29 +86,31 @@ vd_status vd_render_write_png(const vd_frame* f, unsigned layer, const char* pat
   int w = f->width, h = f->height;
   size_t n = (size_t)w * (size_t)h;
   switch (layer) {
-    case VD_LAYER_COLOR:
-      if (!f->rgb) break;
-      return write_png(path, w, h, 3, 8, f->rgb, err);
-    case VD_LAYER_LABEL:
-      if (!f->label) break;
-      return write_png(path, w, h, 1, 16, f->label, err);
-    case VD_LAYER_INSTANCE:
-      if (!f->instance) break;
-      return write_png(path, w, h, 1, 16, f->instance, err);
-    case VD_LAYER_DEPTH: {
-      if (!f->depth) break;
-      // millimetres, rounded; 0 where nothing, 65535 for 65.535 m and beyond
-      uint16_t* mm = vd_malloc(n * sizeof(uint16_t));
-      if (!mm) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
-      for (size_t i = 0; i < n; i++) {
-        double v = f->depth[i] * 1000.0;
-        mm[i] = !(v > 0) ? 0 : v >= 65535 ? 65535 : (uint16_t)fmax(1, floor(v + 0.5));
-      }
-      vd_status st = write_png(path, w, h, 1, 16, mm, err);
-      vd_free(mm, n * sizeof(uint16_t));
-      return st;
+  case VD_LAYER_COLOR:
+    if (!f->rgb) break;
+    return write_png(path, w, h, 3, 8, f->rgb, err);
+  case VD_LAYER_LABEL:
+    if (!f->label) break;
+    return write_png(path, w, h, 1, 16, f->label, err);
+  case VD_LAYER_INSTANCE:
+    if (!f->instance) break;
+    return write_png(path, w, h, 1, 16, f->instance, err);
+  case VD_LAYER_DEPTH: {
+    if (!f->depth) break;
+    // millimetres, rounded; 0 where nothing, 65535 for 65.535 m and beyond
+    uint16_t* mm = vd_malloc(n * sizeof(uint16_t));
+    if (!mm) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+    for (size_t i = 0; i < n; i++) {
+      double v = f->depth[i] * 1000.0;
+      mm[i] = !(v > 0) ? 0 : v >= 65535 ? 65535 : (uint16_t)fmax(1, floor(v + 0.5));
     }
-    default: return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "write one layer at a time (got mask %u)", layer);
+    vd_status st = write_png(path, w, h, 1, 16, mm, err);
+    vd_free(mm, n * sizeof(uint16_t));
+    return st;
+  }
+  default:
+    return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "write one layer at a time (got mask %u)",
+                        layer);
   }
   return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "the frame was drawn without that layer");
 }
@@ -120,7 +125,8 @@ vd_status vd_render_read_png(const char* path, int* w, int* h, int* channels, in
   if (!fp) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot open");
   png_err pe;
   pe.msg[0] = 0;
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &pe, on_png_error, on_png_warning);
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, &pe, on_png_error, on_png_warning);
   png_infop info = png ? png_create_info_struct(png) : NULL;
   uint8_t* row = NULL;
   size_t row_bytes = 0, total = 0;
@@ -170,10 +176,14 @@ vd_status vd_render_read_png(const char* path, int* w, int* h, int* channels, in
 
 static const char* color_by_name(vd_color_by c) {
   switch (c) {
-    case VD_COLOR_INSTANCE: return "instance";
-    case VD_COLOR_STRESS: return "stress";
-    case VD_COLOR_DISPLACEMENT: return "displacement";
-    default: return "label";
+  case VD_COLOR_INSTANCE:
+    return "instance";
+  case VD_COLOR_STRESS:
+    return "stress";
+  case VD_COLOR_DISPLACEMENT:
+    return "displacement";
+  default:
+    return "label";
   }
 }
 
@@ -197,7 +207,8 @@ vd_status vd_render_write_json(const vd_frame* f, const char* const* files, cons
   cJSON_AddItemToObject(pose, "R", cJSON_CreateDoubleArray(k->R, 9));
   double t[3] = {k->t.x, k->t.y, k->t.z};
   cJSON_AddItemToObject(pose, "t", cJSON_CreateDoubleArray(t, 3));
-  cJSON_AddStringToObject(pose, "convention", "x_world = R x_camera + t; camera x right, y down, z forward");
+  cJSON_AddStringToObject(pose, "convention",
+                          "x_world = R x_camera + t; camera x right, y down, z forward");
   cJSON* cam = cJSON_AddObjectToObject(root, "camera");
   double eye[3] = {f->camera.eye.x, f->camera.eye.y, f->camera.eye.z};
   double at[3] = {f->camera.lookat.x, f->camera.lookat.y, f->camera.lookat.z};
@@ -227,7 +238,8 @@ vd_status vd_render_write_json(const vd_frame* f, const char* const* files, cons
   }
   cJSON_AddNumberToObject(root, "robot_label", VD_RENDER_ROBOT_LABEL);
   cJSON* fl = cJSON_AddObjectToObject(root, "files");
-  for (int i = 0; files && files[i] && files[i + 1]; i += 2) cJSON_AddStringToObject(fl, files[i], files[i + 1]);
+  for (int i = 0; files && files[i] && files[i + 1]; i += 2)
+    cJSON_AddStringToObject(fl, files[i], files[i + 1]);
   char* text = cJSON_Print(root);
   cJSON_Delete(root);
   if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");

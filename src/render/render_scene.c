@@ -18,13 +18,14 @@ static const float viridis[9][3] = {
     {0.369f, 0.789f, 0.383f}, {0.678f, 0.864f, 0.190f}, {0.993f, 0.906f, 0.144f}};
 
 void render_colormap(double t, float rgb[3]) {
-  if (!(t >= 0)) t = 0;  // NaN too
+  if (!(t >= 0)) t = 0; // NaN too
   if (t > 1) t = 1;
   double x = t * 8;
   int i = (int)x;
   if (i > 7) i = 7;
   double f = x - i;
-  for (int k = 0; k < 3; k++) rgb[k] = (float)(viridis[i][k] * (1 - f) + viridis[i + 1][k] * f);
+  for (int k = 0; k < 3; k++)
+    rgb[k] = (float)(viridis[i][k] * (1 - f) + viridis[i + 1][k] * f);
 }
 
 // a distinct colour per instance: hues by the golden ratio
@@ -33,7 +34,8 @@ static void instance_rgb(int inst, float rgb[3]) {
   int i = (int)h;
   double f = h - i, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
   double c[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
-  for (int k = 0; k < 3; k++) rgb[k] = (float)c[i % 6][k];
+  for (int k = 0; k < 3; k++)
+    rgb[k] = (float)c[i % 6][k];
 }
 
 // grey for primitives without a value (leaves and fruits under colour by stress)
@@ -61,13 +63,16 @@ static vd_status legend_add(vd_renderer* r, int id, const char* name, const floa
   int lo = 0, hi = r->nlegend;
   while (lo < hi) {
     int mid = (lo + hi) / 2;
-    if (r->legend[mid].id < id) lo = mid + 1;
-    else hi = mid;
+    if (r->legend[mid].id < id)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   if (lo < r->nlegend && r->legend[lo].id == id) return VD_OK;
   if (r->nlegend == r->cap_legend) {
     int cap = r->cap_legend;
-    if (!vd_grow((void**)&r->legend, &cap, r->nlegend + 1, sizeof(vd_legend_entry))) return VD_ERR_NOMEM;
+    if (!vd_grow((void**)&r->legend, &cap, r->nlegend + 1, sizeof(vd_legend_entry)))
+      return VD_ERR_NOMEM;
     r->cap_legend = cap;
   }
   memmove(r->legend + lo + 1, r->legend + lo, sizeof(vd_legend_entry) * (size_t)(r->nlegend - lo));
@@ -147,13 +152,16 @@ static vd_status check_style(const vd_render_style* s, int nseg, vd_error* err) 
   if ((int)s->color_by < VD_COLOR_LABEL || s->color_by > VD_COLOR_DISPLACEMENT)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "unknown colouring %d", (int)s->color_by);
   if (nseg < 0 && s->color_by != VD_COLOR_LABEL && s->color_by != VD_COLOR_INSTANCE)
-    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "a point cloud is coloured by label or instance only");
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "a point cloud is coloured by label or instance only");
   if (s->color_by == VD_COLOR_STRESS && !s->seg_stress)
-    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "colour by stress needs a stress per segment (a simulation state)");
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "colour by stress needs a stress per segment (a simulation state)");
   if (!isfinite(s->range_min) || !isfinite(s->range_max))
     return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "colour range is not finite");
   if (s->slices < 0 || s->slices == 1 || s->slices == 2 || s->slices > 1024)
-    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "slices must be 0 or 3..1024, got %d", s->slices);
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "slices must be 0 or 3..1024, got %d",
+                        s->slices);
   return VD_OK;
 }
 
@@ -201,7 +209,8 @@ static void prim_values(const vd_model* m, const vd_data* d, const vd_render_sty
     }
     double sum = 0;
     int v0 = m->mesh_vert[2 * i], nv = m->mesh_vert[2 * i + 1];
-    for (int v = v0; d && v < v0 + nv; v++) sum += moved(d->vert_pos + 3 * v, m->vert_pos0 + 3 * v);
+    for (int v = v0; d && v < v0 + nv; v++)
+      sum += moved(d->vert_pos + 3 * v, m->vert_pos0 + 3 * v);
     msh[i] = nv ? sum / nv : 0;
   }
 }
@@ -218,7 +227,8 @@ static void put_tri(const vd_mesh* mesh, int t, int side, const float* rgb, floa
   for (int c = 0; c < 3; c++) {
     int v = mesh->tri[3 * t + (flip ? 2 - c : c)];
     for (int x = 0; x < 3; x++) {
-      pos[9 * k + 3 * c + x] = (float)(mesh->pos[3 * v + x] + side * LEAF_HALF_THICKNESS * mesh->normal[3 * v + x]);
+      pos[9 * k + 3 * c + x] =
+          (float)(mesh->pos[3 * v + x] + side * LEAF_HALF_THICKNESS * mesh->normal[3 * v + x]);
       nrm[9 * k + 3 * c + x] = (float)(flip ? -mesh->normal[3 * v + x] : mesh->normal[3 * v + x]);
       if (col) col[9 * k + 3 * c + x] = rgb[x];
     }
@@ -241,11 +251,12 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
   md.slices = s.slices;
   if ((st = vd_geom_tessellate(m, d, &md, &mesh, err))) return st;
   for (int t = 0; t < mesh.ntri; t++)
-    if (mesh.tri_label[t] < 0 || mesh.tri_label[t] >= VD_RENDER_ROBOT_LABEL || mesh.tri_instance[t] < 0 ||
-        mesh.tri_instance[t] > 65535) {
+    if (mesh.tri_label[t] < 0 || mesh.tri_label[t] >= VD_RENDER_ROBOT_LABEL ||
+        mesh.tri_instance[t] < 0 || mesh.tri_instance[t] > 65535) {
       vd_mesh_free(&mesh);
       return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
-                          "label %d / instance %d do not fit the 16-bit masks (labels 0..65534, instances 0..65535)",
+                          "label %d / instance %d do not fit the 16-bit masks (labels 0..65534, "
+                          "instances 0..65535)",
                           mesh.tri_label[t], mesh.tri_instance[t]);
     }
   // scratch: triangle order, per-primitive values, one group's vertex arrays (x2 for back faces)
@@ -273,9 +284,11 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
     r->range_min = lo;
     r->range_max = hi;
   }
-  for (size_t t = 0; t < nt; t++) order[t] = (key){mesh.tri_label[t], mesh.tri_instance[t], (int)t};
+  for (size_t t = 0; t < nt; t++)
+    order[t] = (key){mesh.tri_label[t], mesh.tri_instance[t], (int)t};
   if (nt) qsort(order, nt, sizeof(key), cmp_key);
-  for (int v = 0; v < mesh.nvert; v++) bounds_add(r, vd_v3(mesh.pos[3 * v], mesh.pos[3 * v + 1], mesh.pos[3 * v + 2]));
+  for (int v = 0; v < mesh.nvert; v++)
+    bounds_add(r, vd_v3(mesh.pos[3 * v], mesh.pos[3 * v + 1], mesh.pos[3 * v + 2]));
   if (r->nadded == 0) r->color_by = s.color_by;
   // one item per (label, instance)
   for (size_t g0 = 0, g1; g0 < nt; g0 = g1) {
@@ -292,11 +305,16 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
     it->instance = inst;
     const vd_label* lab = vd_model_find_label(m, label);
     float lrgb[3];
-    if (lab) memcpy(lrgb, lab->rgb, sizeof lrgb);
-    else vd_plant_default_rgb(label, lrgb);
-    if (s.color_by == VD_COLOR_LABEL) memcpy(it->rgba, lrgb, sizeof lrgb);
-    else if (s.color_by == VD_COLOR_INSTANCE) instance_rgb(inst, it->rgba);
-    else it->rgba[0] = it->rgba[1] = it->rgba[2] = 1;
+    if (lab)
+      memcpy(lrgb, lab->rgb, sizeof lrgb);
+    else
+      vd_plant_default_rgb(label, lrgb);
+    if (s.color_by == VD_COLOR_LABEL)
+      memcpy(it->rgba, lrgb, sizeof lrgb);
+    else if (s.color_by == VD_COLOR_INSTANCE)
+      instance_rgb(inst, it->rgba);
+    else
+      it->rgba[0] = it->rgba[1] = it->rgba[2] = 1;
     if (legend_add(r, label, lab ? lab->name : NULL, lrgb)) {
       st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
       goto done;
@@ -311,9 +329,13 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
       int t = order[j].index, prim = mesh.tri_prim[t], kind = mesh.tri_kind[t];
       float rgb[3];
       if (value_mode) {
-        double v = kind == VD_PRIM_SEGMENT ? vseg[prim] : kind == VD_PRIM_SPHERE ? vsph[prim] : vmsh[prim];
-        if (isfinite(v)) render_colormap(hi > lo ? (v - lo) / (hi - lo) : 0, rgb);
-        else memcpy(rgb, no_value_rgb, sizeof rgb);
+        double v = kind == VD_PRIM_SEGMENT  ? vseg[prim]
+                   : kind == VD_PRIM_SPHERE ? vsph[prim]
+                                            : vmsh[prim];
+        if (isfinite(v))
+          render_colormap(hi > lo ? (v - lo) / (hi - lo) : 0, rgb);
+        else
+          memcpy(rgb, no_value_rgb, sizeof rgb);
       }
       int open = kind == VD_PRIM_MESH && !m->mesh_closed[prim];
       put_tri(&mesh, t, open, rgb, pos, nrm, col, k++);
@@ -348,12 +370,16 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
   vd_status st = check_style(&s, -1, err);
   if (st) return st;
   if (p->n < 0) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "negative point count");
-  if (p->n > 0 && !p->xyz) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "points without positions");
-  if (!isfinite(p->radius) || p->radius < 0) return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "splat radius must be >= 0");
-  if (p->nlabel < 0 || (p->nlabel > 0 && !p->labels)) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad label table");
+  if (p->n > 0 && !p->xyz)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "points without positions");
+  if (!isfinite(p->radius) || p->radius < 0)
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "splat radius must be >= 0");
+  if (p->nlabel < 0 || (p->nlabel > 0 && !p->labels))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad label table");
   for (int i = 0; i < p->n; i++) {
     for (int k = 0; k < 3; k++)
-      if (!isfinite(p->xyz[3 * i + k])) return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "point %d is not finite", i);
+      if (!isfinite(p->xyz[3 * i + k]))
+        return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "point %d is not finite", i);
     int l = p->label ? p->label[i] : 0, in = p->instance ? p->instance[i] : 0;
     if (l < 0 || l >= VD_RENDER_ROBOT_LABEL || in < 0 || in > 65535)
       return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
@@ -391,7 +417,8 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
   }
   c->radius = p->radius > 0 ? p->radius : fmax(0.004 * vd_norm(vd_sub(hi, lo)), 1e-4);
   if (n) qsort(keys, n, sizeof(key), cmp_key);
-  for (int i = 0; i < p->n; i++) c->order[i] = keys[i].index;
+  for (int i = 0; i < p->n; i++)
+    c->order[i] = keys[i].index;
   vd_free(keys, n * sizeof(key));
   if (r->nadded == 0) r->color_by = s.color_by;
   // one item per (label, instance); the order keeps the labels and instances
@@ -400,7 +427,8 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
     int label = p->label ? p->label[i0] : 0, inst = p->instance ? p->instance[i0] : 0;
     for (g1 = g0 + 1; g1 < p->n; g1++) {
       int j = c->order[g1];
-      if ((p->label ? p->label[j] : 0) != label || (p->instance ? p->instance[j] : 0) != inst) break;
+      if ((p->label ? p->label[j] : 0) != label || (p->instance ? p->instance[j] : 0) != inst)
+        break;
     }
     item* it = new_item(r);
     if (!it) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
@@ -414,11 +442,16 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
     for (int k = 0; k < p->nlabel; k++)
       if (p->labels[k].id == label) lab = &p->labels[k];
     float lrgb[3];
-    if (lab) memcpy(lrgb, lab->rgb, sizeof lrgb);
-    else vd_plant_default_rgb(label, lrgb);
-    if (s.color_by == VD_COLOR_INSTANCE) instance_rgb(inst, it->rgba);
-    else memcpy(it->rgba, lrgb, sizeof lrgb);
-    if (legend_add(r, label, lab ? lab->name : NULL, lrgb)) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (lab)
+      memcpy(lrgb, lab->rgb, sizeof lrgb);
+    else
+      vd_plant_default_rgb(label, lrgb);
+    if (s.color_by == VD_COLOR_INSTANCE)
+      instance_rgb(inst, it->rgba);
+    else
+      memcpy(it->rgba, lrgb, sizeof lrgb);
+    if (legend_add(r, label, lab ? lab->name : NULL, lrgb))
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   r->cloud_lists_valid = 0;
   r->nadded++;
@@ -428,7 +461,8 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
 vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double fwd[3],
                                const double right[3], const double up[3], vd_error* err) {
   if (r->cloud_lists_valid && !memcmp(eye, r->cloud_eye, sizeof r->cloud_eye) &&
-      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd) && !memcmp(up, r->cloud_up, sizeof r->cloud_up))
+      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd) &&
+      !memcmp(up, r->cloud_up, sizeof r->cloud_up))
     return VD_OK;
   // largest group, for one scratch buffer
   int most = 0;
@@ -451,14 +485,16 @@ vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double
       const double* q = c->xyz + 3 * c->order[it->start + j];
       for (int v = 0; v < 6; v++)
         for (int x = 0; x < 3; x++) {
-          pos[18 * j + 3 * v + x] = (float)(q[x] + s * (corner[v][0] * right[x] + corner[v][1] * up[x]));
+          pos[18 * j + 3 * v + x] =
+              (float)(q[x] + s * (corner[v][0] * right[x] + corner[v][1] * up[x]));
           nrm[18 * j + 3 * v + x] = (float)-fwd[x];
         }
     }
     gl_list_free(&r->gl, it->list);
     gl_tris tris = {2 * it->count, pos, nrm, NULL};
     it->list = gl_list(&r->gl, &tris);
-    if (!it->list) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the cloud");
+    if (!it->list)
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the cloud");
   }
   vd_free(pos, sizeof(float) * 2 * nf);
   if (!st) {
