@@ -379,7 +379,7 @@ TEST(render, colour_modes_and_legend) {
   CHECK_NEAR(f.range_min, 0.03, 1e-9);
   CHECK_NEAR(f.range_max, 0.03, 1e-9);
   CHECK(f.color_by == VD_COLOR_DISPLACEMENT);
-  CHECK_INT(f.nlegend, 0);
+  CHECK(f.nlegend >= 4); // the key of the label mask, whatever the colouring
   // stress needs values; with them, the range is theirs
   vd_render_clear(r);
   s.color_by = VD_COLOR_STRESS;

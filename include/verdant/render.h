@@ -199,7 +199,7 @@ typedef struct vd_frame {
   vd_intrinsics K;          // camera intrinsics and pose
   vd_camera camera;         // the camera drawn from
   vd_color_by color_by;     // colouring of the first plant or cloud
-  int nlegend;              // legend entries (labels by label; none by instance)
+  int nlegend;              // labels present, by id, with names and label colours (the mask key)
   const vd_legend_entry* legend; // (nlegend)
   double range_min, range_max;   // colour scale of stress (Pa) or displacement (m)
 } vd_frame;

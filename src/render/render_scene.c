@@ -240,6 +240,10 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
   vd_render_style s = style ? *style : vd_render_style_default();
   vd_status st = check_style(&s, m->nseg, err);
   if (st) return st;
+  if (d && (d->nnode != m->nnode || d->nseg != m->nseg || d->nsphere != m->nsphere ||
+            d->nvert != m->nvert))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "the state does not belong to this model (sizes differ)");
   if (s.color_by == VD_COLOR_STRESS)
     for (int i = 0; i < m->nseg; i++)
       if (!isfinite(s.seg_stress[i]))
