@@ -154,6 +154,42 @@ expect "truncated cloud" 2 "$V" render "$T/short.ply" -o "$T/x.png"
 printf 'PLY?' >"$T/junk.ply"
 expect "not a ply" 2 "$V" render "$T/junk.ply" -o "$T/x.png"
 
+# a robot from MJCF: its pixels carry label 65535; a broken MJCF is bad input
+expect "render with robot" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/arm.png" --robot "$SRC/data/robots/arm6.xml" --masks --size 160x120
+if python3 - "$T/arm.label.png" <<'PY'
+import struct, sys, zlib
+b = open(sys.argv[1], "rb").read()
+pos, idat = 8, b""
+while pos < len(b):
+    n, kind = struct.unpack(">I4s", b[pos:pos + 8])
+    if kind == b"IHDR": w, h = struct.unpack(">II", b[pos + 8:pos + 16])
+    if kind == b"IDAT": idat += b[pos + 8:pos + 8 + n]
+    pos += 12 + n
+raw, stride, prev, found = zlib.decompress(idat), 2 * w + 1, bytearray(2 * w), False
+for y in range(h):
+    f, line = raw[y * stride], bytearray(raw[y * stride + 1:(y + 1) * stride])
+    for i in range(len(line)):
+        a = line[i - 2] if i >= 2 else 0
+        c = prev[i - 2] if i >= 2 else 0
+        if f == 1: line[i] = (line[i] + a) & 255
+        elif f == 2: line[i] = (line[i] + prev[i]) & 255
+        elif f == 3: line[i] = (line[i] + (a + prev[i]) // 2) & 255
+        elif f == 4:
+            p = a + prev[i] - c; pa, pb, pc = abs(p - a), abs(p - prev[i]), abs(p - c)
+            line[i] = (line[i] + (a if pa <= pb and pa <= pc else prev[i] if pb <= pc else c)) & 255
+    found |= 65535 in struct.unpack(">%dH" % w, line)
+    prev = line
+sys.exit(0 if found else 1)
+PY
+then ok "robot pixels labelled 65535"; else bad "robot pixels labelled 65535"; fi
+printf '<mujoco><worldbody><geom type="sphere"/></worldbody>' >"$T/badrobot.xml"
+expect "broken robot MJCF" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/badrobot.png" --robot "$T/badrobot.xml"
+expect_err "robot error names file" "badrobot.xml"
+
+# an empty plant still gives a picture
+printf 'Axiom: A\n' >"$T/empty.lpy"
+expect "empty plant" 0 "$V" render "$T/empty.lpy" -o "$T/empty.png" --masks --size 64x48
+
 # an unwritable output: exit 1, nothing left
 expect "unwritable output" 1 "$V" render "$SRC/data/tomato.lpy" -o "/nonexistent-dir/x.png" --size 64x48
 

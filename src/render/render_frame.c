@@ -62,7 +62,7 @@ vd_camera vd_camera_preset(vd_camera_kind kind, double azimuth, double elevation
   // a tiny box still gets a picture
   vd_vec3 ctr = vd_scale(vd_add(lo, hi), 0.5);
   vd_vec3 half = vd_scale(vd_sub(hi, lo), 0.5);
-  double hmin = 0.01;
+  double hmin = 0.05;
   half = vd_v3(fmax(half.x, hmin), fmax(half.y, hmin), fmax(half.z, hmin));
   vd_vec3 rt = vd_normalize(vd_cross(f, up)), u = vd_cross(rt, f);
   double ty = tan(c.fovy / 2), tx = ty * (double)width / (double)(height > 0 ? height : 1);
