@@ -18,6 +18,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
   }
   snprintf(ls->file, sizeof ls->file, "%s", name ? name : "");
   vd_arena_init(&ls->arena, 1 << 16);
+  vm_budget(ls, 0);
   ls->max_depth[SEC_DECOMPOSITION] = 1;
   ls->max_depth[SEC_INTERPRETATION] = 1;
   // predefined modules take the first ids, in VD_SYM_LIST order
@@ -106,6 +107,7 @@ vd_lsys_def vd_lsys_def_default(void) {
   d.steps = -1;
   d.seed = 0;
   d.max_modules = 50000000;
+  d.max_ops = LSYS_DEFAULT_MAX_OPS;
   return d;
 }
 
@@ -221,6 +223,7 @@ int vd_lsys_derivation_length(const vd_lsystem* ls) {
   vd_lsystem* mls = (vd_lsystem*)ls;
   vd_error local = {0};
   mls->err = &local;
+  vm_budget(mls, mls->max_ops);  // the work limit of the last run
   int n = 1;
   if (vm_eval(mls, ls->derivation_length, NULL, &v) == VD_OK && v_isnum(v)) n = (int)v.n;
   mls->err = NULL;
@@ -582,6 +585,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   ls->err = err ? err : &local;
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
+  vm_budget(ls, d.max_ops);
   vd_lstring tmp = vd_lstring_empty();
   pass_ctx P = {NULL, 0, d.max_modules};
   vd_status st = build_index(ls);
@@ -663,6 +667,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   ls->err = err ? err : &local;
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
+  vm_budget(ls, d.max_ops);
   pass_ctx P = {NULL, 0, d.max_modules};
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;

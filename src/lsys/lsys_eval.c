@@ -24,6 +24,20 @@ vd_status vm_error(vd_lsystem* ls, vd_status st, int line, int col, const char* 
   return st;
 }
 
+void vm_budget(vd_lsystem* ls, int64_t max_ops) {
+  ls->max_ops = max_ops > 0 ? max_ops : LSYS_DEFAULT_MAX_OPS;
+  ls->ops_left = ls->max_ops;
+}
+
+// take one operation (a loop iteration or a call) from the run's budget; non-zero when spent
+static int spend_op(vd_lsystem* ls, int line, int col) {
+  if (--ls->ops_left >= 0) return 0;
+  vm_error(ls, VD_ERR_LIMIT, line, col,
+           "the run needs more than %lld interpreter operations (loop iterations and calls)",
+           (long long)ls->max_ops);
+  return 1;
+}
+
 // ---------------------------------------------------------------------------------------------
 // builtins
 
@@ -660,6 +674,7 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
           if (++it > MAX_LOOP_ITER)
             return vm_error(ls, VD_ERR_LIMIT, s->line, s->col, "while loop ran more than %lld iterations",
                             MAX_LOOP_ITER);
+          if (spend_op(ls, s->line, s->col)) return ls->err->status;
           if (exec_list(ls, s->body, frame, X)) return ls->err->status;
           if (X->flow == FLOW_BREAK) {
             X->flow = FLOW_NONE;
@@ -682,8 +697,11 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
         double cnt = c.n > 0 ? ceil((b.n - a.n) / c.n) : ceil((a.n - b.n) / -c.n);
         if (cnt > (double)MAX_LOOP_ITER)
           return vm_error(ls, VD_ERR_LIMIT, s->line, s->col, "range() of more than %lld items", MAX_LOOP_ITER);
-        for (double i = a.n; c.n > 0 ? i < b.n : i > b.n; i += c.n) {
-          assign(ls, s, frame, v_int(i));
+        // count iterations rather than adding the step: a + step can round back to a
+        int64_t nit = cnt > 0 ? (int64_t)cnt : 0;
+        for (int64_t k = 0; k < nit; k++) {
+          if (spend_op(ls, s->line, s->col)) return ls->err->status;
+          assign(ls, s, frame, v_int(a.n + (double)k * c.n));
           if (exec_list(ls, s->body, frame, X)) return ls->err->status;
           if (X->flow == FLOW_BREAK) {
             X->flow = FLOW_NONE;
@@ -762,6 +780,7 @@ vd_status vm_call_func(vd_lsystem* ls, int fi, int nargs, const value* args, val
   if (ls->call_depth >= MAX_CALL_DEPTH)
     return vm_error(ls, VD_ERR_LIMIT, line, col, "maximum recursion depth (%d) exceeded in %s()",
                     MAX_CALL_DEPTH, f->name);
+  if (spend_op(ls, line, col)) return ls->err->status;
   value small[32];
   value* frame = small;
   int nl = f->nlocal > 0 ? f->nlocal : 1;

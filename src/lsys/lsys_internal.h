@@ -213,6 +213,8 @@ struct vd_lsystem {
   int iteration;
   int stop_requested;
   int call_depth;
+  int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
+  int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
 };
 
@@ -238,6 +240,9 @@ expr* lsys_parse_expr_text(vd_lsystem* ls, const char* text, int len, int line, 
 tmpl* lsys_parse_tmpl_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 
 // interpreter
+#define LSYS_DEFAULT_MAX_OPS 10000000000LL  // vd_lsys_def.max_ops when unset
+// Start a run with a budget of max_ops interpreter operations (<= 0: the default).
+void vm_budget(vd_lsystem* ls, int64_t max_ops);
 typedef struct vm_out {
   vd_lstring* s;       // where produce writes
   int64_t src;         // source index recorded on produced modules (when s->src)
