@@ -90,3 +90,51 @@ TEST(regress, range_with_huge_start_terminates) {
   CHECK_INT(LSYS("Axiom:\n  for i in range(100000000000000000, 100000000000000010):\n    nproduce B\n"), VD_OK);
   CHECK_INT(expr_path("1"), VD_OK);
 }
+
+// ---------------------------------------------------------------------------------------------
+// parser
+
+TEST(regress, group_number_at_end_of_text) {
+  // strtol read past the end of a text whose last line is `group N` (heap-buffer-overflow)
+  const char src[] = {'A', 'x', 'i', 'o', 'm', ':', ' ', 'A', '\n', 'g', 'r', 'o', 'u', 'p', ' ', '1', '2'};
+  char* exact = malloc(sizeof src);  // exactly sized, as the fuzzer's buffer
+  REQUIRE(exact);
+  memcpy(exact, src, sizeof src);
+  CHECK_INT(lsys_path(exact, sizeof src), VD_ERR_SYNTAX);
+  free(exact);
+  CHECK_INT(LSYS("Axiom: A\nproduction:\ngroup :\nA --> B\n"), VD_ERR_SYNTAX);
+  CHECK_INT(LSYS("Axiom: A\nproduction:\ngroup   2 :\nA --> B\nendgroup\n"), VD_OK);
+}
+
+// ---------------------------------------------------------------------------------------------
+// numbers converted to integers (UBSan: value outside the range of the integer type)
+
+TEST(regress, random_builtins_with_huge_arguments) {
+  CHECK_INT(expr_path("randint(1e300, 1e301)"), VD_ERR_VALUE);
+  CHECK_INT(expr_path("randint(-9e18, 9e18)"), VD_ERR_VALUE);
+  CHECK_INT(expr_path("randrange(1e300)"), VD_ERR_VALUE);
+  CHECK_INT(expr_path("randrange(0, 1e300, 3)"), VD_ERR_VALUE);
+  CHECK_INT(expr_path("seed(1e300)"), VD_ERR_UNSUPPORTED);
+  CHECK_INT(expr_path("randint(-2**53, 2**53), randrange(-2**53, 2**53), seed(2**63) or 1"), VD_OK);
+  // the generator itself over the whole int64 range
+  vd_rng r;
+  vd_rng_seed(&r, 1);
+  int64_t v = vd_rng_randint(&r, INT64_MIN, INT64_MAX);
+  (void)v;
+  CHECK(vd_rng_randint(&r, -5, -5) == -5);
+}
+
+TEST(regress, use_group_with_huge_number) {
+  CHECK_INT(expr_path("useGroup(1e300)"), VD_ERR_VALUE);
+  CHECK_INT(expr_path("useGroup(2) or 1"), VD_OK);
+}
+
+TEST(regress, derivation_length_out_of_int_range) {
+  CHECK_INT(LSYS("Axiom: A\nderivation length: 1e300\n"), VD_ERR_VALUE);
+  vd_lsystem* ls = NULL;
+  vd_error err = {0};
+  const char* src = "Axiom: A\nderivation length: 1e300\n";
+  REQUIRE(vd_lsys_parse(src, strlen(src), "t", &ls, &err) == VD_OK);
+  CHECK_INT(vd_lsys_derivation_length(ls), 1);
+  vd_lsys_destroy(ls);
+}

@@ -225,7 +225,10 @@ int vd_lsys_derivation_length(const vd_lsystem* ls) {
   mls->err = &local;
   vm_budget(mls, mls->max_ops);  // the work limit of the last run
   int n = 1;
-  if (vm_eval(mls, ls->derivation_length, NULL, &v) == VD_OK && v_isnum(v)) n = (int)v.n;
+  // the same range vd_lsys_derive accepts; anything else (NaN, 1e300) stays 1
+  if (vm_eval(mls, ls->derivation_length, NULL, &v) == VD_OK && v_isnum(v) && v.n == floor(v.n) &&
+      v.n >= 0 && v.n <= 1e9)
+    n = (int)v.n;
   mls->err = NULL;
   return n;
 }

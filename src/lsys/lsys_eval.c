@@ -11,6 +11,7 @@
 
 #define MAX_CALL_DEPTH 200
 #define MAX_LOOP_ITER 100000000LL
+#define MAX_EXACT_INT 9007199254740992.0  // 2^53: integers beyond are not exact doubles
 
 vd_status vm_error(vd_lsystem* ls, vd_status st, int line, int col, const char* fmt, ...) {
   if (ls->err && ls->err->status == VD_OK) {
@@ -328,6 +329,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
     }
     case B_RANDINT:
       if (x != floor(x) || y != floor(y)) return vm_error(ls, VD_ERR_VALUE, line, col, "randint() needs integers");
+      if (fabs(x) > MAX_EXACT_INT || fabs(y) > MAX_EXACT_INT)
+        return vm_error(ls, VD_ERR_VALUE, line, col, "randint() arguments beyond +-2^53");
       if (y < x) return vm_error(ls, VD_ERR_VALUE, line, col, "empty range for randint(%g, %g)", x, y);
       *out = v_int((double)vd_rng_randint(r, (int64_t)x, (int64_t)y));
       break;
@@ -335,6 +338,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       double start = n == 1 ? 0 : x, stop = n == 1 ? x : y, step = n == 3 ? a[2].n : 1;
       if (start != floor(start) || stop != floor(stop) || step != floor(step) || step == 0)
         return vm_error(ls, VD_ERR_VALUE, line, col, "randrange() needs integers and a non-zero step");
+      if (fabs(start) > MAX_EXACT_INT || fabs(stop) > MAX_EXACT_INT || fabs(step) > MAX_EXACT_INT)
+        return vm_error(ls, VD_ERR_VALUE, line, col, "randrange() arguments beyond +-2^53");
       double cnt = step > 0 ? floor((stop - start + step - 1) / step) : floor((stop - start + step + 1) / step);
       if (cnt <= 0) return vm_error(ls, VD_ERR_VALUE, line, col, "empty range for randrange()");
       *out = v_int(start + step * (double)vd_rng_randint(r, 0, (int64_t)cnt - 1));
@@ -343,6 +348,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
     case B_SEED:
       if (n && (x != floor(x) || !isfinite(x)))
         return vm_error(ls, VD_ERR_UNSUPPORTED, line, col, "unsupported: seed() with a non-integer");
+      if (n && fabs(x) >= 18446744073709551616.0)
+        return vm_error(ls, VD_ERR_UNSUPPORTED, line, col, "unsupported: seed() beyond 2^64");
       vd_rng_seed(r, n ? (uint64_t)fabs(x) : 0);
       *out = (value){V_NONE, 0};
       break;
@@ -366,7 +373,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       break;
     case B_GETITERATIONNB: *out = v_int(ls->iteration); break;
     case B_USEGROUP:
-      if (x != floor(x) || x < 0) return vm_error(ls, VD_ERR_VALUE, line, col, "useGroup() needs a group number");
+      if (x != floor(x) || x < 0 || x > 1000000)
+        return vm_error(ls, VD_ERR_VALUE, line, col, "useGroup() needs a group number in 0..1000000");
       ls->current_group = (int)x;
       *out = (value){V_NONE, 0};
       break;

@@ -2145,10 +2145,17 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
       continue;
     }
     if (starts_kw(ln, "group", &a) && a < ln->len && is_space(ln->s[a])) {
-      char* end;
-      long g = strtol(ln->s + a, &end, 10);
+      // the number goes through a NUL-terminated copy: the last line of the text has no end
+      while (a < ln->len && is_space(ln->s[a])) a++;
+      char buf[32];
+      int n = ln->len - a < 31 ? ln->len - a : 31;
+      memcpy(buf, ln->s + a, (size_t)n);
+      buf[n] = 0;
+      char* bend;
+      long g = strtol(buf, &bend, 10);
+      const char* end = ln->s + a + (bend - buf);
       while (end < ln->s + ln->len && is_space(*end)) end++;
-      if (end >= ln->s + ln->len || *end != ':' || g < 0 || g > 1000000) {
+      if (bend == buf || end >= ln->s + ln->len || *end != ':' || g < 0 || g > 1000000) {
         st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + a, "expected 'group N:' with an integer N");
         goto done;
       }
