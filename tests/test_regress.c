@@ -138,3 +138,67 @@ TEST(regress, derivation_length_out_of_int_range) {
   CHECK_INT(vd_lsys_derivation_length(ls), 1);
   vd_lsys_destroy(ls);
 }
+
+// ---------------------------------------------------------------------------------------------
+// out of memory at every allocation of the lsys path (the fuzz targets never fail an allocation)
+
+// an allocator that fails once a budget of allocations is spent
+static int64_t oom_budget;
+static void* oom_realloc(void* user, void* ptr, size_t old_size, size_t new_size) {
+  (void)user;
+  (void)old_size;
+  if (new_size == 0) {
+    free(ptr);
+    return NULL;
+  }
+  if (oom_budget-- <= 0) return NULL;
+  return realloc(ptr, new_size);
+}
+
+TEST(regress, lsys_out_of_memory_sweep) {
+  const char* src =
+      "LABELS = {1: 'stem', 2: 'leaf', 3: 'fruit'}\n"
+      "module Apex, Leaf\n"
+      "def f(x):\n"
+      "  return x * 2\n"
+      "Axiom: Apex(1) A('s')\n"
+      "derivation length: 2\n"
+      "ignore: +\n"
+      "production:\n"
+      "Apex(x) --> F(f(x)) [ +(30) Leaf(x) ] Apex(x + 1)\n"
+      "F(x) < Leaf(y) :\n"
+      "  for i in range(2):\n"
+      "    nproduce Leaf(y + i)\n"
+      "A(s) --> A(s + 't')\n"
+      "group 1:\n"
+      "Leaf(y) --> %\n"
+      "endgroup\n"
+      "decomposition:\n"
+      "Leaf(y) --> ~l(y)\n"
+      "interpretation:\n"
+      "Apex(x) --> @O(x)\n"
+      "endlsystem\n"
+      "###### INITIALISATION ######\n"
+      "def __initialiseContext__(context):\n"
+      "\tscalars = [('n', 'Integer', 8, 0, 20)]\n"
+      "\tcontext[\"__scalars__\"] = scalars\n";
+  int64_t start = vd_alloc_bytes();
+  int done = 0;
+  for (int64_t b = 0; b < 5000 && !done; b++) {
+    oom_budget = b;
+    vd_set_allocator(oom_realloc, NULL);
+    vd_status st = LSYS(src);
+    vd_set_allocator(NULL, NULL);
+    done = st == VD_OK;
+    if (st != VD_OK && st != VD_ERR_NOMEM) {
+      vdt_fail(__FILE__, __LINE__, "budget %lld: %s", (long long)b, vd_status_str(st));
+      break;
+    }
+    if (vd_alloc_bytes() != start) {
+      vdt_fail(__FILE__, __LINE__, "budget %lld: %lld bytes not given back", (long long)b,
+               (long long)(vd_alloc_bytes() - start));
+      break;
+    }
+  }
+  CHECK(done);
+}

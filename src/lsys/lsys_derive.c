@@ -37,13 +37,13 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   if (!ls) return;
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
-  vd_free(ls->syms.declared, (size_t)ls->syms.cap);
+  vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);
   vd_free(ls->syms.hash_slot, (size_t)ls->syms.hcap * sizeof(int));
   for (int i = 0; i < ls->nstr; i++) vd_free(ls->str[i], strlen(ls->str[i]) + 1);
   vd_free(ls->str, (size_t)ls->capstr * sizeof(char*));
   for (int i = 0; i < ls->nglobal; i++) vd_free(ls->gdef[i].name, strlen(ls->gdef[i].name) + 1);
   vd_free(ls->gdef, (size_t)ls->capglobal * sizeof(global_def));
-  vd_free(ls->gval, (size_t)ls->capglobal * sizeof(value));
+  vd_free(ls->gval, (size_t)ls->capgval * sizeof(value));
   vd_free(ls->funcs, (size_t)ls->capfunc * sizeof(func*));
   vd_free(ls->rules, (size_t)ls->caprule * sizeof(rule*));
   for (int s = 0; s < SEC_COUNT; s++) {

@@ -145,7 +145,8 @@ typedef struct rule {
 // the lsystem
 
 typedef struct symtab {
-  int n, cap;
+  int n, cap;         // count, capacity of name
+  int cap_declared;   // capacity of declared (grown separately: one can fail after the other)
   char** name;        // symbol names (owned)
   int* hash_slot;     // open addressing table of symbol ids (hcap), -1 empty
   int hcap;
@@ -171,7 +172,7 @@ struct vd_lsystem {
   int nstr, capstr;
   char** str;
   // globals
-  int nglobal, capglobal;
+  int nglobal, capglobal, capgval;  // count, capacities of gdef and gval
   global_def* gdef;        // names and overrides (nglobal)
   value* gval;             // current values (nglobal)
   // functions

@@ -63,13 +63,9 @@ int sym_intern(vd_lsystem* ls, const char* name, int len, int declared) {
     }
     return id;
   }
-  if (t->n == t->cap) {
-    int cap = t->cap;
-    if (!vd_grow((void**)&t->name, &cap, t->n + 1, sizeof(char*))) return -1;
-    int cap2 = t->cap;
-    if (!vd_grow((void**)&t->declared, &cap2, t->n + 1, 1)) return -1;
-    t->cap = cap < cap2 ? cap : cap2;
-  }
+  if (!vd_grow((void**)&t->name, &t->cap, t->n + 1, sizeof(char*)) ||
+      !vd_grow((void**)&t->declared, &t->cap_declared, t->n + 1, 1))
+    return -1;
   char* s = vd_malloc((size_t)len + 1);
   if (!s) return -1;
   memcpy(s, name, (size_t)len);
@@ -147,11 +143,9 @@ int global_slot(vd_lsystem* ls, const char* name, int len, int create) {
     if ((int)strlen(ls->gdef[i].name) == len && memcmp(ls->gdef[i].name, name, (size_t)len) == 0)
       return i;
   if (!create) return -1;
-  int cap = ls->capglobal;
-  if (!vd_grow((void**)&ls->gdef, &cap, ls->nglobal + 1, sizeof(global_def))) return -1;
-  int cap2 = ls->capglobal;
-  if (!vd_grow((void**)&ls->gval, &cap2, ls->nglobal + 1, sizeof(value))) return -1;
-  ls->capglobal = cap < cap2 ? cap : cap2;
+  if (!vd_grow((void**)&ls->gdef, &ls->capglobal, ls->nglobal + 1, sizeof(global_def)) ||
+      !vd_grow((void**)&ls->gval, &ls->capgval, ls->nglobal + 1, sizeof(value)))
+    return -1;
   global_def* g = &ls->gdef[ls->nglobal];
   memset(g, 0, sizeof *g);
   g->name = vd_malloc((size_t)len + 1);
