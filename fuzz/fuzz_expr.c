@@ -35,7 +35,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     vd_lsys_def def = vd_lsys_def_default();
     def.steps = 1;
     def.max_modules = 20000;
-    def.max_ops = 1000000;
+    def.max_ops = 100000;
     vd_lstring s = vd_lstring_empty();
     (void)vd_lsys_derive(ls, &def, &s, &err);
     vd_lstring_free(&s);

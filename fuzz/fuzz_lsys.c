@@ -34,7 +34,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     def.steps = -1;
     def.progress = stop_after_3;
     def.max_modules = 20000;
-    def.max_ops = 1000000;
+    def.max_ops = 100000;
     vd_lstring derived = vd_lstring_empty(), interp = vd_lstring_empty();
     vd_status st = vd_lsys_derive(ls, &def, &derived, &err);
     if (!st) st = vd_lsys_interpret(ls, &def, &derived, &interp, &err);

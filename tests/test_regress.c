@@ -24,7 +24,7 @@ static vd_status lsys_path(const char* src, size_t len) {
   vd_lsys_def def = vd_lsys_def_default();
   def.progress = stop_after_3;
   def.max_modules = 20000;
-  def.max_ops = 1000000;
+  def.max_ops = 100000;
   vd_lstring derived = vd_lstring_empty(), interp = vd_lstring_empty();
   st = vd_lsys_derive(ls, &def, &derived, &err);
   if (!st) st = vd_lsys_interpret(ls, &def, &derived, &interp, &err);
@@ -55,7 +55,7 @@ static vd_status expr_path(const char* e) {
   vd_lsys_def def = vd_lsys_def_default();
   def.steps = 1;
   def.max_modules = 20000;
-  def.max_ops = 1000000;
+  def.max_ops = 100000;
   vd_lstring s = vd_lstring_empty();
   st = vd_lsys_derive(ls, &def, &s, &err);
   vd_lstring_free(&s);
@@ -201,4 +201,20 @@ TEST(regress, lsys_out_of_memory_sweep) {
     }
   }
   CHECK(done);
+}
+
+// ---------------------------------------------------------------------------------------------
+// strings made at run time
+
+TEST(regress, strings_built_in_a_loop) {
+  // every s + str(i) interned its result after a linear search of all strings (each up to 2 KiB):
+  // minutes for this loop, and the table grew without bound; now hashed and limited to 64 MiB
+  CHECK_INT(LSYS("s = 'ab'\nAxiom:\n  global s\n  for i in range(50000):\n    s = s + str(i)\n  produce A(s)\n"),
+            VD_OK);
+  // 40000 distinct strings of ~1.9 KiB pass the limit
+  CHECK_INT(LSYS("Axiom:\n  a = 'abcdefghij'\n  for k in range(6):\n    a = a + a\n  b = a + a + a\n"
+                 "  for i in range(40000):\n    c = b + str(i)\n  produce A(c)\n"),
+            VD_ERR_LIMIT);
+  // the same string again is found, not added
+  CHECK_INT(LSYS("Axiom:\n  for i in range(5000):\n    nproduce A('x' + 'y', str(i % 7))\n"), VD_OK);
 }

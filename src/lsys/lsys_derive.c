@@ -41,6 +41,7 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   vd_free(ls->syms.hash_slot, (size_t)ls->syms.hcap * sizeof(int));
   for (int i = 0; i < ls->nstr; i++) vd_free(ls->str[i], strlen(ls->str[i]) + 1);
   vd_free(ls->str, (size_t)ls->capstr * sizeof(char*));
+  vd_free(ls->str_slot, (size_t)ls->str_hcap * sizeof(int));
   for (int i = 0; i < ls->nglobal; i++) vd_free(ls->gdef[i].name, strlen(ls->gdef[i].name) + 1);
   vd_free(ls->gdef, (size_t)ls->capglobal * sizeof(global_def));
   vd_free(ls->gval, (size_t)ls->capgval * sizeof(value));

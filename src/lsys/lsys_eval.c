@@ -268,7 +268,7 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       if (n) value_repr(ls, a[0], buf, sizeof buf);
       else buf[0] = 0;
       int id = str_intern(ls, buf, (int)strlen(buf));
-      if (id < 0) return vm_error(ls, VD_ERR_NOMEM, line, col, "out of memory");
+      if (id < 0) return str_intern_error(ls, id, line, col);
       *out = (value){V_STR, id};
       break;
     }
@@ -396,7 +396,7 @@ static vd_status arith(vd_lsystem* ls, int op, value a, value b, value* out, int
     char buf[2048];
     snprintf(buf, sizeof buf, "%s%s", ls->str[(int)a.n], ls->str[(int)b.n]);
     int id = str_intern(ls, buf, (int)strlen(buf));
-    if (id < 0) return vm_error(ls, VD_ERR_NOMEM, line, col, "out of memory");
+    if (id < 0) return str_intern_error(ls, id, line, col);
     *out = (value){V_STR, id};
     return VD_OK;
   }

@@ -171,6 +171,9 @@ struct vd_lsystem {
   // strings
   int nstr, capstr;
   char** str;
+  int* str_slot;           // open addressing index of string ids (str_hcap), -1 empty
+  int str_hcap;
+  int64_t str_bytes;       // bytes of all strings (limit LSYS_MAX_STR_BYTES)
   // globals
   int nglobal, capglobal, capgval;  // count, capacities of gdef and gval
   global_def* gdef;        // names and overrides (nglobal)
@@ -225,7 +228,11 @@ struct vd_lsystem {
 // symbol table
 int sym_intern(vd_lsystem* ls, const char* name, int len, int declared);
 int sym_find(const vd_lsystem* ls, const char* name, int len);
+#define LSYS_MAX_STR_BYTES (64 << 20)  // all strings of an lsystem together (bytes)
+// Id of a string, added when new; -1 out of memory, -2 over LSYS_MAX_STR_BYTES.
 int str_intern(vd_lsystem* ls, const char* s, int len);
+// Report a failed str_intern (its negative result) as out of memory or limit; returns the status.
+vd_status str_intern_error(vd_lsystem* ls, int id, int line, int col);
 double lsys_box_str(int id);
 int lsys_unbox_str(double v);
 int global_slot(vd_lsystem* ls, const char* name, int len, int create);

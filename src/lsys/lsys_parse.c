@@ -325,7 +325,7 @@ static vd_status lx_next(lexer* L) {
     if (p >= L->len)
       return perr(L->ls, VD_ERR_SYNTAX, L->lineno, L->col0 + L->pos, "unterminated string");
     L->sid = str_intern(L->ls, buf, n);
-    if (L->sid < 0) return perr(L->ls, VD_ERR_NOMEM, L->lineno, L->col0 + L->pos, "out of memory");
+    if (L->sid < 0) return str_intern_error(L->ls, L->sid, L->lineno, L->col0 + L->pos);
     L->t = T_STR;
     L->tlen = p + 1 - L->pos;
     L->pos = p + 1;
@@ -575,7 +575,10 @@ static expr* parse_atom(pctx* C) {
       char buf[2048];
       snprintf(buf, sizeof buf, "%s%s", C->ls->str[(int)e->k.n], C->ls->str[L->sid]);
       int id = str_intern(C->ls, buf, (int)strlen(buf));
-      if (id < 0) return NULL;
+      if (id < 0) {
+        str_intern_error(C->ls, id, L->lineno, lx_col(L));
+        return NULL;
+      }
       e->k.n = id;
       if (lx_next(L)) return NULL;
     }
@@ -623,6 +626,10 @@ static expr* parse_atom(pctx* C) {
       if (!a) return NULL;
       a->a = e;
       a->slot = str_intern(C->ls, L->s + L->start, L->tlen);
+      if (a->slot < 0) {
+        str_intern_error(C->ls, a->slot, L->lineno, lx_col(L));
+        return NULL;
+      }
       if (lx_next(L)) return NULL;
       e = a;
     } else if (tok_is(L, '[')) {
