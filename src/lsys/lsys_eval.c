@@ -30,9 +30,11 @@ void vm_budget(vd_lsystem* ls, int64_t max_ops) {
   ls->ops_left = ls->max_ops;
 }
 
-// take one operation (a loop iteration or a call) from the run's budget; non-zero when spent
-static int spend_op(vd_lsystem* ls, int line, int col) {
-  if (--ls->ops_left >= 0) return 0;
+// take n operations (a loop iteration or a call is one) from the run's budget; non-zero when
+// the budget is spent
+static int spend_ops(vd_lsystem* ls, int64_t n, int line, int col) {
+  ls->ops_left -= n;
+  if (ls->ops_left >= 0) return 0;
   vm_error(ls, VD_ERR_LIMIT, line, col,
            "the run needs more than %lld interpreter operations (loop iterations and calls)",
            (long long)ls->max_ops);
@@ -395,6 +397,8 @@ static vd_status arith(vd_lsystem* ls, int op, value a, value b, value* out, int
   if (op == E_ADD && a.t == V_STR && b.t == V_STR) {
     char buf[2048];
     snprintf(buf, sizeof buf, "%s%s", ls->str[(int)a.n], ls->str[(int)b.n]);
+    // a concatenation costs one operation per 64 bytes it makes
+    if (spend_ops(ls, (int64_t)strlen(buf) / 64, line, col)) return ls->err->status;
     int id = str_intern(ls, buf, (int)strlen(buf));
     if (id < 0) return str_intern_error(ls, id, line, col);
     *out = (value){V_STR, id};
@@ -682,7 +686,7 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
           if (++it > MAX_LOOP_ITER)
             return vm_error(ls, VD_ERR_LIMIT, s->line, s->col, "while loop ran more than %lld iterations",
                             MAX_LOOP_ITER);
-          if (spend_op(ls, s->line, s->col)) return ls->err->status;
+          if (spend_ops(ls, 1, s->line, s->col)) return ls->err->status;
           if (exec_list(ls, s->body, frame, X)) return ls->err->status;
           if (X->flow == FLOW_BREAK) {
             X->flow = FLOW_NONE;
@@ -708,7 +712,7 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
         // count iterations rather than adding the step: a + step can round back to a
         int64_t nit = cnt > 0 ? (int64_t)cnt : 0;
         for (int64_t k = 0; k < nit; k++) {
-          if (spend_op(ls, s->line, s->col)) return ls->err->status;
+          if (spend_ops(ls, 1, s->line, s->col)) return ls->err->status;
           assign(ls, s, frame, v_int(a.n + (double)k * c.n));
           if (exec_list(ls, s->body, frame, X)) return ls->err->status;
           if (X->flow == FLOW_BREAK) {
@@ -788,7 +792,7 @@ vd_status vm_call_func(vd_lsystem* ls, int fi, int nargs, const value* args, val
   if (ls->call_depth >= MAX_CALL_DEPTH)
     return vm_error(ls, VD_ERR_LIMIT, line, col, "maximum recursion depth (%d) exceeded in %s()",
                     MAX_CALL_DEPTH, f->name);
-  if (spend_op(ls, line, col)) return ls->err->status;
+  if (spend_ops(ls, 1, line, col)) return ls->err->status;
   value small[32];
   value* frame = small;
   int nl = f->nlocal > 0 ? f->nlocal : 1;
