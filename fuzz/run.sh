@@ -44,7 +44,7 @@ for t in $TARGETS; do
     "$OUT/corpus/$t" "fuzz/corpus/$t" >"$log" 2>&1
   rc=$?
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
-  ncorp=$(ls "$OUT/corpus/$t" "fuzz/corpus/$t" | grep -vc ':$')
+  ncorp=$(find "$OUT/corpus/$t" "fuzz/corpus/$t" -type f | wc -l)
   nfind=$(find "$OUT/findings/$t" -type f -newer "$OUT/$t.stamp" | wc -l)
   printf '%-16s %10s %8s %8s %9s\n' "$t" "${execs:-?}" "$SECONDS_PER" "$ncorp" "$nfind"
   if [ $rc -ne 0 ] || [ "$nfind" -ne 0 ]; then
