@@ -23,6 +23,7 @@ typedef struct cli_plant_opts {
   int steps;               // -n/--steps, -1 = file's derivation length
   uint64_t seed;           // --seed
   int64_t max_modules;     // --max-modules
+  int64_t max_ops;         // --max-ops (0 = library default)
   const char* set[64];     // --set NAME=VALUE
   int nset;
   const char* label[64];   // --label ID=NAME

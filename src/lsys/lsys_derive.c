@@ -225,6 +225,11 @@ int vd_lsys_derivation_length(const vd_lsystem* ls) {
   vd_error local = {0};
   mls->err = &local;
   vm_budget(mls, mls->max_ops);  // the work limit of the last run
+  // the expression may use globals: run the top-level code first (derive runs it again)
+  if (run_toplevel(mls, 0) != VD_OK) {
+    mls->err = NULL;
+    return 1;
+  }
   int n = 1;
   // the same range vd_lsys_derive accepts; anything else (NaN, 1e300) stays 1
   if (vm_eval(mls, ls->derivation_length, NULL, &v) == VD_OK && v_isnum(v) && v.n == floor(v.n) &&

@@ -248,7 +248,7 @@ expr* lsys_parse_expr_text(vd_lsystem* ls, const char* text, int len, int line, 
 tmpl* lsys_parse_tmpl_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 
 // interpreter
-#define LSYS_DEFAULT_MAX_OPS 10000000000LL  // vd_lsys_def.max_ops when unset
+#define LSYS_DEFAULT_MAX_OPS 1000000000LL  // vd_lsys_def.max_ops when unset
 // Start a run with a budget of max_ops interpreter operations (<= 0: the default).
 void vm_budget(vd_lsystem* ls, int64_t max_ops);
 typedef struct vm_out {
