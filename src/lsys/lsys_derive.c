@@ -589,6 +589,15 @@ static vd_status call_hook(vd_lsystem* ls, int fi) {
   return vm_call_func(ls, fi, 0, NULL, &r, f->line, 1);
 }
 
+// release a run's scratch, make sure a failure has a message, detach the error sink
+static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, pass_ctx* P) {
+  vd_lstring_free(tmp);
+  vd_free(P->match, sizeof(int64_t) * (size_t)P->match_cap);
+  if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
+  ls->err = NULL;
+  return st;
+}
+
 vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
   vd_error local = {0};
   ls->err = err ? err : &local;
@@ -663,11 +672,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   }
   if ((st = call_hook(ls, ls->hook_end))) goto done;
 done:
-  vd_lstring_free(&tmp);
-  vd_free(P.match, sizeof(int64_t) * (size_t)P.match_cap);
-  if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
-  ls->err = NULL;
-  return st;
+  return end_run(ls, st, &tmp, &P);
 }
 
 vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lstring* in, vd_lstring* out,
@@ -697,11 +702,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   out->n = in->n;
   st = apply_section(ls, SEC_INTERPRETATION, out, &tmp, &P);
 done:
-  vd_lstring_free(&tmp);
-  vd_free(P.match, sizeof(int64_t) * (size_t)P.match_cap);
-  if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
-  ls->err = NULL;
-  return st;
+  return end_run(ls, st, &tmp, &P);
 }
 
 vd_status vd_lsys_parse_lstring(vd_lsystem* ls, const char* text, vd_lstring* out, vd_error* err) {

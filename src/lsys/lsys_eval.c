@@ -647,6 +647,18 @@ vd_status vm_emit_tmpl(vd_lsystem* ls, const tmpl* t, value* frame, vm_out* out)
   return VD_OK;
 }
 
+// one pass through a loop body (it costs one operation): 1 when the loop ends here (break, or
+// return with X->flow left at FLOW_RETURN), 0 to go on, -1 on error
+static int loop_iteration(vd_lsystem* ls, const stmt* s, value* frame, exec_state* X) {
+  if (spend_ops(ls, 1, s->line, s->col) || exec_list(ls, s->body, frame, X)) return -1;
+  if (X->flow == FLOW_CONTINUE) X->flow = FLOW_NONE;
+  if (X->flow == FLOW_BREAK) {
+    X->flow = FLOW_NONE;
+    return 1;
+  }
+  return X->flow == FLOW_RETURN;
+}
+
 static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X) {
   for (; s; s = s->next) {
     value v;
@@ -679,22 +691,14 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
         if (X->flow) return VD_OK;
         break;
       case S_WHILE: {
-        long long it = 0;
         for (;;) {
           if (vm_eval(ls, s->e, frame, &v)) return ls->err->status;
           if (!value_truthy(v)) break;
-          if (++it > MAX_LOOP_ITER)
-            return vm_error(ls, VD_ERR_LIMIT, s->line, s->col, "while loop ran more than %lld iterations",
-                            MAX_LOOP_ITER);
-          if (spend_ops(ls, 1, s->line, s->col)) return ls->err->status;
-          if (exec_list(ls, s->body, frame, X)) return ls->err->status;
-          if (X->flow == FLOW_BREAK) {
-            X->flow = FLOW_NONE;
-            break;
-          }
-          if (X->flow == FLOW_CONTINUE) X->flow = FLOW_NONE;
-          if (X->flow == FLOW_RETURN) return VD_OK;
+          int r = loop_iteration(ls, s, frame, X);
+          if (r < 0) return ls->err->status;
+          if (r > 0) break;
         }
+        if (X->flow == FLOW_RETURN) return VD_OK;
         break;
       }
       case S_FOR: {
@@ -712,16 +716,12 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
         // count iterations rather than adding the step: a + step can round back to a
         int64_t nit = cnt > 0 ? (int64_t)cnt : 0;
         for (int64_t k = 0; k < nit; k++) {
-          if (spend_ops(ls, 1, s->line, s->col)) return ls->err->status;
           assign(ls, s, frame, v_int(a.n + (double)k * c.n));
-          if (exec_list(ls, s->body, frame, X)) return ls->err->status;
-          if (X->flow == FLOW_BREAK) {
-            X->flow = FLOW_NONE;
-            break;
-          }
-          if (X->flow == FLOW_CONTINUE) X->flow = FLOW_NONE;
-          if (X->flow == FLOW_RETURN) return VD_OK;
+          int r = loop_iteration(ls, s, frame, X);
+          if (r < 0) return ls->err->status;
+          if (r > 0) break;
         }
+        if (X->flow == FLOW_RETURN) return VD_OK;
         break;
       }
       case S_PRODUCE:

@@ -36,23 +36,8 @@ typedef struct parser {
   int failed;
 } parser;
 
-static vd_status perr(vd_lsystem* ls, vd_status st, int line, int col, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 5, 6)))
-#endif
-    ;
-
-static vd_status perr(vd_lsystem* ls, vd_status st, int lineno, int col, const char* fmt, ...) {
-  if (ls->err && ls->err->status == VD_OK) {
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    vd_error_set(ls->err, st, ls->file, lineno, col, "%s", msg);
-  }
-  return st;
-}
+// parse errors are recorded like run-time errors: the first one wins
+#define perr vm_error
 
 static void* aalloc(vd_lsystem* ls, size_t n) {
   void* p = vd_arena_alloc(&ls->arena, n);
@@ -804,29 +789,21 @@ static expr* parse_not(pctx* C) {
   return parse_comparison(C);
 }
 
-static expr* parse_and(pctx* C) {
-  expr* a = parse_not(C);
-  while (a && tok_name(C->L, "and")) {
+// a left-associative chain `sub (kw sub)*` joined by op
+static expr* parse_kw_chain(pctx* C, const char* kw, int op, expr* (*sub)(pctx*)) {
+  expr* a = sub(C);
+  while (a && tok_name(C->L, kw)) {
     int col = lx_col(C->L);
     if (lx_next(C->L)) return NULL;
-    expr* b = parse_not(C);
+    expr* b = sub(C);
     if (!b) return NULL;
-    a = binop(C, E_AND, a, b, col);
+    a = binop(C, op, a, b, col);
   }
   return a;
 }
 
-static expr* parse_or(pctx* C) {
-  expr* a = parse_and(C);
-  while (a && tok_name(C->L, "or")) {
-    int col = lx_col(C->L);
-    if (lx_next(C->L)) return NULL;
-    expr* b = parse_and(C);
-    if (!b) return NULL;
-    a = binop(C, E_OR, a, b, col);
-  }
-  return a;
-}
+static expr* parse_and(pctx* C) { return parse_kw_chain(C, "and", E_AND, parse_not); }
+static expr* parse_or(pctx* C) { return parse_kw_chain(C, "or", E_OR, parse_and); }
 
 static expr* parse_expr(pctx* C) {
   if (tok_name(C->L, "lambda")) {
