@@ -31,7 +31,15 @@ for p in arabidopsis tree lilac; do
   echo "== growing data/$p.lpy"
   "$V" grow "data/$p.lpy" --seed 1 -o "out/$p.obj" --stats > "out/$p-stats.json"
 done
+echo "== rendering pictures (headless: EGL, software rendering without a GPU)"
+"$V" render data/tomato.lpy --seed 1 -o out/tomato.png --masks --depth
+"$V" render data/tomato.lpy --seed 1 -o out/tomato-instance.png --color-by instance --camera orbit:-30:25
+"$V" render data/tomato.lpy --seed 1 -o out/tomato-arm.png --robot data/robots/arm6.xml --camera orbit:-60:20
+# the labelled cloud written above (200k sampled points)
+"$V" render out/tomato-cloud.ply -o out/tomato-cloud.png --camera orbit:-30:25 --point-size 0.004
+echo "   out/tomato.png (+ .label.png, .instance.png, .depth.png, .json), tomato-instance.png,"
+echo "   tomato-arm.png, tomato-cloud.png"
 echo "== results in out/: tomato.obj (+ .mtl, one group and material per label), tomato.ply,"
-echo "   tomato.json (plant file), *-stats.json; open the OBJ in any mesh viewer;"
+echo "   tomato.json (plant file), *-stats.json, pictures; open the OBJ in any mesh viewer;"
 echo "   tomato-cloud.ply (labelled points: label, instance), tomato-scan.ply (8 scans, view and"
 echo "   range per point): open them in CloudCompare, Open3D or MeshLab"

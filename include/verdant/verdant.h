@@ -18,5 +18,6 @@
 #include "verdant/lsys.h"
 #include "verdant/geom.h"
 #include "verdant/cloud.h"
+#include "verdant/render.h"
 
 #endif

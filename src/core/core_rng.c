@@ -126,10 +126,12 @@ static uint64_t getrandbits(vd_rng* r, int k) {
 
 int64_t vd_rng_randint(vd_rng* r, int64_t a, int64_t b) {
   if (b <= a) return a;
-  uint64_t n = (uint64_t)(b - a) + 1u;
+  // the width in unsigned arithmetic: b - a overflows int64 for far-apart bounds
+  uint64_t n = (uint64_t)b - (uint64_t)a + 1u;
+  if (n == 0) return (int64_t)getrandbits(r, 64);  // the whole int64 range
   int k = 0;
   for (uint64_t t = n; t; t >>= 1) k++;  // n.bit_length()
   uint64_t v = getrandbits(r, k);
   while (v >= n) v = getrandbits(r, k);
-  return a + (int64_t)v;
+  return (int64_t)((uint64_t)a + v);
 }
