@@ -849,6 +849,14 @@ TEST(cloud, reader_rejects_bad_files) {
       vdt_fail(__FILE__, __LINE__, "%s: %s, expected %s", cases[k].name, vd_status_str(st), vd_status_str(cases[k].want));
     CHECK(c.n == 0 && c.pos == NULL);
   }
+  // an empty cloud reads (no arrays), in memory too (fuzzing found null + 0 here)
+  vd_cloud ec;
+  const char* empty = "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+                      "property float z\nend_header\n";
+  memset(&err, 0, sizeof err);
+  CHECK_STATUS(vd_cloud_parse(empty, strlen(empty), VD_CLOUD_PLY, "empty.ply", &ec, &err), VD_OK, err);
+  CHECK(ec.n == 0 && ec.pos == NULL && ec.label == NULL);
+  vd_cloud_free(&ec);
   // good files cut short or with bytes flipped: an error or a cloud, never a crash
   vd_model* m = compile(grow("data/arabidopsis.lpy", 1));
   REQUIRE(m);

@@ -148,6 +148,9 @@ vd_status vd_cloud_relabel(vd_cloud* c, vd_error* err);
 // [lo, hi] (m). *out is allocated (free with vd_free(*out, *n * sizeof(vd_scanner))).
 vd_status vd_cloud_read_scanners(const char* path, vd_vec3 lo, vd_vec3 hi, vd_scanner** out,
                                  int* n, vd_error* err);
+// The same from JSON text in memory (name Nullable, used in errors).
+vd_status vd_cloud_parse_scanners(const char* text, size_t len, const char* name, vd_vec3 lo,
+                                  vd_vec3 hi, vd_scanner** out, int* n, vd_error* err);
 
 // ---------------------------------------------------------------------------------------------
 // files
@@ -181,6 +184,10 @@ vd_status vd_cloud_write(const vd_cloud* c, const char* path, const vd_cloud_wri
                          vd_error* err);
 // Read a cloud written by vd_cloud_write (format from the extension) into out.
 vd_status vd_cloud_read(const char* path, vd_cloud* out, vd_error* err);
+// Parse a cloud file's bytes in memory (fmt VD_CLOUD_AUTO: from name's extension; name Nullable,
+// used in errors).
+vd_status vd_cloud_parse(const char* data, size_t len, vd_cloud_format fmt, const char* name,
+                         vd_cloud* out, vd_error* err);
 
 #ifdef __cplusplus
 }

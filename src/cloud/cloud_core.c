@@ -65,13 +65,14 @@ vd_status cloud_alloc(vd_cloud* c, int64_t n, const vd_label* labels, int nlabel
   if (nlabel) memcpy(lt, labels, (size_t)nlabel * sizeof(vd_label));
   c->n = n;
   c->nbytes = nbytes;
-  c->pos = (double*)block;
-  c->normal = c->pos + 3 * n;
-  c->range = c->normal + 3 * n;
-  c->label = (int*)(c->range + n);
-  c->instance = c->label + n;
-  c->view = c->instance + n;
-  if (!n) c->pos = c->normal = c->range = NULL, c->label = c->instance = c->view = NULL;
+  if (n > 0) {
+    c->pos = (double*)block;
+    c->normal = c->pos + 3 * n;
+    c->range = c->normal + 3 * n;
+    c->label = (int*)(c->range + n);
+    c->instance = c->label + n;
+    c->view = c->instance + n;
+  }
   c->nlabel = nlabel;
   c->labels = lt;
   return VD_OK;

@@ -642,17 +642,22 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
 // ---------------------------------------------------------------------------------------------
 // dispatch
 
-vd_status vd_cloud_read(const char* path, vd_cloud* out, vd_error* err) {
-  if (!path || !out) return vd_error_set(err, VD_ERR_ARG, path ? path : "", 0, 0, "null argument");
+vd_status vd_cloud_parse(const char* data, size_t len, vd_cloud_format fmt, const char* name,
+                         vd_cloud* out, vd_error* err) {
+  if (!out) return vd_error_set(err, VD_ERR_ARG, name ? name : "", 0, 0, "null argument");
   memset(out, 0, sizeof *out);
-  vd_cloud_format fmt = vd_cloud_format_of(path);
-  if (fmt == VD_CLOUD_AUTO)
-    return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "unknown point cloud format (use .ply, .pcd, .xyz, .csv or .las)");
-  char* s;
-  size_t len;
-  vd_status st = vd_file_read(path, &s, &len, err);
-  if (st) return st;
-  reader r = {path, err, NULL, 0, 0, -1};
+  if (!data && len) return vd_error_set(err, VD_ERR_ARG, name ? name : "", 0, 0, "null data");
+  if (fmt == VD_CLOUD_AUTO) fmt = vd_cloud_format_of(name);
+  if (fmt < VD_CLOUD_PLY || fmt > VD_CLOUD_LAS)
+    return vd_error_set(err, VD_ERR_ARG, name ? name : "", 0, 0,
+                        "unknown point cloud format (use .ply, .pcd, .xyz, .csv or .las)");
+  // the text parsers need a NUL after the data
+  char* s = vd_malloc(len + 1);
+  if (!s) return vd_error_set(err, VD_ERR_NOMEM, name ? name : "", 0, 0, "out of memory");
+  if (len) memcpy(s, data, len);
+  s[len] = 0;
+  reader r = {name ? name : "", err, NULL, 0, 0, -1};
+  vd_status st;
   switch (fmt) {
     case VD_CLOUD_PLY: st = read_ply(&r, s, len, out); break;
     case VD_CLOUD_PCD: st = read_pcd(&r, s, len, out); break;
@@ -663,5 +668,20 @@ vd_status vd_cloud_read(const char* path, vd_cloud* out, vd_error* err) {
   vd_free(s, len + 1);
   vd_free(r.labels, (size_t)r.cap_label * sizeof(vd_label));
   if (st) vd_cloud_free(out);
+  return st;
+}
+
+vd_status vd_cloud_read(const char* path, vd_cloud* out, vd_error* err) {
+  if (!path || !out) return vd_error_set(err, VD_ERR_ARG, path ? path : "", 0, 0, "null argument");
+  memset(out, 0, sizeof *out);
+  vd_cloud_format fmt = vd_cloud_format_of(path);
+  if (fmt == VD_CLOUD_AUTO)
+    return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "unknown point cloud format (use .ply, .pcd, .xyz, .csv or .las)");
+  char* s;
+  size_t len;
+  vd_status st = vd_file_read(path, &s, &len, err);
+  if (st) return st;
+  st = vd_cloud_parse(s, len, fmt, path, out, err);
+  vd_free(s, len + 1);
   return st;
 }

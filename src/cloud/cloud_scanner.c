@@ -10,9 +10,9 @@
 #define FORMAT_NAME "verdant-scanners"
 
 // 1-based line and column of byte pos
-static void line_col(const char* text, size_t pos, int* line, int* col) {
+static void line_col(const char* text, size_t len, size_t pos, int* line, int* col) {
   *line = 1, *col = 1;
-  for (size_t i = 0; i < pos && text[i]; i++) {
+  for (size_t i = 0; i < pos && i < len; i++) {
     if (text[i] == '\n')
       (*line)++, *col = 1;
     else
@@ -106,6 +106,24 @@ static vd_status parse(const cJSON* root, const char* path, vd_vec3 lo, vd_vec3 
   return VD_OK;
 }
 
+vd_status vd_cloud_parse_scanners(const char* text, size_t len, const char* name, vd_vec3 lo,
+                                  vd_vec3 hi, vd_scanner** out, int* n, vd_error* err) {
+  if (!name) name = "";
+  if (!out || !n || (!text && len)) return vd_error_set(err, VD_ERR_ARG, name, 0, 0, "null argument");
+  *out = NULL;
+  *n = 0;
+  const char* end = NULL;
+  cJSON* root = cJSON_ParseWithLengthOpts(text ? text : "", len, &end, 0);
+  if (!root) {
+    int line, col;
+    line_col(text ? text : "", len, end && text && end >= text ? (size_t)(end - text) : 0, &line, &col);
+    return vd_error_set(err, VD_ERR_SYNTAX, name, line, col, "invalid JSON");
+  }
+  vd_status st = parse(root, name, lo, hi, out, n, err);
+  cJSON_Delete(root);
+  return st;
+}
+
 vd_status vd_cloud_read_scanners(const char* path, vd_vec3 lo, vd_vec3 hi, vd_scanner** out,
                                  int* n, vd_error* err) {
   if (!path || !out || !n) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "null argument");
@@ -115,16 +133,7 @@ vd_status vd_cloud_read_scanners(const char* path, vd_vec3 lo, vd_vec3 hi, vd_sc
   size_t len;
   vd_status st = vd_file_read(path, &text, &len, err);
   if (st) return st;
-  const char* end = NULL;
-  cJSON* root = cJSON_ParseWithLengthOpts(text, len, &end, 0);
-  if (!root) {
-    int line, col;
-    line_col(text, end ? (size_t)(end - text) : 0, &line, &col);
-    vd_free(text, len + 1);
-    return vd_error_set(err, VD_ERR_SYNTAX, path, line, col, "invalid JSON");
-  }
-  st = parse(root, path, lo, hi, out, n, err);
-  cJSON_Delete(root);
+  st = vd_cloud_parse_scanners(text, len, path, lo, hi, out, n, err);
   vd_free(text, len + 1);
   return st;
 }
