@@ -837,6 +837,8 @@ TEST(cloud, reader_rejects_bad_files) {
                 "property float z\nend_header\n1 2 3\n", VD_ERR_FORMAT},
       {"p.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1000000000\nDATA ascii\n1 2 3\n",
        VD_ERR_FORMAT},
+      {"q.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                "property float z\nproperty int view\nend_header\n1 2 3 2147483647\n", VD_ERR_FORMAT},
   };
   vd_error err = {0};
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {

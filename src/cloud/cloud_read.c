@@ -150,7 +150,7 @@ static int put_field(vd_cloud* c, int64_t i, int f, double v) {
   if (f == F_LABEL) c->label[i] = (int)v;
   if (f == F_INSTANCE) c->instance[i] = (int)v;
   if (f == F_VIEW) {
-    if (v < 0) return 0;
+    if (v < 0 || v > 65535) return 0;  // scanner indices
     c->view[i] = (int)v;
   }
   return 1;
