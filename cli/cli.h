@@ -104,21 +104,6 @@ int cli_label_counts(const vd_cloud* c, int64_t* count);
 // The --stats JSON of a result (caller deletes it), NULL when out of memory.
 struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total);
 
-// A point cloud read from a file (arrays owned, label and instance Nullable).
-typedef struct cli_ply_cloud {
-  int n;          // points
-  double* xyz;    // positions (m) (n x 3)
-  int* label;     // semantic label per point, NULL when the file has none (n)
-  int* instance;  // instance per point, NULL when the file has none (n)
-  vd_label* labels;  // label names from "comment label ID NAME" header lines (nlabel), owned
-  int nlabel;
-} cli_ply_cloud;
-// Read x, y, z, label, instance of the vertex element of a PLY file (ASCII or binary), and the
-// label names of "comment label ID NAME" lines (as verdant's PLY writers put them).
-vd_status cli_read_ply_cloud(const char* path, cli_ply_cloud* out, vd_error* err);
-// Free what cli_read_ply_cloud allocated.
-void cli_ply_cloud_free(cli_ply_cloud* c);
-
 // Subcommands.
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);

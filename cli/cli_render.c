@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// verdant render: a plant (.lpy or plant file) or a point cloud (.ply) → PNG colour image, with
+// verdant render: a plant (.lpy or plant file) or a point cloud (.ply .pcd .xyz .csv .las) → PNG colour image, with
 // depth (16-bit, mm) and label/instance masks (16-bit ids) and a JSON sidecar on request.
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -13,9 +13,8 @@
 static const char* render_help =
     "usage: verdant render PLANT|CLOUD -o OUT.png [options]\n"
     "\n"
-    "Draw a plant (an .lpy file, derived on the fly, or a plant .json) or a point cloud (.ply "
-    "with\n"
-    "x y z and optional label, instance) headless with MuJoCo's renderer (EGL; software rendering\n"
+    "Draw a plant (an .lpy file, derived on the fly, or a plant .json) or a point cloud (.ply,\n"
+    ".pcd, .xyz, .csv or .las, with optional label and instance) headless with MuJoCo's renderer (EGL; software rendering\n"
     "when there is no GPU) and write a colour PNG with a legend.\n"
     "\n"
     "options:\n"
@@ -205,7 +204,7 @@ int cli_render(int argc, char** argv) {
   }
   // check the whole command line before doing any work
   if (!po.path)
-    return cli_usage_error("render", "missing PLANT or CLOUD (.lpy, plant .json or .ply)");
+    return cli_usage_error("render", "missing PLANT or CLOUD (.lpy, plant .json, or a .ply/.pcd/.xyz/.csv/.las cloud)");
   if (!out) return cli_usage_error("render", "missing -o OUT.png");
   if (!cli_has_ext(out, ".png"))
     return cli_usage_error("render", "output '%s' must end in .png", out);
@@ -223,7 +222,9 @@ int cli_render(int argc, char** argv) {
         "'%s' is a folder: rendering simulation runs waits for the run format of "
         "'verdant sim' (not yet available)",
         po.path);
-  int is_cloud = cli_has_ext(po.path, ".ply");
+  // point clouds in any format the cloud module reads; everything else is a plant
+  int is_cloud = cli_has_ext(po.path, ".ply") || cli_has_ext(po.path, ".pcd") || cli_has_ext(po.path, ".xyz") ||
+                 cli_has_ext(po.path, ".csv") || cli_has_ext(po.path, ".las");
   if (is_cloud && style.color_by != VD_COLOR_LABEL && style.color_by != VD_COLOR_INSTANCE)
     return cli_usage_error("render", "a point cloud is coloured by label or instance");
   if (!is_cloud && style.color_by == VD_COLOR_STRESS)
@@ -238,12 +239,13 @@ int cli_render(int argc, char** argv) {
   vd_model* model = NULL;
   cli_grow_info ginfo;
   memset(&ginfo, 0, sizeof ginfo);
-  cli_ply_cloud cl;
+  vd_cloud cl;
   memset(&cl, 0, sizeof cl);
   vd_renderer* r = NULL;
   int code = EXIT_OK;
   if (is_cloud) {
-    st = cli_read_ply_cloud(po.path, &cl, &err);
+    st = vd_cloud_read(po.path, &cl, &err);
+    if (!st && cl.n > INT32_MAX) st = vd_error_set(&err, VD_ERR_LIMIT, po.path, 0, 0, "more than 2^31 points");
   } else {
     st = cli_load_plant(&po, &plant, &ginfo, &err);
     if (!st) st = vd_plant_compile(plant, &model, &err);
@@ -266,7 +268,7 @@ int cli_render(int argc, char** argv) {
   }
   if (info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
   if (is_cloud) {
-    vd_points pts = {cl.n, cl.xyz, cl.label, cl.instance, point_size, cl.labels, cl.nlabel};
+    vd_points pts = {(int)cl.n, cl.pos, cl.label, cl.instance, point_size, cl.labels, cl.nlabel};
     st = vd_render_add_points(r, &pts, &style, &err);
   } else {
     st = vd_render_add_plant(r, model, NULL, &style, &err);
@@ -333,6 +335,6 @@ done:
   vd_model_destroy(model);
   vd_plant_spec_destroy(plant);
   cli_grow_info_free(&ginfo);
-  cli_ply_cloud_free(&cl);
+  vd_cloud_free(&cl);
   return code;
 }
