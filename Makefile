@@ -4,13 +4,14 @@ BUILD ?= build
 PREFIX ?= /usr/local
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 SANITIZE ?= 0
+FUZZ_SECONDS ?= 30
 
 ifeq ($(SANITIZE),1)
   BUILD := build-sanitize
   CMAKE_FLAGS += -DVD_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 endif
 
-.PHONY: all deps configure test bench demo install clean
+.PHONY: all deps configure test bench demo install clean fuzz fuzz-smoke
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -26,9 +27,10 @@ test: all
 
 bench: all
 	./$(BUILD)/verdant_bench $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_render $(BENCH_ARGS)
+	bash bench/cloud_bench.sh ./$(BUILD)/verdant $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_collide --csv bench/results/collide-2core.csv
-	@if [ -x ./$(BUILD)/verdant_bench_mujoco ]; then \
-	  ./$(BUILD)/verdant_bench_mujoco --csv bench/results/mujoco-chain-2core.csv; fi
+	./$(BUILD)/verdant_bench_mujoco --csv bench/results/mujoco-chain-2core.csv
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant
@@ -37,6 +39,13 @@ install: configure
 	cmake -S . -B $(BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) >/dev/null
 	cmake --build $(BUILD) -j $(JOBS)
 	cmake --install $(BUILD)
+
+# libFuzzer targets built with clang into build-fuzz/, FUZZ_SECONDS each (fuzz/run.sh)
+fuzz:
+	@bash fuzz/run.sh $(FUZZ_SECONDS)
+
+fuzz-smoke:
+	@bash fuzz/run.sh 5
 
 clean:
 	rm -rf build build-sanitize

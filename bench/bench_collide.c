@@ -288,8 +288,8 @@ int main(int argc, char** argv) {
   char d[96];
   snprintf(d, sizeof d, "tomato %d caps + %d spheres", np, m->nsphere);
   row("self-collision (queries/s)", d, reps, t, "per s");
-  printf("  %d candidate pairs, %d contacts, %.1f us per query\n", (int)L.ntested,
-         L.n, 1e6 * t / reps);
+  printf("  %d candidate pairs, %d contacts, %.1f us per query\n", (int)L.ntested, L.n,
+         1e6 * t / reps);
   // the broad phase every 10 steps with 0.01 m of growth, the narrow phase every step
   vd_arena keep;
   vd_arena_init(&keep, 1 << 20);

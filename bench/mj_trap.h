@@ -6,7 +6,8 @@
 //
 // For the bench now and the robot module next (only robot may include MuJoCo headers). The
 // one piece of global state is MuJoCo's own: its hooks take no user pointer, so the open traps
-// are kept per thread (thread-local), and the hooks are set once per process.
+// are kept per thread (thread-local), and the hooks are set once per process. render's mjguard
+// (src/render/render_mujoco.c) sets the same hooks: never use both in one process.
 //
 // Usage (locals changed inside the trap and read after an error must be volatile):
 //   vd_mj_trap trap;

@@ -23,6 +23,7 @@ typedef struct cli_plant_opts {
   int steps;               // -n/--steps, -1 = file's derivation length
   uint64_t seed;           // --seed
   int64_t max_modules;     // --max-modules
+  int64_t max_ops;         // --max-ops (0 = library default)
   const char* set[64];     // --set NAME=VALUE
   int nset;
   const char* label[64];   // --label ID=NAME
@@ -62,7 +63,54 @@ int cli_has_ext(const char* path, const char* ext);
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
 
+// Options of the commands that make point clouds (cloud, dataset).
+#define CLI_MAX_SCANNERS 64
+typedef struct cli_cloud_opts {
+  vd_cloud_def def;                          // sampler settings (scanners filled in later)
+  vd_cloud_write_def wdef;                   // --ascii, --ply-scalar-prefix
+  int nscanner;                              // --scanner count
+  vd_vec3 scanner_pos[CLI_MAX_SCANNERS];     // --scanner positions (m)
+  vd_vec3 scanner_target[CLI_MAX_SCANNERS];  // --scanner targets (m)
+  int scanner_has_target[CLI_MAX_SCANNERS];  // 0: the plant's bounding-box centre
+  const char* scanners_file;                 // --scanners preset
+  vd_scan_pattern pattern;                   // --pattern of --scanner scanners
+  double fov_h, fov_v;                       // --fov (rad)
+  int res_h, res_v;                          // --res
+  int labels_instance;                       // --labels instance
+  int has_cloud_seed;                        // --cloud-seed given
+  uint64_t cloud_seed;                       // --cloud-seed
+  int density_given, scan_opts, points_given; // for consistency checks
+} cli_cloud_opts;
+
+// Defaults of every cloud option (vd_cloud_def_default, the default scanner grid).
+void cli_cloud_opts_init(cli_cloud_opts* o);
+// Consume a cloud option at argv[*i]; 1 consumed, 0 not a cloud option, -1 bad value (printed).
+int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int* i);
+// Check option combinations after parsing; prints and returns EXIT_USAGE, or 0 when fine.
+int cli_cloud_check(const cli_cloud_opts* o, const char* cmd);
+// Help text lines for the cloud options.
+extern const char* cli_cloud_help;
+
+// What cli_cloud_make produced: the cloud (owned, vd_cloud_free) and timings.
+typedef struct cli_cloud_result {
+  vd_cloud cloud;
+  vd_cloud_stats stats;
+  double seconds_load, seconds_compile, seconds_write, seconds_total;
+  int write_failed;  // the failure was writing the output
+} cli_cloud_result;
+
+// Load the plant, sample its cloud, relabel if asked, write it to out (Nullable: no file).
+vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, const char* out,
+                         cli_cloud_result* res, vd_error* err);
+// Points per label table entry (count has c->nlabel slots); 0 when out of memory.
+int cli_label_counts(const vd_cloud* c, int64_t* count);
+// The --stats JSON of a result (caller deletes it), NULL when out of memory.
+struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total);
+
 // Subcommands.
 int cli_grow(int argc, char** argv);
+int cli_cloud(int argc, char** argv);
+int cli_dataset(int argc, char** argv);
+int cli_render(int argc, char** argv);
 
 #endif

@@ -57,6 +57,7 @@ const char* cli_plant_help =
     "      --set NAME=VALUE  replace a global of the .lpy file (repeatable)\n"
     "      --label ID=NAME   name a label id (repeatable; the file's LABELS come first)\n"
     "      --max-modules N   largest L-string allowed (default 50000000)\n"
+    "      --max-ops N       interpreter work allowed: loop iterations + calls (default 1e9)\n"
     "      --curve-step M    curves files: dense sampling step (m; default 0.001)\n"
     "      --curve-connect M curves files: largest branch gap, sigma_connect (m; default 0.01)\n"
     "      --curve-distance M\n"
@@ -121,6 +122,15 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
       return -1;
     }
     o->max_modules = v;
+    return 1;
+  }
+  if (!strcmp(a, "--max-ops")) {
+    TAKE();
+    if (!parse_i64(val, 1, INT64_MAX, &v)) {
+      cli_usage_error(cmd, "--max-ops expects an integer >= 1, got '%s'", val);
+      return -1;
+    }
+    o->max_ops = v;
     return 1;
   }
   if (!strcmp(a, "--set") || !strcmp(a, "--label")) {
@@ -253,6 +263,7 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   def.steps = o->steps;
   def.seed = o->seed;
   def.max_modules = o->max_modules;
+  def.max_ops = o->max_ops;
   if (o->progress) def.progress = progress_cb;
   double t0 = cli_now();
   if (!st) st = vd_lsys_derive(ls, &def, &derived, err);

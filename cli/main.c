@@ -17,6 +17,9 @@ static const char* main_help =
     "\n"
     "commands:\n"
     "  grow      L-system (.lpy) or plant file → plant JSON, OBJ or PLY, with --stats\n"
+    "  cloud     plant → labelled point cloud (PLY, PCD, XYZ/CSV, LAS), scanner effects\n"
+    "  dataset   many plants of one model → labelled clouds + manifest, --jobs, --shard i/N\n"
+    "  render    plant or point cloud → PNG colour image, depth, label and instance masks\n"
     "\n"
     "Run 'verdant <command> --help' for the options of a command.\n"
     "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
@@ -37,6 +40,9 @@ int main(int argc, char** argv) {
     return EXIT_OK;
   }
   if (!strcmp(cmd, "grow")) return cli_grow(argc - 1, argv + 1);
+  if (!strcmp(cmd, "cloud")) return cli_cloud(argc - 1, argv + 1);
+  if (!strcmp(cmd, "dataset")) return cli_dataset(argc - 1, argv + 1);
+  if (!strcmp(cmd, "render")) return cli_render(argc - 1, argv + 1);
   fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
   fputs(main_help, stderr);
   return EXIT_USAGE;

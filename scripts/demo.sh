@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# make demo: grow the bundled tomato and write its plant file, labelled meshes and stats to out/.
+# make demo: grow the bundled tomato and write its plant file, labelled meshes, labelled point
+# clouds and stats to out/.
 set -euo pipefail
 V="${1:-./build/verdant}"
 mkdir -p out
@@ -16,9 +17,29 @@ print("   organs by label: " + ", ".join(f"{k} {v}" for k, v in d["labels"].item
 lo, hi = d["bbox_min"], d["bbox_max"]
 print(f"   size {hi[0]-lo[0]:.2f} x {hi[1]-lo[1]:.2f} x {hi[2]-lo[2]:.2f} m, {d['total_length']:.2f} m of segments in all")
 PY
+echo "== a labelled point cloud of the tomato (200k points, interior points removed)"
+"$V" cloud data/tomato.lpy --seed 1 --points 200000 -o out/tomato-cloud.ply --stats > out/tomato-cloud-stats.json
+"$V" cloud data/tomato.lpy --seed 1 --sensor scan --scanners data/scanners/turntable8.json --noise 0.001 \
+  -o out/tomato-scan.ply
+python3 - out/tomato-cloud-stats.json <<'PY' || cat out/tomato-cloud-stats.json
+import json, sys
+d = json.load(open(sys.argv[1]))
+print(f"   {d['points']} points, {d['instances']} organs: " + ", ".join(f"{k} {v}" for k, v in d["labels"].items()))
+print(f"   {d['rejected']['interior']} candidates inside other organs replaced; {d['points_per_second']['total']:.0f} points/s in all")
+PY
 for p in arabidopsis tree lilac; do
   echo "== growing data/$p.lpy"
   "$V" grow "data/$p.lpy" --seed 1 -o "out/$p.obj" --stats > "out/$p-stats.json"
 done
+echo "== rendering pictures (headless: EGL, software rendering without a GPU)"
+"$V" render data/tomato.lpy --seed 1 -o out/tomato.png --masks --depth
+"$V" render data/tomato.lpy --seed 1 -o out/tomato-instance.png --color-by instance --camera orbit:-30:25
+"$V" render data/tomato.lpy --seed 1 -o out/tomato-arm.png --robot data/robots/arm6.xml --camera orbit:-60:20
+# the labelled cloud written above (200k sampled points)
+"$V" render out/tomato-cloud.ply -o out/tomato-cloud.png --camera orbit:-30:25 --point-size 0.004
+echo "   out/tomato.png (+ .label.png, .instance.png, .depth.png, .json), tomato-instance.png,"
+echo "   tomato-arm.png, tomato-cloud.png"
 echo "== results in out/: tomato.obj (+ .mtl, one group and material per label), tomato.ply,"
-echo "   tomato.json (plant file), *-stats.json; open the OBJ in any mesh viewer"
+echo "   tomato.json (plant file), *-stats.json, pictures; open the OBJ in any mesh viewer;"
+echo "   tomato-cloud.ply (labelled points: label, instance), tomato-scan.ply (8 scans, view and"
+echo "   range per point): open them in CloudCompare, Open3D or MeshLab"

@@ -4,8 +4,12 @@
 # otherwise it prints the exact command and fails.
 set -eu
 # build and test: cmake make gcc pkg-config; JSON: libcjson-dev; PNG: libpng-dev;
-# robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3
-need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3)
+# robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3;
+# headless rendering: EGL and GL headers (libegl-dev, libgl-dev), the EGL loader (libegl1), Mesa's
+# EGL and its software/DRI drivers (libegl-mesa0, libgl1-mesa-dri); dataset checksums (SHA-256):
+# nettle-dev
+need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3
+  libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev)
 missing=()
 for p in "${need[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -55,6 +55,11 @@ printf 'Axiom: A\nproduction:\nA --> AA\n' >"$T/exp.lpy"
 expect "max modules" 2 "$V" grow "$T/exp.lpy" -n 40 --max-modules 100000 --stats
 expect_err "max modules message" "exceed"
 
+# the interpreter's work budget: a runaway loop stops with a clear error
+printf 'Axiom: A\nproduction:\nA :\n  while True:\n    pass\n' >"$T/loop.lpy"
+expect "max ops" 2 "$V" grow "$T/loop.lpy" --max-ops 100000 --stats
+expect_err "max ops message" "loop.lpy:4:[0-9]+: .*interpreter operations"
+
 # --set overrides a global; an unknown global is an error
 printf 'N = 1\nAxiom: A\nderivation length: N\nproduction:\nA --> AB\nB --> A\n' >"$T/set.lpy"
 expect "set global" 0 "$V" grow "$T/set.lpy" --set N=5 --stats

@@ -60,7 +60,7 @@ TEST(collide, point_distances) {
   for (int k = 0; k < 2000; k++) {
     vd_vec3 p = rand_point(&r, 0.3);
     // distances
-    vd_hit h = vd_collide_point(&plane, p);
+    vd_collide_hit h = vd_collide_point(&plane, p);
     CHECK_NEAR(h.dist, vd_dot(vd_sub(p, o), n), 1e-14);
     CHECK_NEAR(vd_dot(h.normal, n), 1, 1e-14);
     h = vd_collide_point(&sph, p);
@@ -72,7 +72,7 @@ TEST(collide, point_distances) {
     // every shape: unit normal, closest point on the surface, normal = gradient of the distance
     const vd_collider* all[4] = {&plane, &sph, &cap, &box};
     for (int s = 0; s < 4; s++) {
-      vd_hit g = vd_collide_point(all[s], p);
+      vd_collide_hit g = vd_collide_point(all[s], p);
       CHECK_NEAR(vd_norm(g.normal), 1, 1e-12);
       CHECK_NEAR(vd_collide_point(all[s], g.point).dist, 0, 1e-12);
       vd_vec3 q = vd_madd(p, g.normal, 1e-7);
@@ -84,7 +84,7 @@ TEST(collide, point_distances) {
   CHECK_NEAR(vd_collide_point(&ab, vd_v3(1.5, 0, 0)).dist, 0.5, 1e-15);
   CHECK_NEAR(vd_collide_point(&ab, vd_v3(4, 6, 0)).dist, 5, 1e-15);
   CHECK_NEAR(vd_collide_point(&ab, vd_v3(2, 3, 4)).dist, sqrt(3), 1e-15);
-  vd_hit in = vd_collide_point(&ab, vd_v3(0.5, 0.1, -2.9));
+  vd_collide_hit in = vd_collide_point(&ab, vd_v3(0.5, 0.1, -2.9));
   CHECK_NEAR(in.dist, -0.1, 1e-15);
   CHECK(in.normal.z == -1);
   // sphere helper: reduced by the radius; the centre of a sphere collider has a defined normal
@@ -109,7 +109,7 @@ static double brute_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double r
 TEST(collide, capsule_distances) {
   // analytic cases
   vd_collider ground = vd_collider_plane(vd_v3(0, 0, 0), vd_v3(0, 0, 1));
-  vd_hit h = vd_collide_capsule(&ground, vd_v3(0, 0, 0.1), vd_v3(1, 0, 0.1), 0.02, 0.02);
+  vd_collide_hit h = vd_collide_capsule(&ground, vd_v3(0, 0, 0.1), vd_v3(1, 0, 0.1), 0.02, 0.02);
   CHECK_NEAR(h.dist, 0.08, 1e-15);
   CHECK_NEAR(h.t, 0.5, 1e-12); // flat: the middle
   h = vd_collide_capsule(&ground, vd_v3(0, 0, 0.1), vd_v3(1, 0, 0.3), 0.02, 0.01);
@@ -329,8 +329,8 @@ TEST(collide, sdf_sphere) {
   vd_collider cm = vd_collider_sdf(pose, g), cs = vd_collider_sphere(pose.pos, R);
   for (int k = 0; k < 300; k++) {
     vd_vec3 a = vd_add(pose.pos, rand_point(&r, 0.07)), b = vd_add(pose.pos, rand_point(&r, 0.07));
-    vd_hit hm = vd_collide_capsule(&cm, a, b, 0.004, 0.003);
-    vd_hit hs = vd_collide_capsule(&cs, a, b, 0.004, 0.003);
+    vd_collide_hit hm = vd_collide_capsule(&cm, a, b, 0.004, 0.003);
+    vd_collide_hit hs = vd_collide_capsule(&cs, a, b, 0.004, 0.003);
     // near the surface (where contacts are) the two agree; farther out, beyond the grid, the
     // grid's distance is an upper bound
     if (hs.dist < def.band)
@@ -736,7 +736,7 @@ TEST(collide, colliders_and_determinism) {
   int n = sp.ncap + sp.nsph, nb = 0, match = 1, per[5] = {0};
   for (int i = 0; i < n; i++)
     for (int k = 0; k < 5; k++) {
-      vd_hit h;
+      vd_collide_hit h;
       if (i < sp.ncap) {
         vd_vec3 a = vd_v3(sp.node[6 * i], sp.node[6 * i + 1], sp.node[6 * i + 2]);
         vd_vec3 b = vd_v3(sp.node[6 * i + 3], sp.node[6 * i + 4], sp.node[6 * i + 5]);

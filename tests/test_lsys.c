@@ -15,6 +15,7 @@ static vd_status derive_str(const char* src, int steps, uint64_t seed, char* buf
   vd_lsys_def d = vd_lsys_def_default();
   d.steps = steps;
   d.seed = seed;
+  d.max_ops = 10000000;  // runaway loops in the malformed cases stop fast
   vd_lstring s = vd_lstring_empty();
   st = vd_lsys_derive(ls, &d, &s, e);
   if (!st) vd_lsys_format(ls, &s, buf, cap);

@@ -27,9 +27,8 @@
 //
 // Usage:
 //   vd_collider ground = vd_collider_plane(vd_v3(0, 0, 0), vd_v3(0, 0, 1));
-//   vd_hit h = vd_collide_capsule(&ground, a, b, 0.004, 0.003);   // h.dist < 0: penetration
-//   vd_collide_def def = vd_collide_def_default();
-//   vd_contact_list self;
+//   vd_collide_hit h = vd_collide_capsule(&ground, a, b, 0.004, 0.003);   // h.dist < 0:
+//   penetration vd_collide_def def = vd_collide_def_default(); vd_contact_list self;
 //   vd_collide_self(&prims, &def, &data->arena, &self, &err);     // self.c[0 .. self.n)
 #ifndef VERDANT_COLLIDE_H
 #define VERDANT_COLLIDE_H
@@ -129,21 +128,21 @@ vd_collider vd_collider_sdf(vd_pose pose, const vd_sdf* sdf);
 void vd_collider_set_pose(vd_collider* c, vd_pose pose);
 
 // Result of a single query.
-typedef struct vd_hit {
+typedef struct vd_collide_hit {
   double dist;    // signed distance between the surfaces (m), negative when overlapping
   vd_vec3 normal; // unit outward normal of the collider at point (world)
   vd_vec3 point;  // closest point on the collider's surface (world, m)
   double t;       // capsule queries: axis parameter in [0, 1] of the deepest point; else 0
-} vd_hit;
+} vd_collide_hit;
 
 // Signed distance from world point p to the collider's surface.
-vd_hit vd_collide_point(const vd_collider* c, vd_vec3 p);
+vd_collide_hit vd_collide_point(const vd_collider* c, vd_vec3 p);
 // Sphere (centre p, radius r) against a collider: vd_collide_point with dist reduced by r.
-vd_hit vd_collide_sphere(const vd_collider* c, vd_vec3 p, double r);
+vd_collide_hit vd_collide_sphere(const vd_collider* c, vd_vec3 p, double r);
 // Tapered capsule a-b (radius ra at a, rb at b) against a collider: the deepest axis point t
 // and the separation there (exact to round-off for the convex shapes; SDF colliders sample the
 // axis every half cell, then refine around the best sample).
-vd_hit vd_collide_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double ra, double rb);
+vd_collide_hit vd_collide_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double ra, double rb);
 // World-space bounding box of a collider (planes are unbounded: +-HUGE_VAL across).
 void vd_collider_bounds(const vd_collider* c, vd_vec3* lo, vd_vec3* hi);
 

@@ -178,6 +178,8 @@ void vd_rng_stream(vd_rng* r, uint64_t master, uint64_t index);
 uint32_t vd_rng_u32(vd_rng* r);
 // Uniform double in [0, 1) with 53 random bits (CPython random()).
 double vd_rng_random(vd_rng* r);
+// Fill out with n uniform doubles in [0, 1): the same numbers as n calls of vd_rng_random.
+void vd_rng_fill(vd_rng* r, double* out, int n);
 // a + (b - a) * random() (CPython uniform()).
 double vd_rng_uniform(vd_rng* r, double a, double b);
 // Normal deviate by CPython's gauss(mu, sigma) (Box-Muller with a cached pair).

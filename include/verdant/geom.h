@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// verdant geom: tessellation of a compiled plant into a labelled triangle mesh, and mesh export
-// (OBJ + MTL, PLY; conventions in docs/formats.md).
+// verdant geom: tessellation of a compiled plant into a labelled triangle mesh, mesh export
+// (OBJ + MTL, PLY; conventions in docs/formats.md), a bounding volume hierarchy with ray casting,
+// and point-inside tests for the plant's closed primitives.
 //
 // vd_geom_tessellate reads a model and one of its states (or the rest shape) and fills a
 // vd_mesh that the caller owns and frees with vd_mesh_free; every triangle carries the label,
@@ -17,6 +18,12 @@
 //     vd_geom_write_obj(&mesh, model->labels, model->nlabel, "plant.obj", &err);
 //     vd_mesh_free(&mesh);
 //   }
+//
+// Rays and solids (the caller owns both and frees them; neither keeps a pointer to its inputs):
+//   vd_bvh bvh; vd_bvh_build_mesh(&mesh, NULL, NULL, &bvh, &err);
+//   vd_hit hit; if (vd_bvh_raycast(&bvh, origin, dir, 0, INFINITY, 0, -1, &hit)) ... hit.label
+//   vd_solids so; vd_solids_build(model, data, &def, &so, &err);
+//   if (vd_solids_inside(&so, p, VD_PRIM_MESH, leaf) >= 0) ... p is inside another organ
 #ifndef VERDANT_GEOM_H
 #define VERDANT_GEOM_H
 
@@ -76,6 +83,123 @@ vd_status vd_geom_write_obj(const vd_mesh* mesh, const vd_label* labels, int nla
 // Write PLY (binary little-endian when binary is 1, else ASCII) with face label and instance.
 vd_status vd_geom_write_ply(const vd_mesh* mesh, const vd_label* labels, int nlabel,
                             const char* path, int binary, vd_error* err);
+
+// ---------------------------------------------------------------------------------------------
+// bounding volume hierarchy: binned SAH build over boxes, flat node array, built sequentially so
+// the same input always gives the same tree
+
+// BVH build settings.
+typedef struct vd_bvh_def {
+  int leaf_size; // most items in a leaf (1..32); default 4
+  int bins;      // SAH bins per axis and node (2..64); default 16
+} vd_bvh_def;
+
+// Defaults: leaf_size 4 items, bins 16.
+vd_bvh_def vd_bvh_def_default(void);
+
+// One node: a box and either two children (first, first + 1) or a run of items.
+typedef struct vd_bvh_node {
+  double lo[3], hi[3]; // box (m)
+  int first;           // interior: index of the left child, the right child is first + 1;
+                       // leaf: first position in the item array
+  int count;           // items of a leaf, 0 for an interior node
+} vd_bvh_node;
+
+// Triangle of a mesh BVH, stored in leaf order for ray casting.
+typedef struct vd_bvh_tri {
+  double v0[3], e1[3], e2[3]; // first vertex and the edges v1 - v0, v2 - v0 (m)
+  int tri;                    // index of the triangle in the mesh
+  int label, instance;        // copied from the mesh
+  int one_sided;              // 1: back faces are culled when a ray asks for culling
+} vd_bvh_tri;
+
+// A BVH. Arrays live in one block owned by the BVH (vd_bvh_free); the root is node 0.
+typedef struct vd_bvh {
+  int nnode, nitem;  // sizes
+  vd_bvh_node* node; // nodes (nnode)
+  int* item;         // item indices in leaf order (nitem)
+  vd_bvh_tri* tri;   // triangles in leaf order for a mesh BVH, NULL for a box BVH (nitem)
+  size_t nbytes;     // size of the block
+} vd_bvh;
+
+// Build a BVH over n boxes (n x 6: lo x y z, hi x y z) (def Nullable: defaults).
+vd_status vd_bvh_build(const double* box, int n, const vd_bvh_def* def, vd_bvh* out,
+                       vd_error* err);
+// Build a BVH over a mesh's triangles; one_sided (Nullable: none) marks triangles whose back
+// faces rays may cull (ntri x 1, nonzero = one-sided).
+vd_status vd_bvh_build_mesh(const vd_mesh* mesh, const unsigned char* one_sided,
+                            const vd_bvh_def* def, vd_bvh* out, vd_error* err);
+// Free a BVH's block and zero it (NULL and empty are fine).
+void vd_bvh_free(vd_bvh* bvh);
+
+// A ray hit on a mesh BVH.
+typedef struct vd_hit {
+  double t;            // distance along the ray (m, for a unit direction)
+  double u, v;         // barycentric weights of the triangle's second and third vertices
+  int tri;             // triangle index in the mesh
+  int label, instance; // the triangle's semantic label and organ instance
+  int front;           // 1 when the ray met the counter-clockwise (outward) side
+} vd_hit;
+
+// Nearest hit of the ray o + t dir, tmin < t < tmax, on a mesh BVH; cull skips back faces of
+// one-sided triangles; skip is a mesh triangle to ignore (-1: none). 1 on a hit, else 0.
+int vd_bvh_raycast(const vd_bvh* bvh, vd_vec3 o, vd_vec3 dir, double tmin, double tmax, int cull,
+                   int skip, vd_hit* hit);
+// 1 when any triangle (both sides, except skip) meets the ray o + t dir for tmin < t < tmax.
+int vd_bvh_occluded(const vd_bvh* bvh, vd_vec3 o, vd_vec3 dir, double tmin, double tmax, int skip);
+// Items of the leaves whose boxes overlap the box [lo, hi] (a superset of the items that do),
+// written to items up to cap; returns how many there are (which may exceed cap).
+int vd_bvh_overlap(const vd_bvh* bvh, const double lo[3], const double hi[3], int* items, int cap);
+
+// ---------------------------------------------------------------------------------------------
+// solids: the closed primitives of a plant (frustums with caps, spheres, closed meshes) as the
+// polyhedra the tessellation makes of them, with exact point-inside tests
+
+// One closed primitive.
+typedef struct vd_solid {
+  int kind;            // vd_prim_kind
+  int prim;            // index of the primitive within its kind
+  int label, instance; // semantic label and organ instance
+  int slices, stacks;  // polygon sides (frustum, sphere longitudes) and sphere latitude bands
+  int joined[2];       // solids of a generalised-cylinder tube sharing a ring with this one
+                       // (parent side, child side), -1 when none
+  vd_vec3 c;           // frustum start centre or sphere centre (m)
+  vd_quat q;           // frustum frame: z along the axis, x toward ring vertex 0
+  double rot[9];       // the same frame as a world-to-frame rotation, rows x, y, z
+  double len;          // frustum length (m)
+  double r0, r1;       // frustum circumradius at start and end, sphere radius in r0 (m)
+  int tri_start, ntri; // closed mesh: range in the solids' triangle array
+  double lo[3], hi[3]; // bounding box (m)
+} vd_solid;
+
+// The closed primitives of one plant state with a BVH over their boxes.
+typedef struct vd_solids {
+  int nsolid;          // solids
+  vd_solid* solid;     // (nsolid)
+  int ntri;            // triangles of closed meshes
+  double* tri;         // their vertices (ntri x 9) (m)
+  int nseg, nsphere, nmesh; // sizes of the lookups below
+  int* seg_solid;      // solid of each segment (nseg)
+  int* sphere_solid;   // solid of each sphere (nsphere)
+  int* mesh_solid;     // solid of each mesh, -1 for open (thin) meshes (nmesh)
+  double eps;          // boundary tolerance (m): points within it of a surface count as inside
+  vd_bvh bvh;          // over the solids' boxes
+  size_t nbytes;       // size of the block holding the arrays above (not the BVH)
+} vd_solids;
+
+// Build the solids of state d (Nullable: rest shape) of m, tessellated as def (Nullable:
+// defaults; caps are always closed) would do it.
+vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def* def,
+                          vd_solids* out, vd_error* err);
+// The solid of primitive (kind, prim), or -1 when it has none (thin meshes, bad indices).
+int vd_solids_own(const vd_solids* so, int kind, int prim);
+// 1 when p is inside solid s or on its boundary (within eps).
+int vd_solid_contains(const vd_solids* so, int s, vd_vec3 p);
+// A solid containing p other than the primitive (kind, prim) and the tube neighbours it is
+// joined to, or -1 when none (kind -1: exclude nothing).
+int vd_solids_inside(const vd_solids* so, vd_vec3 p, int kind, int prim);
+// Free the solids and zero the struct (NULL and empty are fine).
+void vd_solids_free(vd_solids* so);
 
 #ifdef __cplusplus
 }

@@ -17,6 +17,8 @@
 #include "verdant/plant.h"
 #include "verdant/lsys.h"
 #include "verdant/geom.h"
+#include "verdant/cloud.h"
+#include "verdant/render.h"
 #include "verdant/collide.h"
 
 #endif

@@ -60,7 +60,7 @@ void vd_rng_stream(vd_rng* r, uint64_t master, uint64_t index) {
   vd_rng_seed_array(r, key, 5);
 }
 
-uint32_t vd_rng_u32(vd_rng* r) {
+static inline uint32_t next_u32(vd_rng* r) {
   static const uint32_t mag01[2] = {0u, 0x9908b0dfu};
   if (r->mti >= MT_N) {
     int kk;
@@ -85,9 +85,18 @@ uint32_t vd_rng_u32(vd_rng* r) {
   return y;
 }
 
+uint32_t vd_rng_u32(vd_rng* r) { return next_u32(r); }
+
 double vd_rng_random(vd_rng* r) {
-  uint32_t a = vd_rng_u32(r) >> 5, b = vd_rng_u32(r) >> 6;
+  uint32_t a = next_u32(r) >> 5, b = next_u32(r) >> 6;
   return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+}
+
+void vd_rng_fill(vd_rng* r, double* out, int n) {
+  for (int i = 0; i < n; i++) {
+    uint32_t a = next_u32(r) >> 5, b = next_u32(r) >> 6;
+    out[i] = (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+  }
 }
 
 double vd_rng_uniform(vd_rng* r, double a, double b) { return a + (b - a) * vd_rng_random(r); }
@@ -117,10 +126,12 @@ static uint64_t getrandbits(vd_rng* r, int k) {
 
 int64_t vd_rng_randint(vd_rng* r, int64_t a, int64_t b) {
   if (b <= a) return a;
-  uint64_t n = (uint64_t)(b - a) + 1u;
+  // the width in unsigned arithmetic: b - a overflows int64 for far-apart bounds
+  uint64_t n = (uint64_t)b - (uint64_t)a + 1u;
+  if (n == 0) return (int64_t)getrandbits(r, 64);  // the whole int64 range
   int k = 0;
   for (uint64_t t = n; t; t >>= 1) k++;  // n.bit_length()
   uint64_t v = getrandbits(r, k);
   while (v >= n) v = getrandbits(r, k);
-  return a + (int64_t)v;
+  return (int64_t)((uint64_t)a + v);
 }

@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "verdant/geom.h"
+#include "geom_internal.h"
 
 vd_mesh_def vd_mesh_def_default(void) {
   vd_mesh_def def;
@@ -34,9 +34,7 @@ typedef struct plan {
   int sphere_vbase, mesh_vbase; // first vertex of the spheres and of the meshes
 } plan;
 
-static int seg_slices(const plan* p, int i) {
-  return p->def.slices > 0 ? p->def.slices : p->m->seg_slices[i];
-}
+static int seg_slices(const plan* p, int i) { return geom_seg_slices(p->m, p->def.slices, i); }
 static int sphere_slices(const plan* p, int i) {
   return p->def.slices > 0 ? p->def.slices : p->m->sphere_slices[i];
 }
@@ -49,20 +47,21 @@ static int sphere_stacks(const plan* p, int i) {
 // a child continues its parent when both are generalised-cylinder segments meeting at a node with
 // the same section, the child is not broken off (seg_broken severs a segment from its parent),
 // and no earlier child continues the parent already
-static void plan_joints(plan* p) {
-  const vd_model* m = p->m;
+void geom_joints(const vd_model* m, const int* broken, int slices, int* cont, int* joined) {
   for (int i = 0; i < m->nseg; i++)
-    p->cont[i] = -1, p->joined[i] = 0;
+    cont[i] = -1, joined[i] = 0;
   for (int i = 0; i < m->nseg; i++) {
     int q = m->seg_parent[i];
     if (q < 0 || !(m->seg_flags[i] & VD_SEG_GC) || !(m->seg_flags[q] & VD_SEG_GC)) continue;
     if (m->seg_node[2 * i] != m->seg_node[2 * q + 1]) continue;
-    if (seg_slices(p, i) != seg_slices(p, q) || p->cont[q] >= 0) continue;
-    if (p->broken && p->broken[i]) continue;
-    p->cont[q] = i;
-    p->joined[i] = 1;
+    if (geom_seg_slices(m, slices, i) != geom_seg_slices(m, slices, q) || cont[q] >= 0) continue;
+    if (broken && broken[i]) continue;
+    cont[q] = i;
+    joined[i] = 1;
   }
 }
+
+static void plan_joints(plan* p) { geom_joints(p->m, p->broken, p->def.slices, p->cont, p->joined); }
 
 // vertex and triangle counts of every primitive, in output order
 static void plan_counts(plan* p) {

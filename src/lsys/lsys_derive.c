@@ -18,6 +18,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
   }
   snprintf(ls->file, sizeof ls->file, "%s", name ? name : "");
   vd_arena_init(&ls->arena, 1 << 16);
+  vm_budget(ls, 0);
   ls->max_depth[SEC_DECOMPOSITION] = 1;
   ls->max_depth[SEC_INTERPRETATION] = 1;
   // predefined modules take the first ids, in VD_SYM_LIST order
@@ -36,13 +37,14 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   if (!ls) return;
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
-  vd_free(ls->syms.declared, (size_t)ls->syms.cap);
+  vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);
   vd_free(ls->syms.hash_slot, (size_t)ls->syms.hcap * sizeof(int));
   for (int i = 0; i < ls->nstr; i++) vd_free(ls->str[i], strlen(ls->str[i]) + 1);
   vd_free(ls->str, (size_t)ls->capstr * sizeof(char*));
+  vd_free(ls->str_slot, (size_t)ls->str_hcap * sizeof(int));
   for (int i = 0; i < ls->nglobal; i++) vd_free(ls->gdef[i].name, strlen(ls->gdef[i].name) + 1);
   vd_free(ls->gdef, (size_t)ls->capglobal * sizeof(global_def));
-  vd_free(ls->gval, (size_t)ls->capglobal * sizeof(value));
+  vd_free(ls->gval, (size_t)ls->capgval * sizeof(value));
   vd_free(ls->funcs, (size_t)ls->capfunc * sizeof(func*));
   vd_free(ls->rules, (size_t)ls->caprule * sizeof(rule*));
   for (int s = 0; s < SEC_COUNT; s++) {
@@ -106,6 +108,7 @@ vd_lsys_def vd_lsys_def_default(void) {
   d.steps = -1;
   d.seed = 0;
   d.max_modules = 50000000;
+  d.max_ops = LSYS_DEFAULT_MAX_OPS;
   return d;
 }
 
@@ -221,8 +224,17 @@ int vd_lsys_derivation_length(const vd_lsystem* ls) {
   vd_lsystem* mls = (vd_lsystem*)ls;
   vd_error local = {0};
   mls->err = &local;
+  vm_budget(mls, mls->max_ops);  // the work limit of the last run
+  // the expression may use globals: run the top-level code first (derive runs it again)
+  if (run_toplevel(mls, 0) != VD_OK) {
+    mls->err = NULL;
+    return 1;
+  }
   int n = 1;
-  if (vm_eval(mls, ls->derivation_length, NULL, &v) == VD_OK && v_isnum(v)) n = (int)v.n;
+  // the same range vd_lsys_derive accepts; anything else (NaN, 1e300) stays 1
+  if (vm_eval(mls, ls->derivation_length, NULL, &v) == VD_OK && v_isnum(v) && v.n == floor(v.n) &&
+      v.n >= 0 && v.n <= 1e9)
+    n = (int)v.n;
   mls->err = NULL;
   return n;
 }
@@ -577,11 +589,21 @@ static vd_status call_hook(vd_lsystem* ls, int fi) {
   return vm_call_func(ls, fi, 0, NULL, &r, f->line, 1);
 }
 
+// release a run's scratch, make sure a failure has a message, detach the error sink
+static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, pass_ctx* P) {
+  vd_lstring_free(tmp);
+  vd_free(P->match, sizeof(int64_t) * (size_t)P->match_cap);
+  if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
+  ls->err = NULL;
+  return st;
+}
+
 vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
   vd_error local = {0};
   ls->err = err ? err : &local;
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
+  vm_budget(ls, d.max_ops);
   vd_lstring tmp = vd_lstring_empty();
   pass_ctx P = {NULL, 0, d.max_modules};
   vd_status st = build_index(ls);
@@ -650,11 +672,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   }
   if ((st = call_hook(ls, ls->hook_end))) goto done;
 done:
-  vd_lstring_free(&tmp);
-  vd_free(P.match, sizeof(int64_t) * (size_t)P.match_cap);
-  if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
-  ls->err = NULL;
-  return st;
+  return end_run(ls, st, &tmp, &P);
 }
 
 vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lstring* in, vd_lstring* out,
@@ -663,6 +681,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   ls->err = err ? err : &local;
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
+  vm_budget(ls, d.max_ops);
   pass_ctx P = {NULL, 0, d.max_modules};
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;
@@ -683,11 +702,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   out->n = in->n;
   st = apply_section(ls, SEC_INTERPRETATION, out, &tmp, &P);
 done:
-  vd_lstring_free(&tmp);
-  vd_free(P.match, sizeof(int64_t) * (size_t)P.match_cap);
-  if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
-  ls->err = NULL;
-  return st;
+  return end_run(ls, st, &tmp, &P);
 }
 
 vd_status vd_lsys_parse_lstring(vd_lsystem* ls, const char* text, vd_lstring* out, vd_error* err) {

@@ -11,6 +11,7 @@
 
 #define MAX_CALL_DEPTH 200
 #define MAX_LOOP_ITER 100000000LL
+#define MAX_EXACT_INT 9007199254740992.0  // 2^53: integers beyond are not exact doubles
 
 vd_status vm_error(vd_lsystem* ls, vd_status st, int line, int col, const char* fmt, ...) {
   if (ls->err && ls->err->status == VD_OK) {
@@ -22,6 +23,22 @@ vd_status vm_error(vd_lsystem* ls, vd_status st, int line, int col, const char* 
     vd_error_set(ls->err, st, ls->file, line, col, "%s", msg);
   }
   return st;
+}
+
+void vm_budget(vd_lsystem* ls, int64_t max_ops) {
+  ls->max_ops = max_ops > 0 ? max_ops : LSYS_DEFAULT_MAX_OPS;
+  ls->ops_left = ls->max_ops;
+}
+
+// take n operations (a loop iteration or a call is one) from the run's budget; non-zero when
+// the budget is spent
+static int spend_ops(vd_lsystem* ls, int64_t n, int line, int col) {
+  ls->ops_left -= n;
+  if (ls->ops_left >= 0) return 0;
+  vm_error(ls, VD_ERR_LIMIT, line, col,
+           "the run needs more than %lld interpreter operations (loop iterations and calls)",
+           (long long)ls->max_ops);
+  return 1;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -253,7 +270,7 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       if (n) value_repr(ls, a[0], buf, sizeof buf);
       else buf[0] = 0;
       int id = str_intern(ls, buf, (int)strlen(buf));
-      if (id < 0) return vm_error(ls, VD_ERR_NOMEM, line, col, "out of memory");
+      if (id < 0) return str_intern_error(ls, id, line, col);
       *out = (value){V_STR, id};
       break;
     }
@@ -314,6 +331,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
     }
     case B_RANDINT:
       if (x != floor(x) || y != floor(y)) return vm_error(ls, VD_ERR_VALUE, line, col, "randint() needs integers");
+      if (fabs(x) > MAX_EXACT_INT || fabs(y) > MAX_EXACT_INT)
+        return vm_error(ls, VD_ERR_VALUE, line, col, "randint() arguments beyond +-2^53");
       if (y < x) return vm_error(ls, VD_ERR_VALUE, line, col, "empty range for randint(%g, %g)", x, y);
       *out = v_int((double)vd_rng_randint(r, (int64_t)x, (int64_t)y));
       break;
@@ -321,6 +340,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       double start = n == 1 ? 0 : x, stop = n == 1 ? x : y, step = n == 3 ? a[2].n : 1;
       if (start != floor(start) || stop != floor(stop) || step != floor(step) || step == 0)
         return vm_error(ls, VD_ERR_VALUE, line, col, "randrange() needs integers and a non-zero step");
+      if (fabs(start) > MAX_EXACT_INT || fabs(stop) > MAX_EXACT_INT || fabs(step) > MAX_EXACT_INT)
+        return vm_error(ls, VD_ERR_VALUE, line, col, "randrange() arguments beyond +-2^53");
       double cnt = step > 0 ? floor((stop - start + step - 1) / step) : floor((stop - start + step + 1) / step);
       if (cnt <= 0) return vm_error(ls, VD_ERR_VALUE, line, col, "empty range for randrange()");
       *out = v_int(start + step * (double)vd_rng_randint(r, 0, (int64_t)cnt - 1));
@@ -329,6 +350,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
     case B_SEED:
       if (n && (x != floor(x) || !isfinite(x)))
         return vm_error(ls, VD_ERR_UNSUPPORTED, line, col, "unsupported: seed() with a non-integer");
+      if (n && fabs(x) >= 18446744073709551616.0)
+        return vm_error(ls, VD_ERR_UNSUPPORTED, line, col, "unsupported: seed() beyond 2^64");
       vd_rng_seed(r, n ? (uint64_t)fabs(x) : 0);
       *out = (value){V_NONE, 0};
       break;
@@ -352,7 +375,8 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       break;
     case B_GETITERATIONNB: *out = v_int(ls->iteration); break;
     case B_USEGROUP:
-      if (x != floor(x) || x < 0) return vm_error(ls, VD_ERR_VALUE, line, col, "useGroup() needs a group number");
+      if (x != floor(x) || x < 0 || x > 1000000)
+        return vm_error(ls, VD_ERR_VALUE, line, col, "useGroup() needs a group number in 0..1000000");
       ls->current_group = (int)x;
       *out = (value){V_NONE, 0};
       break;
@@ -373,8 +397,10 @@ static vd_status arith(vd_lsystem* ls, int op, value a, value b, value* out, int
   if (op == E_ADD && a.t == V_STR && b.t == V_STR) {
     char buf[2048];
     snprintf(buf, sizeof buf, "%s%s", ls->str[(int)a.n], ls->str[(int)b.n]);
+    // a concatenation costs one operation per 64 bytes it makes
+    if (spend_ops(ls, (int64_t)strlen(buf) / 64, line, col)) return ls->err->status;
     int id = str_intern(ls, buf, (int)strlen(buf));
-    if (id < 0) return vm_error(ls, VD_ERR_NOMEM, line, col, "out of memory");
+    if (id < 0) return str_intern_error(ls, id, line, col);
     *out = (value){V_STR, id};
     return VD_OK;
   }
@@ -621,6 +647,18 @@ vd_status vm_emit_tmpl(vd_lsystem* ls, const tmpl* t, value* frame, vm_out* out)
   return VD_OK;
 }
 
+// one pass through a loop body (it costs one operation): 1 when the loop ends here (break, or
+// return with X->flow left at FLOW_RETURN), 0 to go on, -1 on error
+static int loop_iteration(vd_lsystem* ls, const stmt* s, value* frame, exec_state* X) {
+  if (spend_ops(ls, 1, s->line, s->col) || exec_list(ls, s->body, frame, X)) return -1;
+  if (X->flow == FLOW_CONTINUE) X->flow = FLOW_NONE;
+  if (X->flow == FLOW_BREAK) {
+    X->flow = FLOW_NONE;
+    return 1;
+  }
+  return X->flow == FLOW_RETURN;
+}
+
 static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X) {
   for (; s; s = s->next) {
     value v;
@@ -653,21 +691,14 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
         if (X->flow) return VD_OK;
         break;
       case S_WHILE: {
-        long long it = 0;
         for (;;) {
           if (vm_eval(ls, s->e, frame, &v)) return ls->err->status;
           if (!value_truthy(v)) break;
-          if (++it > MAX_LOOP_ITER)
-            return vm_error(ls, VD_ERR_LIMIT, s->line, s->col, "while loop ran more than %lld iterations",
-                            MAX_LOOP_ITER);
-          if (exec_list(ls, s->body, frame, X)) return ls->err->status;
-          if (X->flow == FLOW_BREAK) {
-            X->flow = FLOW_NONE;
-            break;
-          }
-          if (X->flow == FLOW_CONTINUE) X->flow = FLOW_NONE;
-          if (X->flow == FLOW_RETURN) return VD_OK;
+          int r = loop_iteration(ls, s, frame, X);
+          if (r < 0) return ls->err->status;
+          if (r > 0) break;
         }
+        if (X->flow == FLOW_RETURN) return VD_OK;
         break;
       }
       case S_FOR: {
@@ -682,16 +713,15 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
         double cnt = c.n > 0 ? ceil((b.n - a.n) / c.n) : ceil((a.n - b.n) / -c.n);
         if (cnt > (double)MAX_LOOP_ITER)
           return vm_error(ls, VD_ERR_LIMIT, s->line, s->col, "range() of more than %lld items", MAX_LOOP_ITER);
-        for (double i = a.n; c.n > 0 ? i < b.n : i > b.n; i += c.n) {
-          assign(ls, s, frame, v_int(i));
-          if (exec_list(ls, s->body, frame, X)) return ls->err->status;
-          if (X->flow == FLOW_BREAK) {
-            X->flow = FLOW_NONE;
-            break;
-          }
-          if (X->flow == FLOW_CONTINUE) X->flow = FLOW_NONE;
-          if (X->flow == FLOW_RETURN) return VD_OK;
+        // count iterations rather than adding the step: a + step can round back to a
+        int64_t nit = cnt > 0 ? (int64_t)cnt : 0;
+        for (int64_t k = 0; k < nit; k++) {
+          assign(ls, s, frame, v_int(a.n + (double)k * c.n));
+          int r = loop_iteration(ls, s, frame, X);
+          if (r < 0) return ls->err->status;
+          if (r > 0) break;
         }
+        if (X->flow == FLOW_RETURN) return VD_OK;
         break;
       }
       case S_PRODUCE:
@@ -762,6 +792,7 @@ vd_status vm_call_func(vd_lsystem* ls, int fi, int nargs, const value* args, val
   if (ls->call_depth >= MAX_CALL_DEPTH)
     return vm_error(ls, VD_ERR_LIMIT, line, col, "maximum recursion depth (%d) exceeded in %s()",
                     MAX_CALL_DEPTH, f->name);
+  if (spend_ops(ls, 1, line, col)) return ls->err->status;
   value small[32];
   value* frame = small;
   int nl = f->nlocal > 0 ? f->nlocal : 1;

@@ -145,7 +145,8 @@ typedef struct rule {
 // the lsystem
 
 typedef struct symtab {
-  int n, cap;
+  int n, cap;         // count, capacity of name
+  int cap_declared;   // capacity of declared (grown separately: one can fail after the other)
   char** name;        // symbol names (owned)
   int* hash_slot;     // open addressing table of symbol ids (hcap), -1 empty
   int hcap;
@@ -170,8 +171,11 @@ struct vd_lsystem {
   // strings
   int nstr, capstr;
   char** str;
+  int* str_slot;           // open addressing index of string ids (str_hcap), -1 empty
+  int str_hcap;
+  int64_t str_bytes;       // bytes of all strings (limit LSYS_MAX_STR_BYTES)
   // globals
-  int nglobal, capglobal;
+  int nglobal, capglobal, capgval;  // count, capacities of gdef and gval
   global_def* gdef;        // names and overrides (nglobal)
   value* gval;             // current values (nglobal)
   // functions
@@ -213,6 +217,8 @@ struct vd_lsystem {
   int iteration;
   int stop_requested;
   int call_depth;
+  int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
+  int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
 };
 
@@ -222,7 +228,11 @@ struct vd_lsystem {
 // symbol table
 int sym_intern(vd_lsystem* ls, const char* name, int len, int declared);
 int sym_find(const vd_lsystem* ls, const char* name, int len);
+#define LSYS_MAX_STR_BYTES (64 << 20)  // all strings of an lsystem together (bytes)
+// Id of a string, added when new; -1 out of memory, -2 over LSYS_MAX_STR_BYTES.
 int str_intern(vd_lsystem* ls, const char* s, int len);
+// Report a failed str_intern (its negative result) as out of memory or limit; returns the status.
+vd_status str_intern_error(vd_lsystem* ls, int id, int line, int col);
 double lsys_box_str(int id);
 int lsys_unbox_str(double v);
 int global_slot(vd_lsystem* ls, const char* name, int len, int create);
@@ -238,6 +248,9 @@ expr* lsys_parse_expr_text(vd_lsystem* ls, const char* text, int len, int line, 
 tmpl* lsys_parse_tmpl_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 
 // interpreter
+#define LSYS_DEFAULT_MAX_OPS 1000000000LL  // vd_lsys_def.max_ops when unset
+// Start a run with a budget of max_ops interpreter operations (<= 0: the default).
+void vm_budget(vd_lsystem* ls, int64_t max_ops);
 typedef struct vm_out {
   vd_lstring* s;       // where produce writes
   int64_t src;         // source index recorded on produced modules (when s->src)

@@ -36,23 +36,8 @@ typedef struct parser {
   int failed;
 } parser;
 
-static vd_status perr(vd_lsystem* ls, vd_status st, int line, int col, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 5, 6)))
-#endif
-    ;
-
-static vd_status perr(vd_lsystem* ls, vd_status st, int lineno, int col, const char* fmt, ...) {
-  if (ls->err && ls->err->status == VD_OK) {
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    vd_error_set(ls->err, st, ls->file, lineno, col, "%s", msg);
-  }
-  return st;
-}
+// parse errors are recorded like run-time errors: the first one wins
+#define perr vm_error
 
 static void* aalloc(vd_lsystem* ls, size_t n) {
   void* p = vd_arena_alloc(&ls->arena, n);
@@ -241,12 +226,12 @@ typedef struct lexer {
 
 typedef struct scope {
   // names of locals: slot i has name names[i]
-  int n, cap;
+  int n, cap, caplen;     // count, capacities of names and lens (grown one after the other)
   const char** names;
   int* lens;
   const char** globals;  // names declared global
   int* glens;
-  int ng, capg;
+  int ng, capg, capglen;  // count, capacities of globals and glens
   int is_function;       // 0 at top level (all names are globals)
 } scope;
 
@@ -341,7 +326,7 @@ static vd_status lx_next(lexer* L) {
     if (p >= L->len)
       return perr(L->ls, VD_ERR_SYNTAX, L->lineno, L->col0 + L->pos, "unterminated string");
     L->sid = str_intern(L->ls, buf, n);
-    if (L->sid < 0) return perr(L->ls, VD_ERR_NOMEM, L->lineno, L->col0 + L->pos, "out of memory");
+    if (L->sid < 0) return str_intern_error(L->ls, L->sid, L->lineno, L->col0 + L->pos);
     L->t = T_STR;
     L->tlen = p + 1 - L->pos;
     L->pos = p + 1;
@@ -418,11 +403,9 @@ static int scope_find(const scope* sc, const char* name, int len) {
 static int scope_add(vd_lsystem* ls, scope* sc, const char* name, int len) {
   int i = scope_find(sc, name, len);
   if (i >= 0) return i;
-  int cap = sc->cap;
-  if (!vd_grow((void**)&sc->names, &cap, sc->n + 1, sizeof(char*))) return -1;
-  int cap2 = sc->cap;
-  if (!vd_grow((void**)&sc->lens, &cap2, sc->n + 1, sizeof(int))) return -1;
-  sc->cap = cap < cap2 ? cap : cap2;
+  if (!vd_grow((void**)&sc->names, &sc->cap, sc->n + 1, sizeof(char*)) ||
+      !vd_grow((void**)&sc->lens, &sc->caplen, sc->n + 1, sizeof(int)))
+    return -1;
   (void)ls;
   sc->names[sc->n] = name;
   sc->lens[sc->n] = len;
@@ -437,11 +420,9 @@ static int scope_is_global(const scope* sc, const char* name, int len) {
 
 static int scope_add_global(scope* sc, const char* name, int len) {
   if (scope_is_global(sc, name, len)) return 1;
-  int cap = sc->capg;
-  if (!vd_grow((void**)&sc->globals, &cap, sc->ng + 1, sizeof(char*))) return 0;
-  int cap2 = sc->capg;
-  if (!vd_grow((void**)&sc->glens, &cap2, sc->ng + 1, sizeof(int))) return 0;
-  sc->capg = cap < cap2 ? cap : cap2;
+  if (!vd_grow((void**)&sc->globals, &sc->capg, sc->ng + 1, sizeof(char*)) ||
+      !vd_grow((void**)&sc->glens, &sc->capglen, sc->ng + 1, sizeof(int)))
+    return 0;
   sc->globals[sc->ng] = name;
   sc->glens[sc->ng] = len;
   sc->ng++;
@@ -450,9 +431,9 @@ static int scope_add_global(scope* sc, const char* name, int len) {
 
 static void scope_free(scope* sc) {
   vd_free(sc->names, (size_t)sc->cap * sizeof(char*));
-  vd_free(sc->lens, (size_t)sc->cap * sizeof(int));
+  vd_free(sc->lens, (size_t)sc->caplen * sizeof(int));
   vd_free(sc->globals, (size_t)sc->capg * sizeof(char*));
-  vd_free(sc->glens, (size_t)sc->capg * sizeof(int));
+  vd_free(sc->glens, (size_t)sc->capglen * sizeof(int));
   memset(sc, 0, sizeof *sc);
 }
 
@@ -595,7 +576,10 @@ static expr* parse_atom(pctx* C) {
       char buf[2048];
       snprintf(buf, sizeof buf, "%s%s", C->ls->str[(int)e->k.n], C->ls->str[L->sid]);
       int id = str_intern(C->ls, buf, (int)strlen(buf));
-      if (id < 0) return NULL;
+      if (id < 0) {
+        str_intern_error(C->ls, id, L->lineno, lx_col(L));
+        return NULL;
+      }
       e->k.n = id;
       if (lx_next(L)) return NULL;
     }
@@ -643,6 +627,10 @@ static expr* parse_atom(pctx* C) {
       if (!a) return NULL;
       a->a = e;
       a->slot = str_intern(C->ls, L->s + L->start, L->tlen);
+      if (a->slot < 0) {
+        str_intern_error(C->ls, a->slot, L->lineno, lx_col(L));
+        return NULL;
+      }
       if (lx_next(L)) return NULL;
       e = a;
     } else if (tok_is(L, '[')) {
@@ -801,29 +789,21 @@ static expr* parse_not(pctx* C) {
   return parse_comparison(C);
 }
 
-static expr* parse_and(pctx* C) {
-  expr* a = parse_not(C);
-  while (a && tok_name(C->L, "and")) {
+// a left-associative chain `sub (kw sub)*` joined by op
+static expr* parse_kw_chain(pctx* C, const char* kw, int op, expr* (*sub)(pctx*)) {
+  expr* a = sub(C);
+  while (a && tok_name(C->L, kw)) {
     int col = lx_col(C->L);
     if (lx_next(C->L)) return NULL;
-    expr* b = parse_not(C);
+    expr* b = sub(C);
     if (!b) return NULL;
-    a = binop(C, E_AND, a, b, col);
+    a = binop(C, op, a, b, col);
   }
   return a;
 }
 
-static expr* parse_or(pctx* C) {
-  expr* a = parse_and(C);
-  while (a && tok_name(C->L, "or")) {
-    int col = lx_col(C->L);
-    if (lx_next(C->L)) return NULL;
-    expr* b = parse_and(C);
-    if (!b) return NULL;
-    a = binop(C, E_OR, a, b, col);
-  }
-  return a;
-}
+static expr* parse_and(pctx* C) { return parse_kw_chain(C, "and", E_AND, parse_not); }
+static expr* parse_or(pctx* C) { return parse_kw_chain(C, "or", E_OR, parse_and); }
 
 static expr* parse_expr(pctx* C) {
   if (tok_name(C->L, "lambda")) {
@@ -1005,7 +985,10 @@ static pmod* parse_pattern(vd_lsystem* ls, scope* sc, const char* s, int a, int 
     if (n == cap) {
       int ncap = cap ? cap * 2 : 8;
       pmod* nm = aalloc(ls, sizeof(pmod) * (size_t)ncap);
-      if (!nm) return NULL;
+      if (!nm) {
+        perr(ls, VD_ERR_NOMEM, lineno, mcol, "out of memory");  // NULL alone means no modules
+        return NULL;
+      }
       if (cap) memcpy(nm, mods, sizeof(pmod) * (size_t)cap);
       mods = nm;
       cap = ncap;
@@ -1028,7 +1011,10 @@ static pmod* parse_pattern(vd_lsystem* ls, scope* sc, const char* s, int a, int 
         }
         if (L.t == T_NAME && !tok_name(&L, "True") && !tok_name(&L, "False") && !tok_name(&L, "None")) {
           int sl = scope_add(ls, sc, L.s + L.start, L.tlen);
-          if (sl < 0) return NULL;
+          if (sl < 0) {
+            perr(ls, VD_ERR_NOMEM, lineno, lx_col(&L), "out of memory");
+            return NULL;
+          }
           slots[np] = sl;
           cv[np] = (value){V_NONE, 0};
           if (lx_next(&L)) return NULL;
@@ -1059,7 +1045,10 @@ static pmod* parse_pattern(vd_lsystem* ls, scope* sc, const char* s, int a, int 
       if (np) {
         m->slot = aalloc(ls, sizeof(int) * (size_t)np);
         m->cval = aalloc(ls, sizeof(value) * (size_t)np);
-        if (!m->slot || !m->cval) return NULL;
+        if (!m->slot || !m->cval) {
+          perr(ls, VD_ERR_NOMEM, lineno, mcol, "out of memory");
+          return NULL;
+        }
         memcpy(m->slot, slots, sizeof(int) * (size_t)np);
         memcpy(m->cval, cv, sizeof(value) * (size_t)np);
       }
@@ -1571,27 +1560,27 @@ static vd_status parse_labels_dict(parser* P, const pline* ln, int from) {
     if (lx_next(&L)) return ls->err->status;
     if (expect(&L, ':', "':' in LABELS")) return ls->err->status;
     if (L.t != T_STR) return perr(ls, VD_ERR_SYNTAX, ln->lineno, lx_col(&L), "LABELS value must be a string");
+    // the arrays stay exactly nlabel long, so they are freed by count (labels are few): copy
+    // into new arrays of k + 1, and change nothing when either allocation fails
     int k = ls->nlabel;
-    int cap = k, cap2 = k;
-    if (!vd_grow((void**)&ls->label_id, &cap, k + 1, sizeof(int)) ||
-        !vd_grow((void**)&ls->label_name, &cap2, k + 1, sizeof(char*)))
+    int* ids = vd_malloc(sizeof(int) * (size_t)(k + 1));
+    char** names = vd_malloc(sizeof(char*) * (size_t)(k + 1));
+    if (!ids || !names) {
+      vd_free(ids, sizeof(int) * (size_t)(k + 1));
+      vd_free(names, sizeof(char*) * (size_t)(k + 1));
       return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
-    // capacities are tracked as the count: shrink-to-fit growth (labels are few)
-    ls->label_id[k] = id;
-    ls->label_name[k] = ls->str[L.sid];
-    ls->nlabel++;
-    if (cap != k + 1 || cap2 != k + 1) {
-      // keep arrays exactly sized so they can be freed by count
-      int* ids = vd_malloc(sizeof(int) * (size_t)(k + 1));
-      char** names = vd_malloc(sizeof(char*) * (size_t)(k + 1));
-      if (!ids || !names) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
-      memcpy(ids, ls->label_id, sizeof(int) * (size_t)(k + 1));
-      memcpy(names, ls->label_name, sizeof(char*) * (size_t)(k + 1));
-      vd_free(ls->label_id, sizeof(int) * (size_t)cap);
-      vd_free(ls->label_name, sizeof(char*) * (size_t)cap2);
-      ls->label_id = ids;
-      ls->label_name = names;
     }
+    if (k) {
+      memcpy(ids, ls->label_id, sizeof(int) * (size_t)k);
+      memcpy(names, ls->label_name, sizeof(char*) * (size_t)k);
+    }
+    vd_free(ls->label_id, sizeof(int) * (size_t)k);
+    vd_free(ls->label_name, sizeof(char*) * (size_t)k);
+    ids[k] = id;
+    names[k] = ls->str[L.sid];
+    ls->label_id = ids;
+    ls->label_name = names;
+    ls->nlabel = k + 1;
     if (lx_next(&L)) return ls->err->status;
     if (tok_is(&L, ',')) {
       if (lx_next(&L)) return ls->err->status;
@@ -2161,10 +2150,17 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
       continue;
     }
     if (starts_kw(ln, "group", &a) && a < ln->len && is_space(ln->s[a])) {
-      char* end;
-      long g = strtol(ln->s + a, &end, 10);
+      // the number goes through a NUL-terminated copy: the last line of the text has no end
+      while (a < ln->len && is_space(ln->s[a])) a++;
+      char buf[32];
+      int n = ln->len - a < 31 ? ln->len - a : 31;
+      memcpy(buf, ln->s + a, (size_t)n);
+      buf[n] = 0;
+      char* bend;
+      long g = strtol(buf, &bend, 10);
+      const char* end = ln->s + a + (bend - buf);
       while (end < ln->s + ln->len && is_space(*end)) end++;
-      if (end >= ln->s + ln->len || *end != ':' || g < 0 || g > 1000000) {
+      if (bend == buf || end >= ln->s + ln->len || *end != ':' || g < 0 || g > 1000000) {
         st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + a, "expected 'group N:' with an integer N");
         goto done;
       }

@@ -63,13 +63,9 @@ int sym_intern(vd_lsystem* ls, const char* name, int len, int declared) {
     }
     return id;
   }
-  if (t->n == t->cap) {
-    int cap = t->cap;
-    if (!vd_grow((void**)&t->name, &cap, t->n + 1, sizeof(char*))) return -1;
-    int cap2 = t->cap;
-    if (!vd_grow((void**)&t->declared, &cap2, t->n + 1, 1)) return -1;
-    t->cap = cap < cap2 ? cap : cap2;
-  }
+  if (!vd_grow((void**)&t->name, &t->cap, t->n + 1, sizeof(char*)) ||
+      !vd_grow((void**)&t->declared, &t->cap_declared, t->n + 1, 1))
+    return -1;
   char* s = vd_malloc((size_t)len + 1);
   if (!s) return -1;
   memcpy(s, name, (size_t)len);
@@ -129,16 +125,54 @@ const char* vd_lsys_value_str(const vd_lsystem* ls, double v) {
   return ls->str[id];
 }
 
+// rebuild the string index with hcap slots (a power of two)
+static int str_rehash(vd_lsystem* ls, int hcap) {
+  int* slots = vd_malloc((size_t)hcap * sizeof(int));
+  if (!slots) return 0;
+  for (int i = 0; i < hcap; i++) slots[i] = -1;
+  for (int id = 0; id < ls->nstr; id++) {
+    uint32_t h = hash_name(ls->str[id], (int)strlen(ls->str[id])) & (uint32_t)(hcap - 1);
+    while (slots[h] >= 0) h = (h + 1) & (uint32_t)(hcap - 1);
+    slots[h] = id;
+  }
+  vd_free(ls->str_slot, (size_t)ls->str_hcap * sizeof(int));
+  ls->str_slot = slots;
+  ls->str_hcap = hcap;
+  return 1;
+}
+
+// strings made at run time ('a' + s in a loop) would make a linear lookup quadratic and the
+// table unbounded: they are indexed by hash and limited in total size
 int str_intern(vd_lsystem* ls, const char* s, int len) {
-  for (int i = 0; i < ls->nstr; i++)
-    if ((int)strlen(ls->str[i]) == len && memcmp(ls->str[i], s, (size_t)len) == 0) return i;
+  uint32_t h0 = hash_name(s, len);
+  if (ls->str_hcap) {
+    for (uint32_t h = h0 & (uint32_t)(ls->str_hcap - 1); ls->str_slot[h] >= 0;
+         h = (h + 1) & (uint32_t)(ls->str_hcap - 1)) {
+      const char* t = ls->str[ls->str_slot[h]];
+      if ((int)strlen(t) == len && memcmp(t, s, (size_t)len) == 0) return ls->str_slot[h];
+    }
+  }
+  if (ls->str_bytes + len + 1 > LSYS_MAX_STR_BYTES) return -2;
   if (!vd_grow((void**)&ls->str, &ls->capstr, ls->nstr + 1, sizeof(char*))) return -1;
+  if ((ls->nstr + 1) * 2 > ls->str_hcap && !str_rehash(ls, ls->str_hcap ? ls->str_hcap * 2 : 64))
+    return -1;
   char* c = vd_malloc((size_t)len + 1);
   if (!c) return -1;
   memcpy(c, s, (size_t)len);
   c[len] = 0;
   ls->str[ls->nstr] = c;
+  ls->str_bytes += len + 1;
+  uint32_t h = h0 & (uint32_t)(ls->str_hcap - 1);
+  while (ls->str_slot[h] >= 0) h = (h + 1) & (uint32_t)(ls->str_hcap - 1);
+  ls->str_slot[h] = ls->nstr;
   return ls->nstr++;
+}
+
+vd_status str_intern_error(vd_lsystem* ls, int id, int line, int col) {
+  if (id == -2)
+    return vm_error(ls, VD_ERR_LIMIT, line, col, "the strings of the model exceed %d bytes",
+                    LSYS_MAX_STR_BYTES);
+  return vm_error(ls, VD_ERR_NOMEM, line, col, "out of memory");
 }
 
 // globals: a slot per name, values reset at the start of each derivation
@@ -147,11 +181,9 @@ int global_slot(vd_lsystem* ls, const char* name, int len, int create) {
     if ((int)strlen(ls->gdef[i].name) == len && memcmp(ls->gdef[i].name, name, (size_t)len) == 0)
       return i;
   if (!create) return -1;
-  int cap = ls->capglobal;
-  if (!vd_grow((void**)&ls->gdef, &cap, ls->nglobal + 1, sizeof(global_def))) return -1;
-  int cap2 = ls->capglobal;
-  if (!vd_grow((void**)&ls->gval, &cap2, ls->nglobal + 1, sizeof(value))) return -1;
-  ls->capglobal = cap < cap2 ? cap : cap2;
+  if (!vd_grow((void**)&ls->gdef, &ls->capglobal, ls->nglobal + 1, sizeof(global_def)) ||
+      !vd_grow((void**)&ls->gval, &ls->capgval, ls->nglobal + 1, sizeof(value)))
+    return -1;
   global_def* g = &ls->gdef[ls->nglobal];
   memset(g, 0, sizeof *g);
   g->name = vd_malloc((size_t)len + 1);

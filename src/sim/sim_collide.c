@@ -236,9 +236,9 @@ static double shape_sd(const vd_collider* c, vd_vec3 p, vd_vec3* n) {
   }
 }
 
-static vd_hit hit_from_local(const frame* f, vd_vec3 pw, double sd, vd_vec3 nl, double r,
-                             double t) {
-  vd_hit h;
+static vd_collide_hit hit_from_local(const frame* f, vd_vec3 pw, double sd, vd_vec3 nl, double r,
+                                     double t) {
+  vd_collide_hit h;
   h.normal = f_rotate(f, nl);
   h.point = vd_madd(pw, h.normal, -sd);
   h.dist = sd - r;
@@ -246,17 +246,17 @@ static vd_hit hit_from_local(const frame* f, vd_vec3 pw, double sd, vd_vec3 nl, 
   return h;
 }
 
-static vd_hit sphere_query(const vd_collider* c, const frame* f, vd_vec3 p, double r) {
+static vd_collide_hit sphere_query(const vd_collider* c, const frame* f, vd_vec3 p, double r) {
   vd_vec3 n;
   double sd = shape_sd(c, f_local(f, p), &n);
   return hit_from_local(f, p, sd, n, r, 0);
 }
 
-vd_hit vd_collide_point(const vd_collider* c, vd_vec3 p) {
+vd_collide_hit vd_collide_point(const vd_collider* c, vd_vec3 p) {
   return vd_collide_sphere(c, p, 0);
 }
 
-vd_hit vd_collide_sphere(const vd_collider* c, vd_vec3 p, double r) {
+vd_collide_hit vd_collide_sphere(const vd_collider* c, vd_vec3 p, double r) {
   VD_ASSERT(c);
   frame f = frame_of(&c->pose);
   return sphere_query(c, &f, p, r);
@@ -362,8 +362,8 @@ static double sdf_argmin(const vd_collider* c, vd_vec3 a, vd_vec3 d, double ra, 
   return fmin(f1, f2) < fb ? t : (double)best / m;
 }
 
-static vd_hit capsule_query(const vd_collider* c, const frame* f, vd_vec3 a, vd_vec3 b, double ra,
-                            double rb) {
+static vd_collide_hit capsule_query(const vd_collider* c, const frame* f, vd_vec3 a, vd_vec3 b,
+                                    double ra, double rb) {
   // the axis in the collider's frame
   vd_vec3 al = f_local(f, a), bl = f_local(f, b);
   vd_vec3 d = vd_sub(bl, al);
@@ -386,7 +386,8 @@ static vd_hit capsule_query(const vd_collider* c, const frame* f, vd_vec3 a, vd_
   return hit_from_local(f, vd_madd(a, vd_sub(b, a), t), sd, n, ra + t * dr, t);
 }
 
-vd_hit vd_collide_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double ra, double rb) {
+vd_collide_hit vd_collide_capsule(const vd_collider* c, vd_vec3 a, vd_vec3 b, double ra,
+                                  double rb) {
   VD_ASSERT(c);
   frame f = frame_of(&c->pose);
   return capsule_query(c, &f, a, b, ra, rb);
@@ -486,7 +487,7 @@ int vd_collide_pair(const vd_collide_prims* P, int i, int j, double margin, vd_c
   vd_vec3 cj = vec_at(P->sphere_pos, j - nc);
   double rj = P->sphere_radius[j - nc];
   vd_collider sph = vd_collider_sphere(cj, rj);
-  vd_hit h;
+  vd_collide_hit h;
   if (i < nc) {
     // capsule-sphere: the sphere as a collider
     vd_vec3 a0 = vec_at(P->node_pos, P->capsule_node[2 * i]);
@@ -841,7 +842,7 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
       vd_contact ct;
       memset(&ct, 0, sizeof ct);
       ct.a = i, ct.b = k, ct.collider = 1;
-      vd_hit h;
+      vd_collide_hit h;
       if (i < P->ncapsule) {
         vd_vec3 a0 = vec_at(P->node_pos, P->capsule_node[2 * i]);
         vd_vec3 a1 = vec_at(P->node_pos, P->capsule_node[2 * i + 1]);

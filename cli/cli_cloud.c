@@ -1,0 +1,496 @@
+// SPDX-License-Identifier: MIT
+// verdant cloud: a plant (.lpy or plant file) → a labelled point cloud (.ply .pcd .xyz .csv
+// .las), with scanner effects and --stats. The option parser and the load-sample-write pipeline
+// are shared with verdant dataset.
+#define _POSIX_C_SOURCE 200809L
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+const char* cli_cloud_help =
+    "  -N, --points N        points of the surface sensors (default 100000)\n"
+    "      --sensor S        uniform | distance | scan (default uniform): uniform on the\n"
+    "                        surface; density falling with distance from the scanners; or\n"
+    "                        rays on each scanner's grid, the hits being the points\n"
+    "      --scanner X,Y,Z[,TX,TY,TZ]\n"
+    "                        a scanner at X,Y,Z (m) looking at TX,TY,TZ (m; default the\n"
+    "                        plant's bounding-box centre); repeatable, one view each\n"
+    "      --scanners FILE   scanner preset (JSON, e.g. data/scanners/turntable8.json)\n"
+    "      --density-law L   distance sensor: inverse-square (default) | linear | constant |\n"
+    "                        table:D1:G1,D2:G2,... (density G at distance D m, linear between)\n"
+    "      --noise S[,K]     Gaussian noise, sigma = S + K d (S in m, K in m per m of distance d\n"
+    "                        to the scanner); isotropic on surfaces, along the ray in scans\n"
+    "      --occlusion       keep only points a scanner sees (back faces culled, rays cast)\n"
+    "      --no-interior     keep points inside other closed primitives\n"
+    "      --pattern P       scan rays of --scanner scanners: angular (default) | pinhole\n"
+    "      --fov H,V         their field of view, degrees (default 60,45)\n"
+    "      --res W,H         their rays across and down (default 320,240)\n"
+    "      --labels L        semantic (default) | instance: what the label field holds\n"
+    "      --slices N        sides of every frustum and sphere (default: each primitive's own)\n"
+    "      --cloud-seed S    seed of the sampling (default: the --seed of the plant)\n"
+    "      --threads T       threads (default: all cores); the output does not depend on it\n"
+    "      --ascii           PLY and PCD as text instead of binary\n"
+    "      --ply-scalar-prefix\n"
+    "                        PLY properties scalar_label, scalar_instance, ... (CloudCompare\n"
+    "                        keeps only scalar_* properties)\n";
+
+static const char* cloud_usage =
+    "usage: verdant cloud PLANT -o OUT [options]\n"
+    "\n"
+    "Sample a labelled point cloud of a plant: an L-Py file (.lpy, derived on the fly) or a\n"
+    "plant file (.json). OUT's extension picks the format: .ply .pcd .xyz .csv .las. Every\n"
+    "point carries x y z, normal, label and instance (and view and range with scanners).\n"
+    "\n"
+    "options:\n"
+    "  -o, --output OUT      the cloud file (written under a temporary name, then renamed)\n"
+    "      --stats           print a JSON summary on stdout: points, labels (points per label),\n"
+    "                        instances, bbox_min, bbox_max (m), area (m^2), rejected counts,\n"
+    "                        seconds per stage, points_per_second\n";
+
+void cli_cloud_opts_init(cli_cloud_opts* o) {
+  memset(o, 0, sizeof *o);
+  o->def = vd_cloud_def_default();
+  o->wdef = vd_cloud_write_def_default();
+  vd_scanner s = vd_scanner_default();
+  o->pattern = s.pattern;
+  o->fov_h = s.fov_h, o->fov_v = s.fov_v;
+  o->res_h = s.res_h, o->res_v = s.res_v;
+}
+
+// comma-separated numbers: exactly n of them (or n2 when n2 > 0), all finite
+static int parse_list(const char* s, double* out, int n, int n2) {
+  int k = 0;
+  const char* p = s;
+  while (*p) {
+    if (k == (n2 > n ? n2 : n)) return 0;
+    char* end;
+    errno = 0;
+    out[k] = strtod(p, &end);
+    if (end == p || errno || !isfinite(out[k])) return 0;
+    k++;
+    if (*end == ',') {
+      p = end + 1;
+      if (!*p) return 0;
+    } else if (*end) {
+      return 0;
+    } else {
+      p = end;
+    }
+  }
+  return k == n || (n2 > 0 && k == n2) ? k : 0;
+}
+
+static int parse_int(const char* s, int64_t lo, int64_t hi, int64_t* out) {
+  if (!s || !*s) return 0;
+  char* end;
+  errno = 0;
+  long long v = strtoll(s, &end, 10);
+  if (errno || *end || v < lo || v > hi) return 0;
+  *out = v;
+  return 1;
+}
+
+// table:D1:G1,D2:G2,...
+static int parse_table(const char* s, vd_cloud_def* def) {
+  int n = 0;
+  const char* p = s;
+  while (*p) {
+    if (n == VD_CLOUD_TABLE_MAX) return 0;
+    char* end;
+    errno = 0;
+    double d = strtod(p, &end);
+    if (end == p || *end != ':' || errno) return 0;
+    p = end + 1;
+    double g = strtod(p, &end);
+    if (end == p || errno) return 0;
+    def->table_d[n] = d, def->table_g[n] = g, n++;
+    if (*end == ',') {
+      p = end + 1;
+      if (!*p) return 0;
+    } else if (*end) {
+      return 0;
+    } else {
+      p = end;
+    }
+  }
+  def->ntable = n;
+  return n >= 2;
+}
+
+int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int* i) {
+  const char* a = argv[*i];
+  const char* val = NULL;
+#define TAKE()                                                                                     \
+  do {                                                                                             \
+    if (*i + 1 >= argc) {                                                                          \
+      cli_usage_error(cmd, "%s needs a value", a);                                                 \
+      return -1;                                                                                   \
+    }                                                                                              \
+    val = argv[++*i];                                                                              \
+  } while (0)
+#define FAIL(...)                                                                                  \
+  do {                                                                                             \
+    cli_usage_error(cmd, __VA_ARGS__);                                                             \
+    return -1;                                                                                     \
+  } while (0)
+  int64_t v;
+  double x[6];
+  if (!strcmp(a, "-N") || !strcmp(a, "--points")) {
+    TAKE();
+    if (!parse_int(val, 1, 2000000000, &v)) FAIL("%s expects an integer in 1..2000000000, got '%s'", a, val);
+    o->def.points = v;
+    o->points_given = 1;
+  } else if (!strcmp(a, "--sensor")) {
+    TAKE();
+    if (!strcmp(val, "uniform")) o->def.sensor = VD_SENSOR_UNIFORM;
+    else if (!strcmp(val, "distance")) o->def.sensor = VD_SENSOR_DISTANCE;
+    else if (!strcmp(val, "scan")) o->def.sensor = VD_SENSOR_SCAN;
+    else FAIL("--sensor expects uniform, distance or scan, got '%s'", val);
+  } else if (!strcmp(a, "--scanner")) {
+    TAKE();
+    int k = parse_list(val, x, 3, 6);
+    if (!k) FAIL("--scanner expects X,Y,Z or X,Y,Z,TX,TY,TZ in metres, got '%s'", val);
+    if (o->nscanner == CLI_MAX_SCANNERS) FAIL("too many --scanner options (%d at most)", CLI_MAX_SCANNERS);
+    o->scanner_pos[o->nscanner] = vd_v3(x[0], x[1], x[2]);
+    o->scanner_target[o->nscanner] = k == 6 ? vd_v3(x[3], x[4], x[5]) : vd_v3(0, 0, 0);
+    o->scanner_has_target[o->nscanner] = k == 6;
+    o->nscanner++;
+  } else if (!strcmp(a, "--scanners")) {
+    TAKE();
+    o->scanners_file = val;
+  } else if (!strcmp(a, "--density-law")) {
+    TAKE();
+    o->density_given = 1;
+    if (!strcmp(val, "inverse-square")) o->def.density = VD_DENSITY_INVERSE_SQUARE;
+    else if (!strcmp(val, "linear")) o->def.density = VD_DENSITY_LINEAR;
+    else if (!strcmp(val, "constant")) o->def.density = VD_DENSITY_CONSTANT;
+    else if (!strncmp(val, "table:", 6)) {
+      o->def.density = VD_DENSITY_TABLE;
+      if (!parse_table(val + 6, &o->def))
+        FAIL("--density-law table expects table:D1:G1,D2:G2,... (2..%d pairs), got '%s'", VD_CLOUD_TABLE_MAX, val);
+    } else {
+      FAIL("--density-law expects inverse-square, linear, constant or table:D1:G1,..., got '%s'", val);
+    }
+  } else if (!strcmp(a, "--noise")) {
+    TAKE();
+    int k = parse_list(val, x, 1, 2);
+    if (!k || x[0] < 0 || (k == 2 && x[1] < 0)) FAIL("--noise expects S or S,K with S, K >= 0, got '%s'", val);
+    o->def.noise_sigma = x[0];
+    o->def.noise_slope = k == 2 ? x[1] : 0;
+  } else if (!strcmp(a, "--occlusion")) {
+    o->def.occlusion = 1;
+  } else if (!strcmp(a, "--no-interior")) {
+    o->def.interior = 0;
+  } else if (!strcmp(a, "--pattern")) {
+    TAKE();
+    o->scan_opts = 1;
+    if (!strcmp(val, "angular")) o->pattern = VD_SCAN_ANGULAR;
+    else if (!strcmp(val, "pinhole")) o->pattern = VD_SCAN_PINHOLE;
+    else FAIL("--pattern expects angular or pinhole, got '%s'", val);
+  } else if (!strcmp(a, "--fov")) {
+    TAKE();
+    o->scan_opts = 1;
+    if (!parse_list(val, x, 2, 0) || !(x[0] > 0 && x[0] <= 360 && x[1] > 0 && x[1] <= 180))
+      FAIL("--fov expects H,V in degrees, 0 < H <= 360, 0 < V <= 180, got '%s'", val);
+    o->fov_h = x[0] * VD_PI / 180, o->fov_v = x[1] * VD_PI / 180;
+  } else if (!strcmp(a, "--res")) {
+    TAKE();
+    o->scan_opts = 1;
+    if (!parse_list(val, x, 2, 0) || x[0] != floor(x[0]) || x[1] != floor(x[1]) || x[0] < 1 ||
+        x[1] < 1 || x[0] > 100000 || x[1] > 100000)
+      FAIL("--res expects W,H integers in 1..100000, got '%s'", val);
+    o->res_h = (int)x[0], o->res_v = (int)x[1];
+  } else if (!strcmp(a, "--labels")) {
+    TAKE();
+    if (!strcmp(val, "semantic")) o->labels_instance = 0;
+    else if (!strcmp(val, "instance")) o->labels_instance = 1;
+    else FAIL("--labels expects semantic or instance, got '%s'", val);
+  } else if (!strcmp(a, "--slices")) {
+    TAKE();
+    if (!parse_int(val, 3, 1024, &v)) FAIL("--slices expects an integer in 3..1024, got '%s'", val);
+    o->def.mesh.slices = (int)v;
+  } else if (!strcmp(a, "--cloud-seed")) {
+    TAKE();
+    if (!parse_int(val, 0, INT64_MAX, &v)) FAIL("--cloud-seed expects an integer >= 0, got '%s'", val);
+    o->cloud_seed = (uint64_t)v;
+    o->has_cloud_seed = 1;
+  } else if (!strcmp(a, "--threads")) {
+    TAKE();
+    if (!parse_int(val, 1, 1024, &v)) FAIL("--threads expects an integer in 1..1024, got '%s'", val);
+    o->def.threads = (int)v;
+  } else if (!strcmp(a, "--ascii")) {
+    o->wdef.ascii = 1;
+  } else if (!strcmp(a, "--ply-scalar-prefix")) {
+    o->wdef.ply_prefix = "scalar_";
+  } else {
+    return 0;
+  }
+#undef TAKE
+#undef FAIL
+  return 1;
+}
+
+int cli_cloud_check(const cli_cloud_opts* o, const char* cmd) {
+  if (o->density_given && o->def.sensor != VD_SENSOR_DISTANCE)
+    return cli_usage_error(cmd, "--density-law applies to --sensor distance");
+  if (o->scan_opts && o->def.sensor != VD_SENSOR_SCAN)
+    return cli_usage_error(cmd, "--pattern, --fov and --res apply to --sensor scan");
+  if (o->points_given && o->def.sensor == VD_SENSOR_SCAN)
+    return cli_usage_error(cmd, "--points does not apply to --sensor scan (the ray grid sets the count)");
+  int any = o->nscanner > 0 || o->scanners_file;
+  if (!any && o->def.sensor != VD_SENSOR_UNIFORM)
+    return cli_usage_error(cmd, "--sensor %s needs --scanner or --scanners",
+                           o->def.sensor == VD_SENSOR_SCAN ? "scan" : "distance");
+  if (!any && o->def.occlusion) return cli_usage_error(cmd, "--occlusion needs --scanner or --scanners");
+  if (!any && o->def.noise_slope > 0)
+    return cli_usage_error(cmd, "--noise S,K with K > 0 needs --scanner or --scanners");
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the pipeline: load, compile, scanners, sample, relabel, write
+
+vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, const char* out,
+                         cli_cloud_result* res, vd_error* err) {
+  memset(res, 0, sizeof *res);
+  double t0 = cli_now();
+  vd_plant_spec* plant = NULL;
+  cli_grow_info info;
+  vd_status st = cli_load_plant(po, &plant, &info, err);
+  if (st) return st;
+  cli_grow_info_free(&info);
+  double t1 = cli_now();
+  vd_model* m = NULL;
+  st = vd_plant_compile(plant, &m, err);
+  vd_plant_stats ps;
+  vd_plant_spec_stats(plant, &ps);
+  vd_plant_spec_destroy(plant);
+  if (st) return st;
+  double t2 = cli_now();
+  // scanners: --scanner ones (target: the plant's centre unless given), then the preset's
+  vd_scanner* sc = NULL;
+  int nfile = 0, n = co->nscanner;
+  vd_scanner* fsc = NULL;
+  if (co->scanners_file) st = vd_cloud_read_scanners(co->scanners_file, ps.bbox_min, ps.bbox_max, &fsc, &nfile, err);
+  if (!st && n + nfile > 0) {
+    sc = vd_malloc((size_t)(n + nfile) * sizeof *sc);
+    if (!sc) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  if (!st) {
+    vd_vec3 centre = vd_scale(vd_add(ps.bbox_min, ps.bbox_max), 0.5);
+    for (int i = 0; i < n; i++) {
+      vd_scanner s = vd_scanner_default();
+      s.pos = co->scanner_pos[i];
+      s.target = co->scanner_has_target[i] ? co->scanner_target[i] : centre;
+      s.pattern = co->pattern;
+      s.fov_h = co->fov_h, s.fov_v = co->fov_v, s.res_h = co->res_h, s.res_v = co->res_v;
+      if (vd_norm(vd_sub(s.target, s.pos)) == 0)
+        st = vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                          "--scanner %d: the scanner sits on its target; give a target", i + 1);
+      sc[i] = s;
+    }
+    for (int i = 0; i < nfile; i++)
+      sc[n + i] = fsc[i];
+  }
+  vd_free(fsc, (size_t)nfile * sizeof *fsc);
+  // sample
+  vd_cloud cloud;
+  memset(&cloud, 0, sizeof cloud);
+  if (!st) {
+    vd_cloud_def def = co->def;
+    def.seed = co->has_cloud_seed ? co->cloud_seed : po->seed;
+    def.nscanner = n + nfile;
+    def.scanner = sc;
+    st = vd_cloud_sample(m, NULL, &def, &cloud, &res->stats, err);
+  }
+  vd_free(sc, (size_t)(n + nfile) * sizeof *sc);
+  vd_model_destroy(m);
+  if (!st && co->labels_instance) st = vd_cloud_relabel(&cloud, err);
+  double t3 = cli_now();
+  // write
+  if (!st && out) {
+    vd_cloud_write_def wd = co->wdef;
+    char comment[256];
+    snprintf(comment, sizeof comment, "seed %llu, sensor %s, labels %s", (unsigned long long)(co->has_cloud_seed ? co->cloud_seed : po->seed),
+             co->def.sensor == VD_SENSOR_UNIFORM ? "uniform" : co->def.sensor == VD_SENSOR_DISTANCE ? "distance" : "scan",
+             co->labels_instance ? "instance" : "semantic");
+    wd.comment = comment;
+    st = vd_cloud_write(&cloud, out, &wd, err);
+    if (st) res->write_failed = 1;
+  }
+  double t4 = cli_now();
+  res->seconds_load = t1 - t0;
+  res->seconds_compile = t2 - t1;
+  res->seconds_write = t4 - t3;
+  res->seconds_total = t4 - t0;
+  if (!st) {
+    res->cloud = cloud;
+  } else {
+    vd_cloud_free(&cloud);
+  }
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// --stats
+
+static cJSON* vec_json(const double* v) { return cJSON_CreateDoubleArray(v, 3); }
+
+typedef struct id_index {
+  int id, index;
+} id_index;
+
+static int cmp_id(const void* a, const void* b) {
+  int x = ((const id_index*)a)->id, y = ((const id_index*)b)->id;
+  return (x > y) - (x < y);
+}
+
+int cli_label_counts(const vd_cloud* c, int64_t* count) {
+  for (int l = 0; l < c->nlabel; l++)
+    count[l] = 0;
+  if (c->nlabel == 0) return 1;
+  // the table sorted by id, then one binary search per point
+  id_index* ix = vd_malloc((size_t)c->nlabel * sizeof *ix);
+  if (!ix) return 0;
+  for (int l = 0; l < c->nlabel; l++)
+    ix[l] = (id_index){c->labels[l].id, l};
+  qsort(ix, (size_t)c->nlabel, sizeof *ix, cmp_id);
+  for (int64_t i = 0; i < c->n; i++) {
+    id_index key = {c->label[i], 0};
+    const id_index* at = bsearch(&key, ix, (size_t)c->nlabel, sizeof *ix, cmp_id);
+    if (at) count[at->index]++;
+  }
+  vd_free(ix, (size_t)c->nlabel * sizeof *ix);
+  return 1;
+}
+
+cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
+  const vd_cloud* c = &r->cloud;
+  const vd_cloud_stats* s = &r->stats;
+  cJSON* root = cJSON_CreateObject();
+  if (!root) return NULL;
+  cJSON_AddNumberToObject(root, "points", (double)c->n);
+  // points per label name, in table order; and the distinct instances
+  cJSON* labels = cJSON_AddObjectToObject(root, "labels");
+  int64_t* count = c->nlabel ? vd_calloc((size_t)c->nlabel, sizeof(int64_t)) : NULL;
+  int ninst = 0;
+  if (count && cli_label_counts(c, count)) {
+    for (int l = 0; l < c->nlabel; l++)
+      cJSON_AddNumberToObject(labels, c->labels[l].name, (double)count[l]);
+  }
+  vd_free(count, (size_t)c->nlabel * sizeof(int64_t));
+  int maxi = 0;
+  for (int64_t i = 0; i < c->n; i++)
+    if (c->instance[i] > maxi) maxi = c->instance[i];
+  unsigned char* seen = vd_calloc((size_t)maxi + 1, 1);
+  if (seen) {
+    for (int64_t i = 0; i < c->n; i++)
+      if (c->instance[i] >= 0 && !seen[c->instance[i]]) seen[c->instance[i]] = 1, ninst++;
+    vd_free(seen, (size_t)maxi + 1);
+  }
+  cJSON_AddNumberToObject(root, "instances", ninst);
+  cJSON_AddNumberToObject(root, "views", c->nview);
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int k = 0; k < 3; k++) {
+    if (c->n) lo[k] = INFINITY, hi[k] = -INFINITY;
+    for (int64_t i = 0; i < c->n; i++)
+      lo[k] = fmin(lo[k], c->pos[3 * i + k]), hi[k] = fmax(hi[k], c->pos[3 * i + k]);
+  }
+  cJSON_AddItemToObject(root, "bbox_min", vec_json(lo));
+  cJSON_AddItemToObject(root, "bbox_max", vec_json(hi));
+  cJSON_AddNumberToObject(root, "area", s->area);
+  cJSON_AddNumberToObject(root, "triangles", s->ntri);
+  cJSON_AddNumberToObject(root, "solids", s->nsolid);
+  cJSON_AddNumberToObject(root, "drawn", (double)s->drawn);
+  cJSON* rej = cJSON_AddObjectToObject(root, "rejected");
+  cJSON_AddNumberToObject(rej, "interior", (double)s->rejected_interior);
+  cJSON_AddNumberToObject(rej, "density", (double)s->rejected_density);
+  cJSON_AddNumberToObject(rej, "backface", (double)s->rejected_backface);
+  cJSON_AddNumberToObject(rej, "occluded", (double)s->rejected_occluded);
+  cJSON_AddNumberToObject(rej, "noise", (double)s->rejected_noise);
+  cJSON_AddNumberToObject(root, "missed_rays", (double)s->missed);
+  cJSON_AddNumberToObject(root, "threads", s->threads);
+  cJSON* t = cJSON_AddObjectToObject(root, "seconds");
+  cJSON_AddNumberToObject(t, "load", r->seconds_load);
+  cJSON_AddNumberToObject(t, "compile", r->seconds_compile);
+  cJSON_AddNumberToObject(t, "tessellate", s->seconds_tessellate);
+  cJSON_AddNumberToObject(t, "build", s->seconds_build);
+  cJSON_AddNumberToObject(t, "sample", s->seconds_sample);
+  cJSON_AddNumberToObject(t, "write", r->seconds_write);
+  cJSON_AddNumberToObject(t, "total", seconds_total);
+  cJSON* pps = cJSON_AddObjectToObject(root, "points_per_second");
+  cJSON_AddNumberToObject(pps, "sample", s->seconds_sample > 0 ? (double)c->n / s->seconds_sample : 0);
+  cJSON_AddNumberToObject(pps, "write", r->seconds_write > 0 ? (double)c->n / r->seconds_write : 0);
+  cJSON_AddNumberToObject(pps, "total", seconds_total > 0 ? (double)c->n / seconds_total : 0);
+  return root;
+}
+
+int cli_cloud(int argc, char** argv) {
+  double start = cli_now();
+  cli_plant_opts po;
+  cli_plant_opts_init(&po);
+  cli_cloud_opts co;
+  cli_cloud_opts_init(&co);
+  const char* out = NULL;
+  int stats = 0;
+  for (int i = 1; i < argc; i++) {
+    const char* a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      fputs(cloud_usage, stdout);
+      fputs(cli_cloud_help, stdout);
+      fputs(cli_plant_help, stdout);
+      return EXIT_OK;
+    }
+    int r = cli_plant_opt(&po, "cloud", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    r = cli_cloud_opt(&co, "cloud", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      if (i + 1 >= argc) return cli_usage_error("cloud", "%s needs a file name", a);
+      out = argv[++i];
+    } else if (!strcmp(a, "--stats")) {
+      stats = 1;
+    } else if (a[0] == '-' && a[1]) {
+      return cli_usage_error("cloud", "unknown option '%s'", a);
+    } else if (!po.path) {
+      po.path = a;
+    } else {
+      return cli_usage_error("cloud", "unexpected argument '%s'", a);
+    }
+  }
+  if (!po.path) return cli_usage_error("cloud", "missing PLANT (an .lpy or plant .json file)");
+  if (!out && !stats) return cli_usage_error("cloud", "nothing to do: give -o OUT and/or --stats");
+  if (out && vd_cloud_format_of(out) == VD_CLOUD_AUTO)
+    return cli_usage_error("cloud", "output '%s': unknown format (use .ply, .pcd, .xyz, .csv or .las)", out);
+  if (cli_cloud_check(&co, "cloud")) return EXIT_USAGE;
+  vd_error err = {0};
+  cli_cloud_result res;
+  vd_status st = cli_cloud_make(&po, &co, out, &res, &err);
+  if (st) {
+    int code = cli_report("cloud", &err, st);
+    return res.write_failed && st == VD_ERR_IO ? EXIT_FAIL : code;
+  }
+  if (stats) {
+    cJSON* root = cli_cloud_stats_json(&res, cli_now() - start);
+    char* text = root ? cJSON_Print(root) : NULL;
+    if (text) {
+      fputs(text, stdout);
+      fputc('\n', stdout);
+      cJSON_free(text);
+    }
+    cJSON_Delete(root);
+    if (!text) {
+      vd_cloud_free(&res.cloud);
+      fprintf(stderr, "verdant cloud: out of memory\n");
+      return EXIT_FAIL;
+    }
+  }
+  vd_cloud_free(&res.cloud);
+  return EXIT_OK;
+}

@@ -1,0 +1,534 @@
+// SPDX-License-Identifier: MIT
+// verdant dataset: K plants of one model, each with its labelled cloud, item i seeded from
+// (master seed, i) so any item can be remade alone. Items run in parallel (--jobs) and split
+// across machines (--shard i/N); a run skips complete items, so an interrupted dataset resumes.
+// Every file is written under a temporary name and renamed when complete; an item is complete
+// when its record (written after its cloud) names a cloud file of the recorded size.
+#define _POSIX_C_SOURCE 200809L
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <nettle/sha2.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "cli.h"
+
+#define DATASET_FORMAT "verdant-dataset"
+#define DATASET_VERSION 1
+#define MAX_VARY 16
+
+static const char* dataset_usage =
+    "usage: verdant dataset PLANT --count K -o DIR [options]\n"
+    "\n"
+    "Make K plants of one model (an .lpy file) and a labelled point cloud of each in DIR:\n"
+    "item_000000.ply ... with a record item_000000.json each, and manifest.json (label table,\n"
+    "per-item seed, parameters, point counts, SHA-256 checksums) once every item is there.\n"
+    "Item i uses the seed printed in its record: 'verdant cloud PLANT --seed SEED' with the same\n"
+    "options (and --set NAME=VALUE for each --vary) makes it again. Complete items are skipped,\n"
+    "so an interrupted run resumes where it stopped.\n"
+    "\n"
+    "options:\n"
+    "  -K, --count K         items in the dataset (>= 1)\n"
+    "  -o, --output DIR      the dataset folder (created if missing)\n"
+    "      --seed S          master seed (default 0); item i is seeded from (S, i)\n"
+    "      --format F        cloud files: ply (default) | pcd | xyz | csv | las\n"
+    "      --jobs J          items made at once on this machine (default 1)\n"
+    "      --shard I/N       make only items i with i mod N = I (0 <= I < N): one shard of a\n"
+    "                        Slurm job array or of mpirun ranks (examples/dataset_*.sh)\n"
+    "      --vary NAME=A:B   set the .lpy global NAME to a value drawn uniformly in [A, B] for\n"
+    "                        each item (repeatable); the value is in the item's record\n"
+    "      --force           remake complete items too\n"
+    "      --stats           print a JSON summary on stdout (made, skipped, seconds, items/s)\n";
+
+typedef struct vary {
+  char name[64];
+  double a, b;
+} vary;
+
+typedef struct dataset {
+  const char* dir;
+  const char* ext;  // "ply", ...
+  int count, jobs, shard, nshard, force, progress, width;
+  uint64_t master;
+  vary vary[MAX_VARY];
+  int nvary;
+  int instance_labels; // --labels instance: every item has its own label table
+  char params[17];     // hex FNV-1a of the arguments that shape the output
+  cJSON* arguments;    // those arguments
+} dataset;
+
+// ---------------------------------------------------------------------------------------------
+// small helpers
+
+static uint64_t fnv1a(uint64_t h, const char* s, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    h ^= (unsigned char)s[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+// item seed and --vary values from the stream (master, i): reproducible for one item alone
+static uint64_t item_seed(const dataset* ds, int i, double* values) {
+  vd_rng r;
+  vd_rng_stream(&r, ds->master, (uint64_t)i);
+  uint64_t hi = vd_rng_u32(&r), lo = vd_rng_u32(&r);
+  for (int k = 0; k < ds->nvary; k++)
+    values[k] = vd_rng_uniform(&r, ds->vary[k].a, ds->vary[k].b);
+  return ((hi << 32) | lo) & ((1ull << 53) - 1);  // below 2^53: exact as a JSON number
+}
+
+static void item_path(const dataset* ds, int i, const char* ext, char* buf, size_t cap) {
+  snprintf(buf, cap, "%s/item_%0*d.%s", ds->dir, ds->width, i, ext);
+}
+
+// SHA-256 of a file as 64 hex digits; 0 on a read error
+static int sha256_file(const char* path, char hex[65], int64_t* bytes) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return 0;
+  struct sha256_ctx ctx;
+  sha256_init(&ctx);
+  unsigned char buf[1 << 16];
+  size_t n;
+  *bytes = 0;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+    sha256_update(&ctx, n, buf);
+    *bytes += (int64_t)n;
+  }
+  int ok = !ferror(f);
+  fclose(f);
+  unsigned char d[SHA256_DIGEST_SIZE];
+  sha256_digest(&ctx, SHA256_DIGEST_SIZE, d);
+  for (int k = 0; k < SHA256_DIGEST_SIZE; k++)
+    snprintf(hex + 2 * k, 3, "%02x", d[k]);
+  return ok;
+}
+
+// write JSON atomically
+static vd_status write_json(const char* path, const cJSON* root, int pretty, vd_error* err) {
+  char* text = pretty ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
+  if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (!st) {
+    fputs(text, f.fp);
+    fputc('\n', f.fp);
+    st = vd_outfile_commit(&f, err);
+    vd_outfile_abort(&f);
+  }
+  cJSON_free(text);
+  return st;
+}
+
+// the record of item i if it is complete (parsed, matching parameters, cloud file of its size);
+// *mismatch is set when a record exists but was made with other parameters
+static cJSON* complete_record(const dataset* ds, int i, int* mismatch) {
+  char path[4200];
+  item_path(ds, i, "json", path, sizeof path);
+  char* text;
+  size_t len;
+  vd_error e = {0};
+  if (access(path, F_OK) != 0 || vd_file_read(path, &text, &len, &e)) return NULL;
+  cJSON* rec = cJSON_ParseWithLength(text, len);
+  vd_free(text, len + 1);
+  if (!rec) return NULL;
+  const cJSON* params = cJSON_GetObjectItemCaseSensitive(rec, "parameters");
+  const cJSON* file = cJSON_GetObjectItemCaseSensitive(rec, "file");
+  const cJSON* bytes = cJSON_GetObjectItemCaseSensitive(rec, "bytes");
+  const cJSON* index = cJSON_GetObjectItemCaseSensitive(rec, "index");
+  if (!cJSON_IsString(params) || !cJSON_IsString(file) || !cJSON_IsNumber(bytes) ||
+      !cJSON_IsNumber(index) || index->valuedouble != i) {
+    cJSON_Delete(rec);
+    return NULL;
+  }
+  if (strcmp(params->valuestring, ds->params)) {
+    *mismatch = 1;
+    cJSON_Delete(rec);
+    return NULL;
+  }
+  char cpath[4200];
+  snprintf(cpath, sizeof cpath, "%s/%s", ds->dir, file->valuestring);
+  struct stat sb;
+  if (strchr(file->valuestring, '/') || stat(cpath, &sb) != 0 || (double)sb.st_size != bytes->valuedouble) {
+    cJSON_Delete(rec);
+    return NULL;
+  }
+  return rec;
+}
+
+// ---------------------------------------------------------------------------------------------
+// one item
+
+static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const cli_cloud_opts* co,
+                           int i, int64_t* points, vd_error* err) {
+  double values[MAX_VARY];
+  uint64_t seed = item_seed(ds, i, values);
+  // the item's plant options: its seed, the --vary values as --set
+  cli_plant_opts po = *po0;
+  po.seed = seed;
+  po.progress = 0;
+  char setbuf[MAX_VARY][96];
+  for (int k = 0; k < ds->nvary; k++) {
+    if (po.nset == 64) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "too many --set and --vary options");
+    snprintf(setbuf[k], sizeof setbuf[k], "%s=%.17g", ds->vary[k].name, values[k]);
+    po.set[po.nset++] = setbuf[k];
+  }
+  cli_cloud_opts cco = *co;
+  cco.has_cloud_seed = 0;  // the cloud is seeded by the item seed as well
+  if (ds->jobs > 1 && cco.def.threads == 0) cco.def.threads = 1;
+  char cpath[4200], rpath[4200];
+  item_path(ds, i, ds->ext, cpath, sizeof cpath);
+  item_path(ds, i, "json", rpath, sizeof rpath);
+  cli_cloud_result res;
+  vd_status st = cli_cloud_make(&po, &cco, cpath, &res, err);
+  if (st) return st;
+  // the record: seed, values, counts, the file's size and checksum
+  char hex[65];
+  int64_t bytes;
+  if (!sha256_file(cpath, hex, &bytes)) {
+    vd_cloud_free(&res.cloud);
+    return vd_error_set(err, VD_ERR_IO, cpath, 0, 0, "cannot read back the cloud: %s", strerror(errno));
+  }
+  cJSON* rec = cJSON_CreateObject();
+  if (!rec) {
+    vd_cloud_free(&res.cloud);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  const char* slash = strrchr(cpath, '/');
+  cJSON_AddNumberToObject(rec, "index", i);
+  cJSON_AddNumberToObject(rec, "seed", (double)seed);
+  cJSON* vv = cJSON_AddObjectToObject(rec, "vary");
+  for (int k = 0; k < ds->nvary; k++)
+    cJSON_AddNumberToObject(vv, ds->vary[k].name, values[k]);
+  cJSON_AddStringToObject(rec, "file", slash ? slash + 1 : cpath);
+  cJSON_AddNumberToObject(rec, "points", (double)res.cloud.n);
+  cJSON* lc = cJSON_AddObjectToObject(rec, "label_points");
+  cJSON* lt = cJSON_AddArrayToObject(rec, "labels");
+  int64_t* count = res.cloud.nlabel ? vd_calloc((size_t)res.cloud.nlabel, sizeof(int64_t)) : NULL;
+  if (res.cloud.nlabel && (!count || !cli_label_counts(&res.cloud, count))) {
+    vd_free(count, (size_t)res.cloud.nlabel * sizeof(int64_t));
+    vd_cloud_free(&res.cloud);
+    cJSON_Delete(rec);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  for (int l = 0; l < res.cloud.nlabel; l++) {
+    cJSON_AddNumberToObject(lc, res.cloud.labels[l].name, (double)count[l]);
+    cJSON* e = cJSON_CreateObject();
+    cJSON_AddNumberToObject(e, "id", res.cloud.labels[l].id);
+    cJSON_AddStringToObject(e, "name", res.cloud.labels[l].name);
+    cJSON_AddItemToArray(lt, e);
+  }
+  vd_free(count, (size_t)res.cloud.nlabel * sizeof(int64_t));
+  cJSON_AddNumberToObject(rec, "bytes", (double)bytes);
+  cJSON_AddStringToObject(rec, "sha256", hex);
+  cJSON_AddStringToObject(rec, "parameters", ds->params);
+  *points = res.cloud.n;
+  vd_cloud_free(&res.cloud);
+  st = write_json(rpath, rec, 0, err);
+  cJSON_Delete(rec);
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// progress and the manifest
+
+static void progress(const dataset* ds, int done, int total, double t0) {
+  if (!ds->progress) return;
+  double el = cli_now() - t0, rate = el > 0 ? done / el : 0;
+  double eta = rate > 0 ? (total - done) / rate : 0;
+  int w = 30, fill = total > 0 ? (int)((double)done / total * w) : w;
+  char bar[64];
+  for (int k = 0; k < w; k++)
+    bar[k] = k < fill ? '#' : ' ';
+  bar[w] = 0;
+  fprintf(stderr, "\rdataset [%s] %d/%d items, %.1f items/s, ETA %.0f s   ", bar, done, total, rate, eta);
+  if (done == total) fputc('\n', stderr);
+  fflush(stderr);
+}
+
+// manifest.json when every item of the dataset is complete; 0 written, 1 not yet, -1 error
+static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error* err) {
+  cJSON* items = cJSON_CreateArray();
+  cJSON* root = cJSON_CreateObject();
+  if (!items || !root) {
+    cJSON_Delete(items);
+    cJSON_Delete(root);
+    vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    return -1;
+  }
+  int64_t total = 0;
+  cJSON* labels = cJSON_CreateArray();
+  for (int i = 0; i < ds->count; i++) {
+    int mismatch = 0;
+    cJSON* rec = complete_record(ds, i, &mismatch);
+    if (!rec) {
+      cJSON_Delete(items);
+      cJSON_Delete(root);
+      cJSON_Delete(labels);
+      return 1;
+    }
+    // the label table: every id once, in order of first appearance (semantic labels); with
+    // instance labels each item keeps its own table
+    const cJSON* lt = cJSON_GetObjectItemCaseSensitive(rec, "labels");
+    const cJSON* e;
+    if (!ds->instance_labels) {
+      cJSON_ArrayForEach(e, lt) {
+        const cJSON* id = cJSON_GetObjectItemCaseSensitive(e, "id");
+        int seen = 0;
+        const cJSON* o;
+        cJSON_ArrayForEach(o, labels) {
+          const cJSON* oid = cJSON_GetObjectItemCaseSensitive(o, "id");
+          seen |= cJSON_IsNumber(oid) && cJSON_IsNumber(id) && oid->valuedouble == id->valuedouble;
+        }
+        if (!seen) cJSON_AddItemToArray(labels, cJSON_Duplicate(e, 1));
+      }
+      cJSON_DeleteItemFromObjectCaseSensitive(rec, "labels");
+    }
+    cJSON_DeleteItemFromObjectCaseSensitive(rec, "parameters");
+    const cJSON* pts = cJSON_GetObjectItemCaseSensitive(rec, "points");
+    total += cJSON_IsNumber(pts) ? (int64_t)pts->valuedouble : 0;
+    cJSON_AddItemToArray(items, rec);
+  }
+  cJSON_AddStringToObject(root, "format", DATASET_FORMAT);
+  cJSON_AddNumberToObject(root, "version", DATASET_VERSION);
+  cJSON_AddStringToObject(root, "plant", po->path);
+  cJSON_AddNumberToObject(root, "count", ds->count);
+  if (ds->master < (1ull << 53)) {
+    cJSON_AddNumberToObject(root, "master_seed", (double)ds->master);
+  } else {  // beyond a double's integers: as text
+    char seedtxt[32];
+    snprintf(seedtxt, sizeof seedtxt, "%llu", (unsigned long long)ds->master);
+    cJSON_AddStringToObject(root, "master_seed", seedtxt);
+  }
+  cJSON_AddStringToObject(root, "cloud_format", ds->ext);
+  cJSON_AddNumberToObject(root, "points", (double)total);
+  cJSON* par = cJSON_AddObjectToObject(root, "parameters");
+  cJSON_AddStringToObject(par, "id", ds->params);
+  cJSON_AddItemToObject(par, "arguments", cJSON_Duplicate(ds->arguments, 1));
+  cJSON* vv = cJSON_AddObjectToObject(par, "vary");
+  for (int k = 0; k < ds->nvary; k++) {
+    double ab[2] = {ds->vary[k].a, ds->vary[k].b};
+    cJSON_AddItemToObject(vv, ds->vary[k].name, cJSON_CreateDoubleArray(ab, 2));
+  }
+  cJSON_AddStringToObject(root, "regenerate",
+                          "verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
+                          "<parameters.arguments> -o item.<cloud_format>");
+  if (ds->instance_labels)
+    cJSON_Delete(labels);  // in the items
+  else
+    cJSON_AddItemToObject(root, "labels", labels);
+  cJSON_AddItemToObject(root, "items", items);
+  char path[4200];
+  snprintf(path, sizeof path, "%s/manifest.json", ds->dir);
+  vd_status st = write_json(path, root, 1, err);
+  cJSON_Delete(root);
+  return st ? -1 : 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the command
+
+static int parse_vary(const char* s, vary* v) {
+  const char* eq = strchr(s, '=');
+  if (!eq || eq == s || (size_t)(eq - s) >= sizeof v->name) return 0;
+  memcpy(v->name, s, (size_t)(eq - s));
+  v->name[eq - s] = 0;
+  char* end;
+  errno = 0;
+  v->a = strtod(eq + 1, &end);
+  if (end == eq + 1 || *end != ':' || errno || !isfinite(v->a)) return 0;
+  const char* p = end + 1;
+  v->b = strtod(p, &end);
+  if (end == p || *end || errno || !isfinite(v->b) || v->b < v->a) return 0;
+  return 1;
+}
+
+// options that do not change what an item holds: left out of the parameter id
+static int neutral_option(const char* a, int* takes_value) {
+  static const char* with_value[] = {"-o", "--output", "--jobs", "--shard", "--threads", "-K", "--count"};
+  static const char* flags[] = {"--force", "--no-progress", "--stats"};
+  for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++)
+    if (!strcmp(a, with_value[k])) return *takes_value = 1, 1;
+  for (size_t k = 0; k < sizeof flags / sizeof *flags; k++)
+    if (!strcmp(a, flags[k])) return *takes_value = 0, 1;
+  return 0;
+}
+
+int cli_dataset(int argc, char** argv) {
+  double t0 = cli_now();
+  cli_plant_opts po;
+  cli_plant_opts_init(&po);
+  cli_cloud_opts co;
+  cli_cloud_opts_init(&co);
+  dataset ds;
+  memset(&ds, 0, sizeof ds);
+  ds.jobs = 1, ds.nshard = 1, ds.ext = "ply", ds.count = -1;
+  ds.progress = po.progress;
+  int stats = 0;
+  for (int i = 1; i < argc; i++) {
+    const char* a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      fputs(dataset_usage, stdout);
+      fputs(cli_cloud_help, stdout);
+      fputs(cli_plant_help, stdout);
+      return EXIT_OK;
+    }
+    int r = cli_plant_opt(&po, "dataset", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    r = cli_cloud_opt(&co, "dataset", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    const char* val = i + 1 < argc ? argv[i + 1] : NULL;
+    char* end;
+    if (!strcmp(a, "-K") || !strcmp(a, "--count")) {
+      long v = val ? (errno = 0, strtol(val, &end, 10)) : 0;
+      if (!val || errno || *end || v < 1 || v > 100000000)
+        return cli_usage_error("dataset", "%s expects an integer in 1..100000000", a);
+      ds.count = (int)v, i++;
+    } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      if (!val) return cli_usage_error("dataset", "%s needs a folder", a);
+      ds.dir = val, i++;
+    } else if (!strcmp(a, "--format")) {
+      if (!val || (strcmp(val, "ply") && strcmp(val, "pcd") && strcmp(val, "xyz") && strcmp(val, "csv") && strcmp(val, "las")))
+        return cli_usage_error("dataset", "--format expects ply, pcd, xyz, csv or las");
+      ds.ext = val, i++;
+    } else if (!strcmp(a, "--jobs")) {
+      long v = val ? (errno = 0, strtol(val, &end, 10)) : 0;
+      if (!val || errno || *end || v < 1 || v > 1024) return cli_usage_error("dataset", "--jobs expects an integer in 1..1024");
+      ds.jobs = (int)v, i++;
+    } else if (!strcmp(a, "--shard")) {
+      int si, sn, len = 0;
+      if (!val || sscanf(val, "%d/%d%n", &si, &sn, &len) != 2 || val[len] || sn < 1 || si < 0 || si >= sn)
+        return cli_usage_error("dataset", "--shard expects I/N with 0 <= I < N, got '%s'", val ? val : "");
+      ds.shard = si, ds.nshard = sn, i++;
+    } else if (!strcmp(a, "--vary")) {
+      if (ds.nvary == MAX_VARY) return cli_usage_error("dataset", "too many --vary options (%d at most)", MAX_VARY);
+      if (!val || !parse_vary(val, &ds.vary[ds.nvary]))
+        return cli_usage_error("dataset", "--vary expects NAME=A:B with A <= B, got '%s'", val ? val : "");
+      ds.nvary++, i++;
+    } else if (!strcmp(a, "--force")) {
+      ds.force = 1;
+    } else if (!strcmp(a, "--stats")) {
+      stats = 1;
+    } else if (a[0] == '-' && a[1]) {
+      return cli_usage_error("dataset", "unknown option '%s'", a);
+    } else if (!po.path) {
+      po.path = a;
+    } else {
+      return cli_usage_error("dataset", "unexpected argument '%s'", a);
+    }
+  }
+  if (!po.path) return cli_usage_error("dataset", "missing PLANT (an .lpy or plant .json file)");
+  if (ds.count < 0) return cli_usage_error("dataset", "missing --count K");
+  if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
+  if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
+  if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
+  ds.master = po.seed;
+  ds.instance_labels = co.labels_instance;
+  ds.progress = po.progress;
+  ds.width = 6;
+  for (int c = ds.count - 1; c >= 1000000; c /= 10) ds.width++;
+  // the parameter id: the arguments that shape an item, in order (the plant path included)
+  ds.arguments = cJSON_CreateArray();
+  if (!ds.arguments) return EXIT_FAIL;
+  uint64_t h = 1469598103934665603ull;
+  for (int i = 1; i < argc; i++) {
+    int takes = 0;
+    if (neutral_option(argv[i], &takes)) {
+      i += takes;
+      continue;
+    }
+    cJSON_AddItemToArray(ds.arguments, cJSON_CreateString(argv[i]));
+    h = fnv1a(h, argv[i], strlen(argv[i]) + 1);
+  }
+  h = fnv1a(h, ds.ext, strlen(ds.ext) + 1);
+  snprintf(ds.params, sizeof ds.params, "%016llx", (unsigned long long)h);
+  if (mkdir(ds.dir, 0777) != 0 && errno != EEXIST) {
+    cJSON_Delete(ds.arguments);
+    fprintf(stderr, "verdant dataset: %s: cannot create the folder: %s\n", ds.dir, strerror(errno));
+    return EXIT_FAIL;
+  }
+  // this shard's items that are not complete yet
+  int* todo = vd_malloc((size_t)ds.count * sizeof(int));
+  if (!todo) {
+    cJSON_Delete(ds.arguments);
+    fprintf(stderr, "verdant dataset: out of memory\n");
+    return EXIT_FAIL;
+  }
+  int ntodo = 0, skipped = 0, mismatch_at = -1;
+  for (int i = ds.shard; i < ds.count; i += ds.nshard) {
+    int mismatch = 0;
+    cJSON* rec = ds.force ? NULL : complete_record(&ds, i, &mismatch);
+    if (mismatch && mismatch_at < 0) mismatch_at = i;
+    if (rec) {
+      skipped++;
+      cJSON_Delete(rec);
+    } else {
+      todo[ntodo++] = i;
+    }
+  }
+  if (mismatch_at >= 0) {
+    vd_free(todo, (size_t)ds.count * sizeof(int));
+    cJSON_Delete(ds.arguments);
+    fprintf(stderr, "verdant dataset: %s: item %d was made with other options; use another folder or --force\n",
+            ds.dir, mismatch_at);
+    return EXIT_USAGE;
+  }
+  // the items, --jobs at a time; the first failure (lowest item) stops the rest
+  int done = 0, failed_item = -1;
+  int64_t points = 0;
+  vd_error first = {0};
+  vd_status first_st = VD_OK;
+  progress(&ds, 0, ntodo, t0);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ds.jobs)
+  for (int k = 0; k < ntodo; k++) {
+    int stop;
+#pragma omp atomic read
+    stop = failed_item;
+    if (stop >= 0) continue;
+    vd_error err = {0};
+    int64_t n = 0;
+    vd_status st = make_item(&ds, &po, &co, todo[k], &n, &err);
+#pragma omp critical(dataset_progress)
+    {
+      if (st && (failed_item < 0 || todo[k] < failed_item)) {
+        failed_item = todo[k];
+        first = err;
+        first_st = st;
+      }
+      if (!st) {
+        done++;
+        points += n;
+        progress(&ds, done, ntodo, t0);
+      }
+    }
+  }
+  vd_free(todo, (size_t)ds.count * sizeof(int));
+  if (failed_item >= 0) {
+    cJSON_Delete(ds.arguments);
+    if (ds.progress) fputc('\n', stderr);
+    char buf[1024];
+    fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
+            first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
+    return first_st == VD_ERR_IO || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);
+  }
+  // the manifest, once the whole dataset (every shard) is complete
+  vd_error err = {0};
+  int m = write_manifest(&ds, &po, &err);
+  cJSON_Delete(ds.arguments);
+  if (m < 0) return cli_report("dataset", &err, err.status);
+  double el = cli_now() - t0;
+  if (stats) {
+    printf("{\n\t\"made\":\t%d,\n\t\"skipped\":\t%d,\n\t\"points\":\t%lld,\n\t\"manifest\":\t%s,\n"
+           "\t\"seconds\":\t%.6f,\n\t\"items_per_second\":\t%.3f\n}\n",
+           done, skipped, (long long)points, m == 0 ? "true" : "false", el, el > 0 ? done / el : 0.0);
+  }
+  return EXIT_OK;
+}

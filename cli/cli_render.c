@@ -1,0 +1,340 @@
+// SPDX-License-Identifier: MIT
+// verdant render: a plant (.lpy or plant file) or a point cloud (.ply .pcd .xyz .csv .las) → PNG colour image, with
+// depth (16-bit, mm) and label/instance masks (16-bit ids) and a JSON sidecar on request.
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli.h"
+
+static const char* render_help =
+    "usage: verdant render PLANT|CLOUD -o OUT.png [options]\n"
+    "\n"
+    "Draw a plant (an .lpy file, derived on the fly, or a plant .json) or a point cloud (.ply,\n"
+    ".pcd, .xyz, .csv or .las, with optional label and instance) headless with MuJoCo's renderer (EGL; software rendering\n"
+    "when there is no GPU) and write a colour PNG with a legend.\n"
+    "\n"
+    "options:\n"
+    "  -o, --output OUT.png  colour image; the other files take its name: OUT.depth.png,\n"
+    "                        OUT.label.png, OUT.instance.png, OUT.json\n"
+    "      --camera VIEW     front | side | top | orbit[:AZ[:EL]] (degrees, orbit alone is\n"
+    "                        orbit:-60:20), fitted to the plant; default orbit\n"
+    "      --eye X,Y,Z       explicit camera position (m); with --lookat, replaces --camera\n"
+    "      --lookat X,Y,Z    point the camera looks at (m)\n"
+    "      --up X,Y,Z        image up direction (default 0,0,1)\n"
+    "      --fov DEG         vertical field of view (degrees, default 45)\n"
+    "      --size WxH        image size in pixels (default 640x480)\n"
+    "      --color-by WHAT   label | instance | stress | displacement (default label); stress\n"
+    "                        needs a simulation state, a plant at rest has zero displacement\n"
+    "      --depth           also write OUT.depth.png (16-bit grey, millimetres along the optical\n"
+    "                        axis, 0 = nothing) and OUT.json (intrinsics, pose)\n"
+    "      --masks           also write OUT.label.png and OUT.instance.png (16-bit ids, 0 =\n"
+    "                        background, exact: no anti-aliasing) and OUT.json\n"
+    "      --supersample K   colour anti-aliasing, K x K samples per pixel (1..4, default 2)\n"
+    "      --point-size M    splat half-size of cloud points (m, default 0.4% of the cloud)\n"
+    "      --robot FILE.xml  draw a robot from its MJCF (with its own world) beside the plant\n"
+    "      --no-floor, --no-shadows, --no-legend, --no-sky   leave those out\n"
+    "      --info            print the OpenGL context used on stderr\n";
+
+// three comma-separated numbers
+static int parse_vec(const char* s, vd_vec3* v) {
+  char* end;
+  double x[3];
+  for (int k = 0; k < 3; k++) {
+    errno = 0;
+    x[k] = strtod(s, &end);
+    if (end == s || errno || !isfinite(x[k])) return 0;
+    s = end;
+    if (k < 2) {
+      if (*s != ',') return 0;
+      s++;
+    }
+  }
+  if (*s) return 0;
+  *v = vd_v3(x[0], x[1], x[2]);
+  return 1;
+}
+
+// a number, the whole text
+static int parse_num(const char* s, double* out) {
+  char* end;
+  errno = 0;
+  double x = strtod(s, &end);
+  if (end == s || *end || errno || !isfinite(x)) return 0;
+  *out = x;
+  return 1;
+}
+
+// --camera VIEW
+static int parse_camera(const char* s, vd_camera_kind* kind, double* az, double* el) {
+  *az = -60, *el = 20;
+  if (!strcmp(s, "front"))
+    *kind = VD_CAMERA_FRONT;
+  else if (!strcmp(s, "side"))
+    *kind = VD_CAMERA_SIDE;
+  else if (!strcmp(s, "top"))
+    *kind = VD_CAMERA_TOP;
+  else if (!strncmp(s, "orbit", 5) && (s[5] == 0 || s[5] == ':')) {
+    *kind = VD_CAMERA_ORBIT;
+    if (s[5] == ':') {
+      char buf[64];
+      snprintf(buf, sizeof buf, "%s", s + 6);
+      char* colon = strchr(buf, ':');
+      if (colon) *colon = 0;
+      if (!parse_num(buf, az)) return 0;
+      if (colon && !parse_num(colon + 1, el)) return 0;
+      if (*el < -90 || *el > 90) return 0;
+    }
+  } else {
+    return 0;
+  }
+  return 1;
+}
+
+// OUT.png → OUT.<what>.<ext>
+static void sibling(const char* out, const char* what, char* buf, size_t cap) {
+  size_t n = strlen(out);
+  if (cli_has_ext(out, ".png")) n -= 4;
+  snprintf(buf, cap, "%.*s.%s", (int)n, out, what);
+}
+
+int cli_render(int argc, char** argv) {
+  cli_plant_opts po;
+  cli_plant_opts_init(&po);
+  const char* out = NULL;
+  const char* robot = NULL;
+  const char* camera_text = "orbit";
+  vd_vec3 eye, lookat, up = vd_v3(0, 0, 1);
+  int has_eye = 0, has_lookat = 0, depth = 0, masks = 0, info = 0;
+  double fov = 45, point_size = 0;
+  vd_render_def def = vd_render_def_default();
+  vd_render_style style = vd_render_style_default();
+  for (int i = 1; i < argc; i++) {
+    const char* a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      fputs(render_help, stdout);
+      fputs(cli_plant_help, stdout);
+      return EXIT_OK;
+    }
+    int r = cli_plant_opt(&po, "render", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    // options with a value
+    const char* val = NULL;
+    static const char* with_value[] = {"-o",         "--output",      "--camera",     "--eye",
+                                       "--lookat",   "--up",          "--fov",        "--size",
+                                       "--color-by", "--supersample", "--point-size", "--robot"};
+    for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
+      if (!strcmp(a, with_value[k])) {
+        if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
+        val = argv[++i];
+      }
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      out = val;
+    } else if (!strcmp(a, "--camera")) {
+      camera_text = val;
+    } else if (!strcmp(a, "--eye")) {
+      if (!parse_vec(val, &eye))
+        return cli_usage_error("render", "--eye expects X,Y,Z in metres, got '%s'", val);
+      has_eye = 1;
+    } else if (!strcmp(a, "--lookat")) {
+      if (!parse_vec(val, &lookat))
+        return cli_usage_error("render", "--lookat expects X,Y,Z in metres, got '%s'", val);
+      has_lookat = 1;
+    } else if (!strcmp(a, "--up")) {
+      if (!parse_vec(val, &up))
+        return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
+    } else if (!strcmp(a, "--fov")) {
+      if (!parse_num(val, &fov) || fov <= 0 || fov >= 180)
+        return cli_usage_error("render", "--fov expects degrees in (0, 180), got '%s'", val);
+    } else if (!strcmp(a, "--size")) {
+      int w, h;
+      char tail;
+      if (sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'",
+                               val);
+      def.width = w, def.height = h;
+    } else if (!strcmp(a, "--color-by")) {
+      if (!strcmp(val, "label"))
+        style.color_by = VD_COLOR_LABEL;
+      else if (!strcmp(val, "instance"))
+        style.color_by = VD_COLOR_INSTANCE;
+      else if (!strcmp(val, "stress"))
+        style.color_by = VD_COLOR_STRESS;
+      else if (!strcmp(val, "displacement"))
+        style.color_by = VD_COLOR_DISPLACEMENT;
+      else
+        return cli_usage_error(
+            "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
+    } else if (!strcmp(a, "--supersample")) {
+      double k;
+      if (!parse_num(val, &k) || k != floor(k) || k < 1 || k > 4)
+        return cli_usage_error("render", "--supersample expects 1, 2, 3 or 4, got '%s'", val);
+      def.supersample = (int)k;
+    } else if (!strcmp(a, "--point-size")) {
+      if (!parse_num(val, &point_size) || point_size <= 0)
+        return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'",
+                               val);
+    } else if (!strcmp(a, "--robot")) {
+      robot = val;
+    } else if (!strcmp(a, "--depth")) {
+      depth = 1;
+    } else if (!strcmp(a, "--masks")) {
+      masks = 1;
+    } else if (!strcmp(a, "--no-floor")) {
+      def.floor = 0;
+    } else if (!strcmp(a, "--no-shadows")) {
+      def.shadows = 0;
+    } else if (!strcmp(a, "--no-legend")) {
+      def.legend = 0;
+    } else if (!strcmp(a, "--no-sky")) {
+      def.sky = 0;
+    } else if (!strcmp(a, "--info")) {
+      info = 1;
+    } else if (a[0] == '-' && a[1]) {
+      return cli_usage_error("render", "unknown option '%s'", a);
+    } else if (!po.path) {
+      po.path = a;
+    } else {
+      return cli_usage_error("render", "unexpected argument '%s'", a);
+    }
+  }
+  // check the whole command line before doing any work
+  if (!po.path)
+    return cli_usage_error("render", "missing PLANT or CLOUD (.lpy, plant .json, or a .ply/.pcd/.xyz/.csv/.las cloud)");
+  if (!out) return cli_usage_error("render", "missing -o OUT.png");
+  if (!cli_has_ext(out, ".png"))
+    return cli_usage_error("render", "output '%s' must end in .png", out);
+  vd_camera_kind kind = VD_CAMERA_FRONT;
+  double az = 0, el = 0;
+  if (!parse_camera(camera_text, &kind, &az, &el))
+    return cli_usage_error(
+        "render", "--camera expects front, side, top or orbit[:AZ[:EL]] (degrees), got '%s'",
+        camera_text);
+  if (has_eye != has_lookat) return cli_usage_error("render", "--eye and --lookat go together");
+  struct stat sb;
+  if (stat(po.path, &sb) == 0 && S_ISDIR(sb.st_mode))
+    return cli_usage_error(
+        "render",
+        "'%s' is a folder: rendering simulation runs waits for the run format of "
+        "'verdant sim' (not yet available)",
+        po.path);
+  // point clouds in any format the cloud module reads; everything else is a plant
+  int is_cloud = cli_has_ext(po.path, ".ply") || cli_has_ext(po.path, ".pcd") || cli_has_ext(po.path, ".xyz") ||
+                 cli_has_ext(po.path, ".csv") || cli_has_ext(po.path, ".las");
+  if (is_cloud && style.color_by != VD_COLOR_LABEL && style.color_by != VD_COLOR_INSTANCE)
+    return cli_usage_error("render", "a point cloud is coloured by label or instance");
+  if (!is_cloud && style.color_by == VD_COLOR_STRESS)
+    return cli_usage_error("render",
+                           "--color-by stress needs a simulation state (a run of 'verdant sim'); "
+                           "a plant at rest carries no stress");
+  def.robot_mjcf = robot;
+  // load what is drawn
+  vd_error err = {0};
+  vd_status st;
+  vd_plant_spec* plant = NULL;
+  vd_model* model = NULL;
+  cli_grow_info ginfo;
+  memset(&ginfo, 0, sizeof ginfo);
+  vd_cloud cl;
+  memset(&cl, 0, sizeof cl);
+  vd_renderer* r = NULL;
+  int code = EXIT_OK;
+  if (is_cloud) {
+    st = vd_cloud_read(po.path, &cl, &err);
+    if (!st && cl.n > INT32_MAX) st = vd_error_set(&err, VD_ERR_LIMIT, po.path, 0, 0, "more than 2^31 points");
+  } else {
+    st = cli_load_plant(&po, &plant, &ginfo, &err);
+    if (!st) st = vd_plant_compile(plant, &model, &err);
+  }
+  if (st) {
+    code = cli_report("render", &err, st);
+    goto done;
+  }
+  // room in the scene for every organ instance (or cloud group) whatever the plant's size
+  {
+    long need = is_cloud ? cl.n : model->ninstance;
+    if (need + 16 > def.max_geoms) def.max_geoms = need + 16 > 10000000 ? 10000000 : (int)need + 16;
+  }
+  // the renderer: a missing OpenGL context is a failed run, not bad input
+  st = vd_render_create(&def, &r, &err);
+  if (st) {
+    code = cli_report("render", &err, st);
+    if (st == VD_ERR_UNSUPPORTED || st == VD_ERR_NOMEM) code = EXIT_FAIL;
+    goto done;
+  }
+  if (info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
+  if (is_cloud) {
+    vd_points pts = {(int)cl.n, cl.pos, cl.label, cl.instance, point_size, cl.labels, cl.nlabel};
+    st = vd_render_add_points(r, &pts, &style, &err);
+  } else {
+    st = vd_render_add_plant(r, model, NULL, &style, &err);
+  }
+  if (st) {
+    code = cli_report("render", &err, st);
+    goto done;
+  }
+  // the camera
+  vd_camera cam;
+  if (has_eye) {
+    cam.eye = eye, cam.lookat = lookat, cam.up = up;
+    cam.fovy = fov * VD_PI / 180;
+    double dist = vd_norm(vd_sub(lookat, eye));
+    cam.znear = fmax(1e-3, 0.01 * dist);
+    cam.zfar = 100 * dist + 60;
+  } else {
+    vd_vec3 lo, hi;
+    vd_render_bounds(r, &lo, &hi);
+    cam = vd_camera_preset(kind, az * VD_PI / 180, el * VD_PI / 180, lo, hi, def.width, def.height);
+    if (fov != 45) {
+      // keep the fitted view, narrow or widen the lens: move along the axis to keep the framing
+      double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2),
+             f1 = tan(fov * VD_PI / 360);
+      vd_vec3 dir = vd_normalize(vd_sub(cam.eye, cam.lookat));
+      cam.eye = vd_madd(cam.lookat, dir, d * f0 / f1);
+      cam.fovy = fov * VD_PI / 180;
+      cam.zfar += d * f0 / f1;
+    }
+  }
+  unsigned layers = VD_LAYER_COLOR | (depth ? VD_LAYER_DEPTH : 0) |
+                    (masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
+  vd_frame f;
+  st = vd_render_draw(r, &cam, layers, &f, &err);
+  if (st) {
+    code = cli_report("render", &err, st);
+    goto done;
+  }
+  // the files: colour, then depth and masks, then the sidecar naming them
+  char p_depth[4200], p_label[4200], p_inst[4200], p_json[4200];
+  sibling(out, "depth.png", p_depth, sizeof p_depth);
+  sibling(out, "label.png", p_label, sizeof p_label);
+  sibling(out, "instance.png", p_inst, sizeof p_inst);
+  sibling(out, "json", p_json, sizeof p_json);
+  st = vd_render_write_png(&f, VD_LAYER_COLOR, out, &err);
+  if (!st && depth) st = vd_render_write_png(&f, VD_LAYER_DEPTH, p_depth, &err);
+  if (!st && masks) st = vd_render_write_png(&f, VD_LAYER_LABEL, p_label, &err);
+  if (!st && masks) st = vd_render_write_png(&f, VD_LAYER_INSTANCE, p_inst, &err);
+  if (!st && (depth || masks)) {
+    const char* files[12];
+    int nf = 0;
+    files[nf++] = "color", files[nf++] = out;
+    if (depth) files[nf++] = "depth", files[nf++] = p_depth;
+    if (masks)
+      files[nf++] = "label", files[nf++] = p_label, files[nf++] = "instance", files[nf++] = p_inst;
+    files[nf] = NULL;
+    st = vd_render_write_json(&f, files, p_json, &err);
+  }
+  if (st)
+    code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL)
+                           : cli_report("render", &err, st);
+done:
+  vd_render_destroy(r);
+  vd_model_destroy(model);
+  vd_plant_spec_destroy(plant);
+  cli_grow_info_free(&ginfo);
+  vd_cloud_free(&cl);
+  return code;
+}

@@ -1,0 +1,269 @@
+// SPDX-License-Identifier: MIT
+// The renderer's lifetime: defaults, the OpenGL context, the stage model (floor, sky) written as
+// MJCF into MuJoCo's in-memory file system or a robot's MJCF, MuJoCo's scene and context, image
+// buffers.
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "render_internal.h"
+
+vd_render_def vd_render_def_default(void) {
+  vd_render_def d;
+  memset(&d, 0, sizeof d);
+  d.width = 640;
+  d.height = 480;
+  d.supersample = 2;
+  d.shadows = 1;
+  d.floor = 1;
+  d.sky = 1;
+  d.background[0] = d.background[1] = d.background[2] = 1.0f;
+  d.light_azimuth = -2.0;
+  d.light_elevation = 1.0;
+  d.light = 0.6;
+  d.headlight = 0.35;
+  d.ambient = 0.3;
+  d.legend = 1;
+  d.max_geoms = 20000;
+  d.robot_mjcf = NULL;
+  return d;
+}
+
+vd_render_style vd_render_style_default(void) {
+  vd_render_style s;
+  memset(&s, 0, sizeof s);
+  s.color_by = VD_COLOR_LABEL;
+  return s;
+}
+
+// is x a finite number in [lo, hi]?
+static int in_range(double x, double lo, double hi) {
+  return isfinite(x) && x >= lo && x <= hi;
+}
+
+// check the settings, naming the first bad field
+static vd_status check_def(const vd_render_def* d, vd_error* err) {
+  const char* bad = NULL;
+  if (d->width < 1 || d->width > 8192)
+    bad = "width (1..8192 pixels)";
+  else if (d->height < 1 || d->height > 8192)
+    bad = "height (1..8192 pixels)";
+  else if (d->supersample < 1 || d->supersample > 4)
+    bad = "supersample (1..4)";
+  else if ((long)d->width * d->supersample > 16384 || (long)d->height * d->supersample > 16384)
+    bad = "width or height x supersample (at most 16384 pixels)";
+  else if (!in_range(d->light_azimuth, -1e3, 1e3))
+    bad = "light_azimuth (finite, rad)";
+  else if (!in_range(d->light_elevation, 1e-3, VD_PI / 2 + 1e-9))
+    bad = "light_elevation (0..pi/2 rad)";
+  else if (!in_range(d->light, 0, 1))
+    bad = "light (0..1)";
+  else if (!in_range(d->headlight, 0, 1))
+    bad = "headlight (0..1)";
+  else if (!in_range(d->ambient, 0, 1))
+    bad = "ambient (0..1)";
+  else if (d->max_geoms < 1 || d->max_geoms > 10000000)
+    bad = "max_geoms (1..10000000)";
+  for (int k = 0; !bad && k < 3; k++)
+    if (!in_range(d->background[k], 0, 1)) bad = "background (each in 0..1)";
+  if (bad) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad render setting: %s", bad);
+  return VD_OK;
+}
+
+// the stage: a floor plane and a sky, as MJCF text (lights are set per frame)
+static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
+  const float* bg = d->background;
+  return snprintf(
+      buf, cap,
+      "<mujoco model=\"verdant_stage\">\n"
+      "  <visual>\n"
+      "    <global offwidth=\"%d\" offheight=\"%d\"/>\n"
+      "    <quality shadowsize=\"2048\" offsamples=\"0\"/>\n"
+      "  </visual>\n"
+      "  <asset>\n"
+      "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"%g %g %g\" rgb2=\"%g "
+      "%g %g\" "
+      "width=\"256\" height=\"1536\"/>\n"
+      "    <texture name=\"ground\" type=\"2d\" builtin=\"checker\" rgb1=\"0.62 0.57 0.50\" "
+      "rgb2=\"0.55 0.50 0.43\" width=\"256\" height=\"256\"/>\n"
+      "    <material name=\"ground\" texture=\"ground\" texrepeat=\"2 2\" texuniform=\"true\"/>\n"
+      "  </asset>\n"
+      "  <worldbody>\n"
+      "%s"
+      "  </worldbody>\n"
+      "</mujoco>\n",
+      d->width * d->supersample, d->height * d->supersample, d->sky ? 0.92 : bg[0],
+      d->sky ? 0.95 : bg[1], d->sky ? 1.0 : bg[2], d->sky ? 0.55 : bg[0], d->sky ? 0.68 : bg[1],
+      d->sky ? 0.85 : bg[2],
+      d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 3\" material=\"ground\"/>\n"
+               : "");
+}
+
+// load the stage from memory, or the robot from its file; NULL with *st and err set on failure
+static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
+  char msg[1000] = "";
+  mjModel* m = NULL;
+  if (r->def.robot_mjcf) {
+    m = mj_loadXML(r->robot_path, NULL, msg, sizeof msg);
+    if (!m) *st = vd_error_set(err, VD_ERR_FORMAT, r->robot_path, 0, 0, "robot MJCF: %s", msg);
+    return m;
+  }
+  char xml[4096];
+  int len = stage_xml(&r->def, xml, sizeof xml);
+  r->vfs = vd_malloc(sizeof *r->vfs);
+  if (!r->vfs) {
+    *st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    return NULL;
+  }
+  mj_defaultVFS(r->vfs);
+  if (mj_makeEmptyFileVFS(r->vfs, "stage.xml", len) != 0) {
+    mj_deleteVFS(r->vfs);
+    *st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "MuJoCo's file system refused the stage");
+    return NULL;
+  }
+  int i = mj_findFileVFS(r->vfs, "stage.xml");
+  memcpy(r->vfs->filedata[i], xml, (size_t)len);
+  m = mj_loadXML("stage.xml", r->vfs, msg, sizeof msg);
+  if (!m) *st = vd_error_set(err, VD_ERR_FORMAT, "", 0, 0, "stage model: %s", msg);
+  // the file system is needed for loading only
+  mj_deleteVFS(r->vfs);
+  vd_free(r->vfs, sizeof *r->vfs);
+  r->vfs = NULL;
+  return m;
+}
+
+// MuJoCo part of create, under the error guard
+static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
+  jmp_buf jb;
+  jmp_buf* prev = mjguard_push(&jb);
+  if (setjmp(jb)) {
+    mjguard_pop(prev);
+    return vd_error_set(err, VD_ERR_FORMAT, r->def.robot_mjcf ? r->robot_path : "", 0, 0,
+                        "MuJoCo: %s", mjguard_message());
+  }
+  vd_status st = VD_OK;
+  r->m = load_model(r, &st, err);
+  if (r->m) {
+    // offscreen buffer for the supersampled colour pass; no multisampling (exact id pass)
+    r->m->vis.global.offwidth = r->def.width * r->def.supersample;
+    r->m->vis.global.offheight = r->def.height * r->def.supersample;
+    r->m->vis.quality.offsamples = 0;
+    r->m->vis.quality.shadowsize = 2048;
+    r->d = mj_makeData(r->m);
+    mj_forward(r->m, r->d);
+    mjv_defaultOption(&r->opt);
+    mjv_defaultPerturb(&r->pert);
+    mjv_defaultCamera(&r->mjcam);
+    mjv_defaultScene(&r->scn);
+    mjv_makeScene(r->m, &r->scn, r->m->ngeom + 16 + r->def.max_geoms);
+    mjr_defaultContext(&r->con);
+    int k = r->def.supersample;
+    mjr_makeContext(r->m, &r->con,
+                    k >= 3   ? mjFONTSCALE_300
+                    : k == 2 ? mjFONTSCALE_200
+                             : mjFONTSCALE_100);
+    r->have_mj = 1;
+    mjr_setBuffer(mjFB_OFFSCREEN, &r->con);
+    if (r->con.currentBuffer != mjFB_OFFSCREEN)
+      st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
+                        "no OpenGL context: MuJoCo has no offscreen buffer");
+  }
+  mjguard_pop(prev);
+  return st;
+}
+
+vd_status vd_render_create(const vd_render_def* def, vd_renderer** out, vd_error* err) {
+  *out = NULL;
+  vd_render_def d = def ? *def : vd_render_def_default();
+  vd_status st = check_def(&d, err);
+  if (st) return st;
+  if (d.robot_mjcf && strlen(d.robot_mjcf) >= 4096)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "robot MJCF path too long");
+  vd_renderer* r = vd_calloc(1, sizeof *r);
+  if (!r) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  r->def = d;
+  if (d.robot_mjcf) {
+    snprintf(r->robot_path, sizeof r->robot_path, "%s", d.robot_mjcf);
+    r->def.robot_mjcf = r->robot_path;
+  }
+  mjguard_install();
+  // the context first: without one nothing else can be made
+  st = gl_create(&r->gl, err);
+  r->have_gl = r->gl.api != NULL;
+  if (!st) st = make_mujoco(r, err);
+  // image buffers
+  if (!st) {
+    size_t n = (size_t)d.width * (size_t)d.height,
+           k2 = (size_t)d.supersample * (size_t)d.supersample;
+    r->big = vd_malloc(3 * n * k2);
+    r->rgb = vd_malloc(3 * n);
+    r->ids = vd_malloc(3 * n);
+    r->zbuf = vd_malloc(n * sizeof(float));
+    r->depth = vd_malloc(n * sizeof(double));
+    r->label = vd_malloc(n * sizeof(uint16_t));
+    r->instance = vd_malloc(n * sizeof(uint16_t));
+    if (!r->big || !r->rgb || !r->ids || !r->zbuf || !r->depth || !r->label || !r->instance)
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  if (st) {
+    vd_render_destroy(r);
+    return st;
+  }
+  *out = r;
+  return VD_OK;
+}
+
+void vd_render_destroy(vd_renderer* r) {
+  if (!r) return;
+  vd_error ignore;
+  if (r->have_gl && r->gl.ctx) gl_current(&r->gl, &ignore);
+  render_items_free(r);
+  vd_free(r->items, sizeof(item) * (size_t)r->cap_item);
+  vd_free(r->clouds, sizeof(cloud) * (size_t)r->cap_cloud);
+  vd_free(r->legend, sizeof(vd_legend_entry) * (size_t)r->cap_legend);
+  if (r->have_mj) {
+    mjr_freeContext(&r->con);
+    mjv_freeScene(&r->scn);
+  }
+  if (r->d) mj_deleteData(r->d);
+  if (r->m) mj_deleteModel(r->m);
+  if (r->vfs) mj_deleteVFS(r->vfs);
+  vd_free(r->vfs, sizeof *r->vfs);
+  if (r->have_gl) gl_destroy(&r->gl);
+  size_t n = (size_t)r->def.width * (size_t)r->def.height;
+  size_t k2 = (size_t)r->def.supersample * (size_t)r->def.supersample;
+  vd_free(r->big, 3 * n * k2);
+  vd_free(r->rgb, 3 * n);
+  vd_free(r->ids, 3 * n);
+  vd_free(r->zbuf, n * sizeof(float));
+  vd_free(r->depth, n * sizeof(double));
+  vd_free(r->label, n * sizeof(uint16_t));
+  vd_free(r->instance, n * sizeof(uint16_t));
+  vd_free(r, sizeof *r);
+}
+
+const char* vd_render_info(const vd_renderer* r) {
+  return r->gl.info;
+}
+
+vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err) {
+  if (!r->def.robot_mjcf)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the renderer has no robot");
+  if (nq != r->m->nq)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "robot qpos has %d values, the model needs %d",
+                        nq, r->m->nq);
+  for (int i = 0; i < nq; i++)
+    if (!isfinite(qpos[i]))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "robot qpos[%d] is not finite", i);
+  jmp_buf jb;
+  jmp_buf* prev = mjguard_push(&jb);
+  if (setjmp(jb)) {
+    mjguard_pop(prev);
+    return vd_error_set(err, VD_ERR_VALUE, r->robot_path, 0, 0, "MuJoCo: %s", mjguard_message());
+  }
+  memcpy(r->d->qpos, qpos, sizeof(double) * (size_t)nq);
+  mj_forward(r->m, r->d);
+  mjguard_pop(prev);
+  return VD_OK;
+}

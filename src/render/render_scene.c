@@ -1,0 +1,511 @@
+// SPDX-License-Identifier: MIT
+// What a frame shows: plants tessellated into one display list per organ instance (so that the
+// id pass writes exact label and instance masks), point clouds grouped the same way and splatted
+// as camera-facing squares, colours by label, instance, stress or displacement, and the legend.
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render_internal.h"
+
+// ---------------------------------------------------------------------------------------------
+// colours
+
+// viridis at 9 evenly spaced points (matplotlib's colour map, sampled)
+static const float viridis[9][3] = {
+    {0.267f, 0.005f, 0.329f}, {0.279f, 0.175f, 0.483f}, {0.230f, 0.322f, 0.546f},
+    {0.173f, 0.449f, 0.558f}, {0.128f, 0.567f, 0.551f}, {0.153f, 0.683f, 0.502f},
+    {0.369f, 0.789f, 0.383f}, {0.678f, 0.864f, 0.190f}, {0.993f, 0.906f, 0.144f}};
+
+void render_colormap(double t, float rgb[3]) {
+  if (!(t >= 0)) t = 0; // NaN too
+  if (t > 1) t = 1;
+  double x = t * 8;
+  int i = (int)x;
+  if (i > 7) i = 7;
+  double f = x - i;
+  for (int k = 0; k < 3; k++)
+    rgb[k] = (float)(viridis[i][k] * (1 - f) + viridis[i + 1][k] * f);
+}
+
+// a distinct colour per instance: hues by the golden ratio
+static void instance_rgb(int inst, float rgb[3]) {
+  double h = fmod(inst * 0.6180339887498949, 1.0) * 6, s = 0.65, v = 0.92;
+  int i = (int)h;
+  double f = h - i, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  double c[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+  for (int k = 0; k < 3; k++)
+    rgb[k] = (float)c[i % 6][k];
+}
+
+// grey for primitives without a value (leaves and fruits under colour by stress)
+static const float no_value_rgb[3] = {0.62f, 0.62f, 0.62f};
+
+// ---------------------------------------------------------------------------------------------
+// tables
+
+// append an item; NULL when out of memory
+static item* new_item(vd_renderer* r) {
+  if (r->nitem == r->cap_item) {
+    int cap = r->cap_item;
+    if (!vd_grow((void**)&r->items, &cap, r->nitem + 1, sizeof(item))) return NULL;
+    r->cap_item = cap;
+  }
+  item* it = &r->items[r->nitem++];
+  memset(it, 0, sizeof *it);
+  it->cloud = -1;
+  it->rgba[3] = 1;
+  return it;
+}
+
+// add a label to the legend (sorted by id; the first name given for an id stays)
+static vd_status legend_add(vd_renderer* r, int id, const char* name, const float rgb[3]) {
+  int lo = 0, hi = r->nlegend;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (r->legend[mid].id < id)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  if (lo < r->nlegend && r->legend[lo].id == id) return VD_OK;
+  if (r->nlegend == r->cap_legend) {
+    int cap = r->cap_legend;
+    if (!vd_grow((void**)&r->legend, &cap, r->nlegend + 1, sizeof(vd_legend_entry)))
+      return VD_ERR_NOMEM;
+    r->cap_legend = cap;
+  }
+  memmove(r->legend + lo + 1, r->legend + lo, sizeof(vd_legend_entry) * (size_t)(r->nlegend - lo));
+  vd_legend_entry* e = &r->legend[lo];
+  memset(e, 0, sizeof *e);
+  e->id = id;
+  if (name) {
+    strncpy(e->name, name, VD_LABEL_NAME_MAX - 1);
+  } else {
+    char buf[32];
+    snprintf(buf, sizeof buf, "label_%d", id);
+    memcpy(e->name, buf, strlen(buf) + 1);
+  }
+  memcpy(e->rgb, rgb, sizeof e->rgb);
+  r->nlegend++;
+  return VD_OK;
+}
+
+// grow the bounds of everything added, and of what is above the floor
+static void bounds_add(vd_renderer* r, vd_vec3 p) {
+  r->lo = r->has_bounds ? vd_vmin(r->lo, p) : p;
+  r->hi = r->has_bounds ? vd_vmax(r->hi, p) : p;
+  r->has_bounds = 1;
+  if (p.z >= 0) {
+    r->lo_up = r->has_bounds_up ? vd_vmin(r->lo_up, p) : p;
+    r->hi_up = r->has_bounds_up ? vd_vmax(r->hi_up, p) : p;
+    r->has_bounds_up = 1;
+  }
+}
+
+int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi) {
+  // with a floor, what lies under it (roots) is hidden: the bounds are those of what is above
+  int up = r->def.floor && r->has_bounds_up;
+  int any = r->has_bounds;
+  *lo = up ? r->lo_up : any ? r->lo : vd_v3(0, 0, 0);
+  *hi = up ? r->hi_up : any ? r->hi : vd_v3(0, 0, 0);
+  // the robot's geoms (bounding spheres), world geoms such as its floor left out
+  if (r->def.robot_mjcf)
+    for (int g = 0; g < r->m->ngeom; g++) {
+      if (r->m->geom_bodyid[g] == 0) continue;
+      const double* p = r->d->geom_xpos + 3 * g;
+      double s = r->m->geom_rbound[g];
+      vd_vec3 a = vd_v3(p[0] - s, p[1] - s, p[2] - s), b = vd_v3(p[0] + s, p[1] + s, p[2] + s);
+      *lo = any ? vd_vmin(*lo, a) : a;
+      *hi = any ? vd_vmax(*hi, b) : b;
+      any = 1;
+    }
+  return any;
+}
+
+void render_items_free(vd_renderer* r) {
+  for (int i = 0; i < r->nitem; i++) {
+    gl_list_free(&r->gl, r->items[i].list);
+    gl_list_free(&r->gl, r->items[i].list_rgb);
+  }
+  r->nitem = 0;
+  for (int c = 0; c < r->ncloud; c++) {
+    vd_free(r->clouds[c].xyz, sizeof(double) * 3 * (size_t)r->clouds[c].n);
+    vd_free(r->clouds[c].order, sizeof(int) * (size_t)r->clouds[c].n);
+  }
+  r->ncloud = 0;
+  r->cloud_lists_valid = 0;
+}
+
+void vd_render_clear(vd_renderer* r) {
+  vd_error ignore;
+  if (r->gl.ctx) gl_current(&r->gl, &ignore);
+  render_items_free(r);
+  r->nlegend = 0;
+  r->nadded = 0;
+  r->has_bounds = r->has_bounds_up = 0;
+  r->range_min = r->range_max = 0;
+}
+
+// check a style for a plant (nseg segments) or a cloud (nseg < 0)
+static vd_status check_style(const vd_render_style* s, int nseg, vd_error* err) {
+  if ((int)s->color_by < VD_COLOR_LABEL || s->color_by > VD_COLOR_DISPLACEMENT)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "unknown colouring %d", (int)s->color_by);
+  if (nseg < 0 && s->color_by != VD_COLOR_LABEL && s->color_by != VD_COLOR_INSTANCE)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "a point cloud is coloured by label or instance only");
+  if (s->color_by == VD_COLOR_STRESS && !s->seg_stress)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "colour by stress needs a stress per segment (a simulation state)");
+  if (!isfinite(s->range_min) || !isfinite(s->range_max))
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "colour range is not finite");
+  if (s->slices < 0 || s->slices == 1 || s->slices == 2 || s->slices > 1024)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "slices must be 0 or 3..1024, got %d",
+                        s->slices);
+  return VD_OK;
+}
+
+// ---------------------------------------------------------------------------------------------
+// plants
+
+// sort key of a triangle or point: one group per (label, instance), input order inside
+typedef struct key {
+  int label, instance, index;
+} key;
+static int cmp_key(const void* a, const void* b) {
+  const key *x = a, *y = b;
+  if (x->label != y->label) return x->label < y->label ? -1 : 1;
+  if (x->instance != y->instance) return x->instance < y->instance ? -1 : 1;
+  return (x->index > y->index) - (x->index < y->index);
+}
+
+// distance of a point of state d from the same point at rest (m)
+static double moved(const double* now, const double* rest) {
+  double dx = now[0] - rest[0], dy = now[1] - rest[1], dz = now[2] - rest[2];
+  return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// value of each primitive for colour by stress or displacement (NaN: no value)
+static void prim_values(const vd_model* m, const vd_data* d, const vd_render_style* s, double* seg,
+                        double* sph, double* msh) {
+  for (int i = 0; i < m->nseg; i++) {
+    if (s->color_by == VD_COLOR_STRESS) {
+      seg[i] = s->seg_stress[i];
+    } else {
+      int a = m->seg_node[2 * i], b = m->seg_node[2 * i + 1];
+      seg[i] = d ? 0.5 * (moved(d->node_pos + 3 * a, m->node_pos0 + 3 * a) +
+                          moved(d->node_pos + 3 * b, m->node_pos0 + 3 * b))
+                 : 0;
+    }
+  }
+  for (int i = 0; i < m->nsphere; i++)
+    sph[i] = s->color_by == VD_COLOR_STRESS ? NAN
+             : d                            ? moved(d->sphere_pos + 3 * i, m->sphere_pos0 + 3 * i)
+                                            : 0;
+  for (int i = 0; i < m->nmesh; i++) {
+    if (s->color_by == VD_COLOR_STRESS) {
+      msh[i] = NAN;
+      continue;
+    }
+    double sum = 0;
+    int v0 = m->mesh_vert[2 * i], nv = m->mesh_vert[2 * i + 1];
+    for (int v = v0; d && v < v0 + nv; v++)
+      sum += moved(d->vert_pos + 3 * v, m->vert_pos0 + 3 * v);
+    msh[i] = nv ? sum / nv : 0;
+  }
+}
+
+// half thickness given to open surfaces (leaves) drawn from both sides (m): the two faces lie
+// apart, so neither shadows nor depth-tests the other (real leaves are 0.1-0.5 mm thick)
+#define LEAF_HALF_THICKNESS 1e-4
+
+// emit triangle t of mesh into the float arrays at slot k; side 0: as is, 1 or -1: a face of
+// an open surface moved along its normal by side x LEAF_HALF_THICKNESS (-1 reversed, facing back)
+static void put_tri(const vd_mesh* mesh, int t, int side, const float* rgb, float* pos, float* nrm,
+                    float* col, int k) {
+  int flip = side < 0;
+  for (int c = 0; c < 3; c++) {
+    int v = mesh->tri[3 * t + (flip ? 2 - c : c)];
+    for (int x = 0; x < 3; x++) {
+      pos[9 * k + 3 * c + x] =
+          (float)(mesh->pos[3 * v + x] + side * LEAF_HALF_THICKNESS * mesh->normal[3 * v + x]);
+      nrm[9 * k + 3 * c + x] = (float)(flip ? -mesh->normal[3 * v + x] : mesh->normal[3 * v + x]);
+      if (col) col[9 * k + 3 * c + x] = rgb[x];
+    }
+  }
+}
+
+vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* d,
+                              const vd_render_style* style, vd_error* err) {
+  vd_render_style s = style ? *style : vd_render_style_default();
+  vd_status st = check_style(&s, m->nseg, err);
+  if (st) return st;
+  if (d && (d->nnode != m->nnode || d->nseg != m->nseg || d->nsphere != m->nsphere ||
+            d->nvert != m->nvert))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "the state does not belong to this model (sizes differ)");
+  if (s.color_by == VD_COLOR_STRESS)
+    for (int i = 0; i < m->nseg; i++)
+      if (!isfinite(s.seg_stress[i]))
+        return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "stress of segment %d is not finite", i);
+  if ((st = gl_current(&r->gl, err))) return st;
+  // the plant as labelled triangles
+  vd_mesh mesh;
+  vd_mesh_def md = vd_mesh_def_default();
+  md.slices = s.slices;
+  if ((st = vd_geom_tessellate(m, d, &md, &mesh, err))) return st;
+  for (int t = 0; t < mesh.ntri; t++)
+    if (mesh.tri_label[t] < 0 || mesh.tri_label[t] >= VD_RENDER_ROBOT_LABEL ||
+        mesh.tri_instance[t] < 0 || mesh.tri_instance[t] > 65535) {
+      vd_mesh_free(&mesh);
+      return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                          "label %d / instance %d do not fit the 16-bit masks (labels 0..65534, "
+                          "instances 0..65535)",
+                          mesh.tri_label[t], mesh.tri_instance[t]);
+    }
+  // scratch: triangle order, per-primitive values, one group's vertex arrays (x2 for back faces)
+  size_t nt = (size_t)mesh.ntri;
+  key* order = vd_malloc(nt ? nt * sizeof(key) : 1);
+  double* val = vd_malloc(sizeof(double) * (size_t)(m->nseg + m->nsphere + m->nmesh + 1));
+  float* buf = vd_malloc(nt ? sizeof(float) * 2 * nt * 27 : 1);
+  if (!order || !val || !buf) {
+    st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    goto done;
+  }
+  int value_mode = s.color_by == VD_COLOR_STRESS || s.color_by == VD_COLOR_DISPLACEMENT;
+  double* vseg = val;
+  double* vsph = val + m->nseg;
+  double* vmsh = vsph + m->nsphere;
+  double lo = s.range_min, hi = s.range_max;
+  if (value_mode) {
+    prim_values(m, d, &s, vseg, vsph, vmsh);
+    if (!(hi > lo)) {
+      lo = INFINITY, hi = -INFINITY;
+      for (int i = 0; i < m->nseg + m->nsphere + m->nmesh; i++)
+        if (isfinite(val[i])) lo = fmin(lo, val[i]), hi = fmax(hi, val[i]);
+      if (!(hi >= lo)) lo = hi = 0;
+    }
+    r->range_min = lo;
+    r->range_max = hi;
+  }
+  for (size_t t = 0; t < nt; t++)
+    order[t] = (key){mesh.tri_label[t], mesh.tri_instance[t], (int)t};
+  if (nt) qsort(order, nt, sizeof(key), cmp_key);
+  for (int v = 0; v < mesh.nvert; v++)
+    bounds_add(r, vd_v3(mesh.pos[3 * v], mesh.pos[3 * v + 1], mesh.pos[3 * v + 2]));
+  if (r->nadded == 0) r->color_by = s.color_by;
+  // one item per (label, instance)
+  for (size_t g0 = 0, g1; g0 < nt; g0 = g1) {
+    int label = order[g0].label, inst = order[g0].instance;
+    for (g1 = g0 + 1; g1 < nt && order[g1].label == label && order[g1].instance == inst; g1++) {
+    }
+    item* it = new_item(r);
+    if (!it) {
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+      goto done;
+    }
+    it->kind = ITEM_PLANT;
+    it->label = label;
+    it->instance = inst;
+    const vd_label* lab = vd_model_find_label(m, label);
+    float lrgb[3];
+    if (lab)
+      memcpy(lrgb, lab->rgb, sizeof lrgb);
+    else
+      vd_plant_default_rgb(label, lrgb);
+    if (s.color_by == VD_COLOR_LABEL)
+      memcpy(it->rgba, lrgb, sizeof lrgb);
+    else if (s.color_by == VD_COLOR_INSTANCE)
+      instance_rgb(inst, it->rgba);
+    else
+      it->rgba[0] = it->rgba[1] = it->rgba[2] = 1;
+    if (legend_add(r, label, lab ? lab->name : NULL, lrgb)) {
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+      goto done;
+    }
+    // the group's triangles; open surfaces (leaves) twice, the second copy facing back
+    size_t cap = 2 * (g1 - g0);
+    float* pos = buf;
+    float* nrm = buf + 9 * cap;
+    float* col = value_mode ? buf + 18 * cap : NULL;
+    int k = 0;
+    for (size_t j = g0; j < g1; j++) {
+      int t = order[j].index, prim = mesh.tri_prim[t], kind = mesh.tri_kind[t];
+      float rgb[3];
+      if (value_mode) {
+        double v = kind == VD_PRIM_SEGMENT  ? vseg[prim]
+                   : kind == VD_PRIM_SPHERE ? vsph[prim]
+                                            : vmsh[prim];
+        if (isfinite(v))
+          render_colormap(hi > lo ? (v - lo) / (hi - lo) : 0, rgb);
+        else
+          memcpy(rgb, no_value_rgb, sizeof rgb);
+      }
+      int open = kind == VD_PRIM_MESH && !m->mesh_closed[prim];
+      put_tri(&mesh, t, open, rgb, pos, nrm, col, k++);
+      if (open) put_tri(&mesh, t, -1, rgb, pos, nrm, col, k++);
+    }
+    gl_tris tris = {k, pos, nrm, NULL};
+    it->list = gl_list(&r->gl, &tris);
+    if (value_mode) {
+      tris.rgb = col;
+      it->list_rgb = gl_list(&r->gl, &tris);
+    }
+    if (!it->list || (value_mode && !it->list_rgb)) {
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the plant's geometry");
+      goto done;
+    }
+  }
+  r->nadded++;
+done:
+  vd_free(order, nt ? nt * sizeof(key) : 1);
+  vd_free(val, sizeof(double) * (size_t)(m->nseg + m->nsphere + m->nmesh + 1));
+  vd_free(buf, nt ? sizeof(float) * 2 * nt * 27 : 1);
+  vd_mesh_free(&mesh);
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// point clouds
+
+vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_render_style* style,
+                               vd_error* err) {
+  vd_render_style s = style ? *style : vd_render_style_default();
+  vd_status st = check_style(&s, -1, err);
+  if (st) return st;
+  if (p->n < 0) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "negative point count");
+  if (p->n > 0 && !p->xyz)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "points without positions");
+  if (!isfinite(p->radius) || p->radius < 0)
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "splat radius must be >= 0");
+  if (p->nlabel < 0 || (p->nlabel > 0 && !p->labels))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad label table");
+  for (int i = 0; i < p->n; i++) {
+    for (int k = 0; k < 3; k++)
+      if (!isfinite(p->xyz[3 * i + k]))
+        return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "point %d is not finite", i);
+    int l = p->label ? p->label[i] : 0, in = p->instance ? p->instance[i] : 0;
+    if (l < 0 || l >= VD_RENDER_ROBOT_LABEL || in < 0 || in > 65535)
+      return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                          "point %d: label %d / instance %d do not fit the 16-bit masks", i, l, in);
+  }
+  // keep a copy: the splats face the camera, so their lists are made at draw time
+  if (r->ncloud == r->cap_cloud) {
+    int cap = r->cap_cloud;
+    if (!vd_grow((void**)&r->clouds, &cap, r->ncloud + 1, sizeof(cloud)))
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    r->cap_cloud = cap;
+  }
+  cloud* c = &r->clouds[r->ncloud];
+  memset(c, 0, sizeof *c);
+  size_t n = (size_t)p->n;
+  key* keys = n ? vd_malloc(n * sizeof(key)) : NULL;
+  c->xyz = n ? vd_malloc(sizeof(double) * 3 * n) : NULL;
+  c->order = n ? vd_malloc(sizeof(int) * n) : NULL;
+  if (n && (!keys || !c->xyz || !c->order)) {
+    vd_free(keys, n * sizeof(key));
+    vd_free(c->xyz, sizeof(double) * 3 * n);
+    vd_free(c->order, sizeof(int) * n);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  c->n = p->n;
+  if (n) memcpy(c->xyz, p->xyz, sizeof(double) * 3 * n);
+  r->ncloud++;
+  vd_vec3 lo = vd_v3(0, 0, 0), hi = lo;
+  for (int i = 0; i < p->n; i++) {
+    vd_vec3 q = vd_v3(p->xyz[3 * i], p->xyz[3 * i + 1], p->xyz[3 * i + 2]);
+    lo = i ? vd_vmin(lo, q) : q;
+    hi = i ? vd_vmax(hi, q) : q;
+    bounds_add(r, q);
+    keys[i] = (key){p->label ? p->label[i] : 0, p->instance ? p->instance[i] : 0, i};
+  }
+  c->radius = p->radius > 0 ? p->radius : fmax(0.004 * vd_norm(vd_sub(hi, lo)), 1e-4);
+  if (n) qsort(keys, n, sizeof(key), cmp_key);
+  for (int i = 0; i < p->n; i++)
+    c->order[i] = keys[i].index;
+  vd_free(keys, n * sizeof(key));
+  if (r->nadded == 0) r->color_by = s.color_by;
+  // one item per (label, instance); the order keeps the labels and instances
+  for (int g0 = 0, g1; g0 < p->n; g0 = g1) {
+    int i0 = c->order[g0];
+    int label = p->label ? p->label[i0] : 0, inst = p->instance ? p->instance[i0] : 0;
+    for (g1 = g0 + 1; g1 < p->n; g1++) {
+      int j = c->order[g1];
+      if ((p->label ? p->label[j] : 0) != label || (p->instance ? p->instance[j] : 0) != inst)
+        break;
+    }
+    item* it = new_item(r);
+    if (!it) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    it->kind = ITEM_POINTS;
+    it->label = label;
+    it->instance = inst;
+    it->cloud = r->ncloud - 1;
+    it->start = g0;
+    it->count = g1 - g0;
+    const vd_label* lab = NULL;
+    for (int k = 0; k < p->nlabel; k++)
+      if (p->labels[k].id == label) lab = &p->labels[k];
+    float lrgb[3];
+    if (lab)
+      memcpy(lrgb, lab->rgb, sizeof lrgb);
+    else
+      vd_plant_default_rgb(label, lrgb);
+    if (s.color_by == VD_COLOR_INSTANCE)
+      instance_rgb(inst, it->rgba);
+    else
+      memcpy(it->rgba, lrgb, sizeof lrgb);
+    if (legend_add(r, label, lab ? lab->name : NULL, lrgb))
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  r->cloud_lists_valid = 0;
+  r->nadded++;
+  return VD_OK;
+}
+
+vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double fwd[3],
+                               const double right[3], const double up[3], vd_error* err) {
+  if (r->cloud_lists_valid && !memcmp(eye, r->cloud_eye, sizeof r->cloud_eye) &&
+      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd) &&
+      !memcmp(up, r->cloud_up, sizeof r->cloud_up))
+    return VD_OK;
+  // largest group, for one scratch buffer
+  int most = 0;
+  for (int i = 0; i < r->nitem; i++)
+    if (r->items[i].kind == ITEM_POINTS && r->items[i].count > most) most = r->items[i].count;
+  if (!most) return VD_OK;
+  size_t nf = (size_t)most * 2 * 9;
+  float* pos = vd_malloc(sizeof(float) * 2 * nf);
+  if (!pos) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  float* nrm = pos + nf;
+  vd_status st = VD_OK;
+  for (int i = 0; i < r->nitem && !st; i++) {
+    item* it = &r->items[i];
+    if (it->kind != ITEM_POINTS) continue;
+    const cloud* c = &r->clouds[it->cloud];
+    double s = c->radius;
+    // two triangles per point, a square facing the camera
+    static const double corner[6][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, -1}, {1, 1}, {-1, 1}};
+    for (int j = 0; j < it->count; j++) {
+      const double* q = c->xyz + 3 * c->order[it->start + j];
+      for (int v = 0; v < 6; v++)
+        for (int x = 0; x < 3; x++) {
+          pos[18 * j + 3 * v + x] =
+              (float)(q[x] + s * (corner[v][0] * right[x] + corner[v][1] * up[x]));
+          nrm[18 * j + 3 * v + x] = (float)-fwd[x];
+        }
+    }
+    gl_list_free(&r->gl, it->list);
+    gl_tris tris = {2 * it->count, pos, nrm, NULL};
+    it->list = gl_list(&r->gl, &tris);
+    if (!it->list)
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the cloud");
+  }
+  vd_free(pos, sizeof(float) * 2 * nf);
+  if (!st) {
+    memcpy(r->cloud_eye, eye, sizeof r->cloud_eye);
+    memcpy(r->cloud_fwd, fwd, sizeof r->cloud_fwd);
+    memcpy(r->cloud_up, up, sizeof r->cloud_up);
+    r->cloud_lists_valid = 1;
+  }
+  return st;
+}

@@ -1,0 +1,614 @@
+// SPDX-License-Identifier: MIT
+// render: camera presets and intrinsics; with an OpenGL context (tests that need one print why
+// and skip when none can be made here): masks agree with geometry (one leaf: its pixels carry its
+// label and instance, the background 0), depth of planes against ray casting within 1 mm, point
+// splats, a robot from MJCF, identical images for a seed, PNG round trips, bad input.
+#include <stdlib.h>
+
+#include "test.h"
+#include "verdant/verdant.h"
+
+// ---------------------------------------------------------------------------------------------
+// helpers
+
+// a renderer, or NULL after printing why the test is skipped
+static vd_renderer* renderer(vd_render_def* def) {
+  vd_renderer* r = NULL;
+  vd_error err = {0};
+  vd_status st = vd_render_create(def, &r, &err);
+  if (st == VD_ERR_UNSUPPORTED) {
+    char buf[1024];
+    fprintf(stderr, "  skip: %s\n", vd_error_format(&err, buf, sizeof buf));
+    return NULL;
+  }
+  CHECK_STATUS(st, VD_OK, err);
+  return r;
+}
+
+// small, fast settings: no shadows, no legend, no supersampling
+static vd_render_def small_def(int w, int h) {
+  vd_render_def d = vd_render_def_default();
+  d.width = w, d.height = h, d.supersample = 1, d.shadows = 0, d.legend = 0;
+  return d;
+}
+
+// a plant of one quad (two triangles) with the given corners, label and instance
+static vd_model* quad_plant(const vd_vec3 v[4], int label, int instance) {
+  vd_plant_spec* s = vd_plant_spec_create();
+  if (!s) return NULL;
+  vd_mesh_spec m = {0};
+  m.label = label, m.instance = instance, m.node = -1, m.parent = -1, m.module = -1;
+  int t[6] = {0, 1, 2, 0, 2, 3};
+  vd_plant_add_mesh(s, &m, v, 4, t, 2);
+  vd_plant_set_label(s, label, "leaf");
+  vd_model* model = NULL;
+  vd_error err = {0};
+  vd_plant_compile(s, &model, &err);
+  vd_plant_spec_destroy(s);
+  return model;
+}
+
+// a camera at eye looking along +Y with Z up
+static vd_camera cam_y(vd_vec3 eye, double fovy_deg) {
+  vd_camera c;
+  c.eye = eye;
+  c.lookat = vd_add(eye, vd_v3(0, 1, 0));
+  c.up = vd_v3(0, 0, 1);
+  c.fovy = fovy_deg * VD_PI / 180;
+  c.znear = 0.05;
+  c.zfar = 50;
+  return c;
+}
+
+// the bundled tomato for a seed, compiled
+static vd_model* tomato(uint64_t seed) {
+  vd_lsystem* ls = NULL;
+  vd_error err = {0};
+  if (vd_lsys_load(vdt_path("data/tomato.lpy"), &ls, &err)) return NULL;
+  vd_plant_spec* s = vd_plant_spec_create();
+  vd_lsys_def def = vd_lsys_def_default();
+  def.seed = seed;
+  vd_model* m = NULL;
+  if (s && !vd_lsys_grow(ls, &def, NULL, s, &err)) vd_plant_compile(s, &m, &err);
+  vd_plant_spec_destroy(s);
+  vd_lsys_destroy(ls);
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// cameras (no context needed)
+
+TEST(render, camera_preset_fits_box) {
+  vd_vec3 lo = vd_v3(-0.4, -0.3, 0), hi = vd_v3(0.5, 0.45, 1.4);
+  vd_camera_kind kinds[] = {VD_CAMERA_FRONT, VD_CAMERA_SIDE, VD_CAMERA_TOP, VD_CAMERA_ORBIT};
+  for (int k = 0; k < 4; k++) {
+    vd_camera c = vd_camera_preset(kinds[k], 0.7, 0.4, lo, hi, 640, 480);
+    vd_error err = {0};
+    CHECK_STATUS(vd_camera_check(&c, &err), VD_OK, err);
+    vd_intrinsics K = vd_camera_intrinsics(&c, 640, 480);
+    // every corner projects inside the image and between the clip planes
+    double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
+    for (int i = 0; i < 8; i++) {
+      vd_vec3 p = vd_v3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+      double u, v, z;
+      CHECK(vd_camera_project(&K, p, &u, &v, &z));
+      CHECK(u >= -0.5 && u <= 639.5 && v >= -0.5 && v <= 479.5);
+      CHECK(z > c.znear && z < c.zfar);
+      umin = fmin(umin, u), umax = fmax(umax, u), vmin = fmin(vmin, v), vmax = fmax(vmax, v);
+    }
+    // and the box fills the image in one direction (a tight fit, within the 8% margin)
+    CHECK(umax - umin > 0.8 * 640 || vmax - vmin > 0.8 * 480);
+  }
+}
+
+TEST(render, camera_intrinsics) {
+  vd_camera c = cam_y(vd_v3(0, -2, 0.5), 60);
+  vd_intrinsics K = vd_camera_intrinsics(&c, 400, 300);
+  CHECK_NEAR(K.fy, 150 / tan(VD_PI / 6), 1e-9);
+  CHECK_NEAR(K.fx, K.fy, 1e-12);
+  CHECK_NEAR(K.cx, 199.5, 1e-12);
+  CHECK_NEAR(K.cy, 149.5, 1e-12);
+  // the look-at point is the principal point; up in the world is up in the image (v smaller)
+  double u, v, z;
+  CHECK(vd_camera_project(&K, vd_v3(0, 0, 0.5), &u, &v, &z));
+  CHECK_NEAR(u, 199.5, 1e-9);
+  CHECK_NEAR(v, 149.5, 1e-9);
+  CHECK_NEAR(z, 2, 1e-12);
+  CHECK(vd_camera_project(&K, vd_v3(0.1, 0, 0.6), &u, &v, &z));
+  CHECK(u > 199.5 && v < 149.5);
+  CHECK(!vd_camera_project(&K, vd_v3(0, -3, 0.5), &u, &v, &z));
+  // bad cameras
+  vd_error err = {0};
+  vd_camera b = c;
+  b.fovy = 0;
+  CHECK_STATUS(vd_camera_check(&b, &err), VD_ERR_VALUE, err);
+  b = c, b.up = vd_v3(0, 1, 0);
+  CHECK_STATUS(vd_camera_check(&b, &err), VD_ERR_VALUE, err);
+  b = c, b.znear = 2, b.zfar = 1;
+  CHECK_STATUS(vd_camera_check(&b, &err), VD_ERR_VALUE, err);
+  b = c, b.eye.x = NAN;
+  CHECK_STATUS(vd_camera_check(&b, &err), VD_ERR_VALUE, err);
+  b = c, b.lookat = b.eye;
+  CHECK_STATUS(vd_camera_check(&b, &err), VD_ERR_VALUE, err);
+}
+
+TEST(render, bad_settings) {
+  vd_renderer* r = NULL;
+  vd_error err = {0};
+  vd_render_def d = vd_render_def_default();
+  d.width = 0;
+  CHECK_STATUS(vd_render_create(&d, &r, &err), VD_ERR_ARG, err);
+  d = vd_render_def_default(), d.supersample = 5;
+  CHECK_STATUS(vd_render_create(&d, &r, &err), VD_ERR_ARG, err);
+  d = vd_render_def_default(), d.ambient = NAN;
+  CHECK_STATUS(vd_render_create(&d, &r, &err), VD_ERR_ARG, err);
+  CHECK(r == NULL);
+}
+
+// ---------------------------------------------------------------------------------------------
+// masks and depth
+
+TEST(render, one_leaf_mask) {
+  vd_render_def d = small_def(200, 150);
+  d.floor = 0;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  // a leaf 0.4 x 0.3 m facing the camera 2 m away, label 2, instance 5
+  vd_vec3 v[4] = {{-0.2, 0, 0.35}, {0.2, 0, 0.35}, {0.2, 0, 0.65}, {-0.2, 0, 0.65}};
+  vd_model* m = quad_plant(v, 2, 5);
+  REQUIRE(m);
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+  vd_camera c = cam_y(vd_v3(0.03, -2, 0.52), 40);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
+  REQUIRE(f.label && f.instance && f.depth && f.rgb);
+  // the leaf's rectangle in the image from the intrinsics
+  double u0, v0, u1, v1, z;
+  vd_camera_project(&f.K, v[3], &u0, &v0, &z);
+  vd_camera_project(&f.K, v[1], &u1, &v1, &z);
+  int inside = 0, wrong = 0, edge = 0, area = 0;
+  for (int y = 0; y < f.height; y++)
+    for (int x = 0; x < f.width; x++) {
+      int l = f.label[y * f.width + x], in = f.instance[y * f.width + x];
+      // pixel centres more than half a pixel inside or outside the rectangle are certain
+      int in_rect = x > u0 + 0.5 && x < u1 - 0.5 && y > v0 + 0.5 && y < v1 - 0.5;
+      int out_rect = x < u0 - 0.5 || x > u1 + 0.5 || y < v0 - 0.5 || y > v1 + 0.5;
+      if (l) area++;
+      if (in_rect)
+        inside++, wrong += !(l == 2 && in == 5);
+      else if (out_rect)
+        wrong += l != 0 || in != 0;
+      else
+        edge += l != 0 && !(l == 2 && in == 5); // no mixed ids on the edge either
+    }
+  CHECK(inside > 1000);
+  CHECK_INT(wrong, 0);
+  CHECK_INT(edge, 0);
+  // the labelled area is the projected area within a pixel's border
+  double exact = (u1 - u0) * (v1 - v0);
+  CHECK(fabs(area - exact) < (u1 - u0 + v1 - v0) + 4);
+  // the sidecar legend names the leaf
+  CHECK_INT(f.nlegend, 1);
+  CHECK_INT(f.legend[0].id, 2);
+  CHECK_STR(f.legend[0].name, "leaf");
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}
+
+// distance along the optical axis to plane (p0, n) through pixel (u, v) of K, or 0
+static double ray_plane(const vd_intrinsics* K, double u, double v, vd_vec3 p0, vd_vec3 n) {
+  double X = (u - K->cx) / K->fx, Y = (v - K->cy) / K->fy;
+  vd_vec3 dir = vd_v3(K->R[0] * X + K->R[1] * Y + K->R[2], K->R[3] * X + K->R[4] * Y + K->R[5],
+                      K->R[6] * X + K->R[7] * Y + K->R[8]);
+  double den = vd_dot(dir, n);
+  if (fabs(den) < 1e-12) return 0;
+  return vd_dot(vd_sub(p0, K->t), n) / den; // dir has camera z = 1, so t is the depth
+}
+
+TEST(render, depth_of_planes) {
+  vd_render_def d = small_def(160, 120);
+  d.floor = 0;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_error err = {0};
+  // a plane facing the camera at 1.2345 m, and a plane tilted by 50 degrees
+  double dist = 1.2345;
+  vd_vec3 a[4] = {{-3, dist, -3}, {3, dist, -3}, {3, dist, 3}, {-3, dist, 3}};
+  double s = sin(50 * VD_PI / 180), co = cos(50 * VD_PI / 180);
+  vd_vec3 b[4] = {{-3, 2.5 - 3 * s, -3 * co},
+                  {3, 2.5 - 3 * s, -3 * co},
+                  {3, 2.5 + 3 * s, 3 * co},
+                  {-3, 2.5 + 3 * s, 3 * co}};
+  vd_vec3 nb = vd_normalize(vd_cross(vd_sub(b[1], b[0]), vd_sub(b[3], b[0])));
+  for (int k = 0; k < 2; k++) {
+    vd_render_clear(r);
+    vd_model* m = quad_plant(k ? b : a, 1, 1);
+    REQUIRE(m);
+    CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+    vd_camera c = cam_y(vd_v3(0, 0, 0), 50);
+    c.znear = 0.01;
+    c.zfar = 100;
+    vd_frame f;
+    CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_DEPTH | VD_LAYER_LABEL, &f, &err), VD_OK, err);
+    REQUIRE(f.depth && !f.rgb);
+    double worst = 0;
+    int n = 0;
+    for (int y = 0; y < f.height; y++)
+      for (int x = 0; x < f.width; x++) {
+        double want = ray_plane(&f.K, x, y, k ? b[0] : a[0], k ? nb : vd_v3(0, -1, 0));
+        double got = f.depth[y * f.width + x];
+        if (f.label[y * f.width + x] != 1) continue;
+        worst = fmax(worst, fabs(got - want));
+        n++;
+      }
+    CHECK(n > f.width * f.height * 9 / 10); // the planes (nearly) fill the view
+    CHECK(worst < 1e-3);
+    if (k == 0) {
+      // the 16-bit PNG holds millimetres
+      char path[512];
+      snprintf(path, sizeof path, "%s/depth.png", vdt_tmpdir());
+      CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_DEPTH, path, &err), VD_OK, err);
+      int w, h, ch, bits;
+      uint16_t* pix;
+      CHECK_STATUS(vd_render_read_png(path, &w, &h, &ch, &bits, &pix, &err), VD_OK, err);
+      if (pix) {
+        CHECK_INT(w * h, f.width * f.height);
+        CHECK_INT(ch, 1);
+        CHECK_INT(bits, 16);
+        CHECK(abs((int)pix[0] - 1235) <= 1); // 1234.5 mm, rounded
+        CHECK(abs((int)pix[w * h / 2 + w / 2] - 1235) <= 1);
+        vd_free(pix, (size_t)w * h * ch * sizeof(uint16_t));
+      }
+    }
+    vd_model_destroy(m);
+  }
+  vd_render_destroy(r);
+}
+
+TEST(render, tomato_masks_consistent) {
+  vd_render_def d = small_def(320, 240);
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_model* m = tomato(4);
+  REQUIRE(m);
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+  vd_vec3 lo, hi;
+  CHECK(vd_render_bounds(r, &lo, &hi));
+  vd_camera c = vd_camera_preset(VD_CAMERA_ORBIT, -1, 0.3, lo, hi, 320, 240);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
+  // every instance in the mask has one label, the one the model gives it; floor pixels are 0
+  // but have depth; sky pixels have no depth
+  int* inst_label = calloc((size_t)m->ninstance + 1, sizeof(int));
+  REQUIRE(inst_label);
+  for (int i = 0; i < m->nseg; i++)
+    inst_label[m->seg_instance[i]] = m->seg_label[i];
+  for (int i = 0; i < m->nsphere; i++)
+    inst_label[m->sphere_instance[i]] = m->sphere_label[i];
+  for (int i = 0; i < m->nmesh; i++)
+    inst_label[m->mesh_instance[i]] = m->mesh_label[i];
+  int plant = 0, bad = 0, floor_px = 0, sky = 0, labels_seen = 0;
+  for (int i = 0; i < f.width * f.height; i++) {
+    int in = f.instance[i], l = f.label[i];
+    if (in) {
+      plant++;
+      bad += in > m->ninstance || inst_label[in] != l;
+      labels_seen |= 1 << (l & 31);
+    } else {
+      bad += l != 0;
+      if (f.depth[i] > 0)
+        floor_px++;
+      else
+        sky++;
+    }
+  }
+  free(inst_label);
+  CHECK_INT(bad, 0);
+  CHECK(plant > 1000);
+  CHECK(floor_px > 1000 && sky > 1000);
+  CHECK(labels_seen & (1 << 2)); // leaves
+  CHECK(labels_seen & (1 << 1)); // stem
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}
+
+TEST(render, deterministic) {
+  // the same seed twice, from fresh renderers: identical colour and masks; another seed differs
+  uint8_t* rgb[3] = {NULL, NULL, NULL};
+  uint16_t* lab[3] = {NULL, NULL, NULL};
+  size_t n = 240 * 180;
+  uint64_t seeds[3] = {7, 7, 8};
+  int ran = 0;
+  for (int k = 0; k < 3; k++) {
+    vd_render_def d = vd_render_def_default();
+    d.width = 240, d.height = 180;
+    vd_renderer* r = renderer(&d);
+    if (!r) break;
+    vd_model* m = tomato(seeds[k]);
+    vd_error err = {0};
+    if (m) CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+    vd_vec3 lo, hi;
+    vd_render_bounds(r, &lo, &hi);
+    vd_camera c = vd_camera_preset(VD_CAMERA_FRONT, 0, 0, lo, hi, 240, 180);
+    vd_frame f;
+    CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR | VD_LAYER_LABEL, &f, &err), VD_OK, err);
+    rgb[k] = malloc(3 * n);
+    lab[k] = malloc(2 * n);
+    if (rgb[k] && lab[k] && f.rgb && f.label)
+      memcpy(rgb[k], f.rgb, 3 * n), memcpy(lab[k], f.label, 2 * n);
+    vd_render_destroy(r);
+    vd_model_destroy(m);
+    ran++;
+  }
+  if (ran == 3) {
+    CHECK(memcmp(rgb[0], rgb[1], 3 * n) == 0);
+    CHECK(memcmp(lab[0], lab[1], 2 * n) == 0);
+    CHECK(memcmp(lab[0], lab[2], 2 * n) != 0);
+  }
+  for (int k = 0; k < 3; k++)
+    free(rgb[k]), free(lab[k]);
+}
+
+TEST(render, colour_modes_and_legend) {
+  vd_render_def d = small_def(160, 120);
+  d.legend = 1;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_model* m = tomato(1);
+  REQUIRE(m);
+  vd_data* st = vd_data_create(m);
+  REQUIRE(st);
+  vd_error err = {0};
+  // displacement: move the whole plant by 3 cm, every primitive has moved 3 cm
+  for (int i = 0; i < 3 * m->nnode; i += 3)
+    st->node_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nsphere; i += 3)
+    st->sphere_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nvert; i += 3)
+    st->vert_pos[i] += 0.03;
+  vd_render_style s = vd_render_style_default();
+  s.color_by = VD_COLOR_DISPLACEMENT;
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
+  vd_vec3 lo, hi;
+  vd_render_bounds(r, &lo, &hi);
+  vd_camera c = vd_camera_preset(VD_CAMERA_FRONT, 0, 0, lo, hi, 160, 120);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK_NEAR(f.range_min, 0.03, 1e-9);
+  CHECK_NEAR(f.range_max, 0.03, 1e-9);
+  CHECK(f.color_by == VD_COLOR_DISPLACEMENT);
+  CHECK(f.nlegend >= 4); // the key of the label mask, whatever the colouring
+  // stress needs values; with them, the range is theirs
+  vd_render_clear(r);
+  s.color_by = VD_COLOR_STRESS;
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_ERR_ARG, err);
+  double* stress = malloc(sizeof(double) * (size_t)m->nseg);
+  REQUIRE(stress);
+  for (int i = 0; i < m->nseg; i++)
+    stress[i] = 1e5 * i;
+  s.seg_stress = stress;
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
+  CHECK_NEAR(f.range_max, 1e5 * (m->nseg - 1), 1e-6);
+  stress[3] = NAN;
+  vd_render_clear(r);
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_ERR_VALUE, err);
+  free(stress);
+  // by label: the legend lists the plant's labels in id order with their names
+  vd_render_clear(r);
+  CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK(f.nlegend >= 4);
+  for (int i = 1; i < f.nlegend; i++)
+    CHECK(f.legend[i].id > f.legend[i - 1].id);
+  CHECK(vd_model_find_label(m, f.legend[0].id) != NULL);
+  if (f.nlegend) CHECK_STR(f.legend[0].name, vd_model_find_label(m, f.legend[0].id)->name);
+  // a layer that was not drawn cannot be written; a bad layer mask is refused
+  CHECK_STATUS(vd_render_draw(r, &c, 0, &f, &err), VD_ERR_ARG, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  char path[512];
+  snprintf(path, sizeof path, "%s/none.png", vdt_tmpdir());
+  CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_LABEL, path, &err), VD_ERR_ARG, err);
+  vd_data_destroy(st);
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}
+
+TEST(render, point_splats) {
+  vd_render_def d = small_def(200, 150);
+  d.floor = 0;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  // two clusters of points: label 3 instance 7 on the left, label 4 instance 9 on the right
+  enum { N = 200 };
+  double xyz[3 * N];
+  int lab[N], inst[N];
+  for (int i = 0; i < N; i++) {
+    int right = i >= N / 2;
+    xyz[3 * i] = (right ? 0.3 : -0.3) + 0.002 * (i % 10);
+    xyz[3 * i + 1] = 0.01 * (i % 7);
+    xyz[3 * i + 2] = 0.5 + 0.002 * ((i / 10) % 10);
+    lab[i] = right ? 4 : 3;
+    inst[i] = right ? 9 : 7;
+  }
+  vd_label names[2] = {{3, "fruit", VD_ORGAN_FRUIT, {1, 0, 0}},
+                       {4, "leaf", VD_ORGAN_LEAF, {0, 1, 0}}};
+  vd_points p = {N, xyz, lab, inst, 0.01, names, 2};
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_add_points(r, &p, NULL, &err), VD_OK, err);
+  vd_camera c = cam_y(vd_v3(0, -2, 0.51), 40);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
+  // the pixel at each cluster's first point carries its ids; the corners are background
+  double u, v, z;
+  vd_camera_project(&f.K, vd_v3(xyz[0], xyz[1], xyz[2]), &u, &v, &z);
+  int at = (int)lround(v) * f.width + (int)lround(u);
+  CHECK_INT(f.label[at], 3);
+  CHECK_INT(f.instance[at], 7);
+  vd_camera_project(&f.K, vd_v3(xyz[3 * N - 3], xyz[3 * N - 2], xyz[3 * N - 1]), &u, &v, &z);
+  at = (int)lround(v) * f.width + (int)lround(u);
+  CHECK_INT(f.label[at], 4);
+  CHECK_INT(f.instance[at], 9);
+  CHECK_INT(f.label[0], 0);
+  CHECK_INT(f.nlegend, 2);
+  CHECK_STR(f.legend[1].name, "leaf");
+  // a second camera rebuilds the splats to face it
+  vd_camera c2 = c;
+  c2.eye = vd_v3(-2, 0.03, 0.51), c2.lookat = vd_v3(0, 0.03, 0.51); // label 3 in front
+  CHECK_STATUS(vd_render_draw(r, &c2, VD_LAYER_LABEL, &f, &err), VD_OK, err);
+  int n3 = 0;
+  for (int i = 0; i < f.width * f.height; i++)
+    n3 += f.label[i] == 3;
+  CHECK(n3 > 20);
+  // bad points
+  xyz[5] = NAN;
+  CHECK_STATUS(vd_render_add_points(r, &p, NULL, &err), VD_ERR_VALUE, err);
+  xyz[5] = 0;
+  lab[0] = 70000;
+  CHECK_STATUS(vd_render_add_points(r, &p, NULL, &err), VD_ERR_LIMIT, err);
+  lab[0] = 3;
+  vd_render_style s = vd_render_style_default();
+  s.color_by = VD_COLOR_DISPLACEMENT;
+  CHECK_STATUS(vd_render_add_points(r, &p, &s, &err), VD_ERR_ARG, err);
+  vd_render_destroy(r);
+}
+
+// a robot in MJCF: a red capsule standing in front of the plant
+static const char* robot_xml =
+    "<mujoco model=\"post\">\n"
+    "  <worldbody>\n"
+    "    <body name=\"post\" pos=\"0 -1 0.5\">\n"
+    "      <joint name=\"slide\" type=\"slide\" axis=\"1 0 0\"/>\n"
+    "      <geom type=\"capsule\" size=\"0.05 0.3\" rgba=\"0.8 0.2 0.2 1\"/>\n"
+    "    </body>\n"
+    "  </worldbody>\n"
+    "</mujoco>\n";
+
+TEST(render, robot_from_mjcf) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/post.xml", vdt_tmpdir());
+  FILE* fp = fopen(path, "w");
+  REQUIRE(fp);
+  fputs(robot_xml, fp);
+  fclose(fp);
+  vd_render_def d = small_def(160, 120);
+  d.robot_mjcf = path;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_camera c = cam_y(vd_v3(0, -3, 0.5), 40);
+  vd_frame f;
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_LABEL | VD_LAYER_DEPTH, &f, &err), VD_OK, err);
+  int mid = 60 * 160 + 80;
+  CHECK_INT(f.label[mid], VD_RENDER_ROBOT_LABEL);
+  CHECK_NEAR(f.depth[mid], 2 - 0.05, 2e-3);
+  // moving the joint moves the robot out of the centre
+  double q = 0.5;
+  CHECK_STATUS(vd_render_set_robot_qpos(r, &q, 1, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_LABEL, &f, &err), VD_OK, err);
+  CHECK_INT(f.label[mid], 0);
+  CHECK_STATUS(vd_render_set_robot_qpos(r, &q, 2, &err), VD_ERR_ARG, err);
+  vd_render_destroy(r);
+  // a broken or missing MJCF is a format error naming the file
+  fp = fopen(path, "w");
+  REQUIRE(fp);
+  fputs("<mujoco><worldbody><geom type=\"capsule\"", fp);
+  fclose(fp);
+  vd_renderer* bad = NULL;
+  vd_status st = vd_render_create(&d, &bad, &err);
+  if (st != VD_ERR_UNSUPPORTED) CHECK_STATUS(st, VD_ERR_FORMAT, err);
+  CHECK(bad == NULL);
+  snprintf(path, sizeof path, "%s/missing.xml", vdt_tmpdir());
+  st = vd_render_create(&d, &bad, &err);
+  if (st != VD_ERR_UNSUPPORTED) CHECK_STATUS(st, VD_ERR_FORMAT, err);
+}
+
+TEST(render, png_round_trip) {
+  // 16-bit masks and 8-bit colour come back unchanged; a file that is not a PNG is refused
+  enum { W = 37, H = 23 };
+  uint16_t lab[W * H], inst[W * H];
+  uint8_t rgb[W * H * 3];
+  for (int i = 0; i < W * H; i++)
+    lab[i] = (uint16_t)(i * 97), inst[i] = (uint16_t)(65535 - i), rgb[3 * i] = (uint8_t)i,
+    rgb[3 * i + 1] = (uint8_t)(i >> 3), rgb[3 * i + 2] = 7;
+  vd_frame f;
+  memset(&f, 0, sizeof f);
+  f.width = W, f.height = H, f.rgb = rgb, f.label = lab, f.instance = inst;
+  char path[512];
+  snprintf(path, sizeof path, "%s/rt.png", vdt_tmpdir());
+  vd_error err = {0};
+  int w, h, ch, bits;
+  uint16_t* pix;
+  CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_INSTANCE, path, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_read_png(path, &w, &h, &ch, &bits, &pix, &err), VD_OK, err);
+  if (pix) {
+    CHECK(w == W && h == H && ch == 1 && bits == 16);
+    CHECK(memcmp(pix, inst, sizeof inst) == 0);
+    vd_free(pix, (size_t)w * h * ch * 2);
+  }
+  CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_COLOR, path, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_read_png(path, &w, &h, &ch, &bits, &pix, &err), VD_OK, err);
+  if (pix) {
+    CHECK(ch == 3 && bits == 8);
+    int same = 1;
+    for (int i = 0; i < W * H * 3; i++)
+      same &= pix[i] == rgb[i];
+    CHECK(same);
+    vd_free(pix, (size_t)w * h * ch * 2);
+  }
+  // an unwritable path fails with nothing left behind; garbage is not a PNG
+  CHECK_STATUS(vd_render_write_png(&f, VD_LAYER_LABEL, "/nonexistent-dir/x.png", &err), VD_ERR_IO,
+               err);
+  snprintf(path, sizeof path, "%s/garbage.png", vdt_tmpdir());
+  FILE* fp = fopen(path, "w");
+  REQUIRE(fp);
+  fputs("not a png at all", fp);
+  fclose(fp);
+  CHECK_STATUS(vd_render_read_png(path, &w, &h, &ch, &bits, &pix, &err), VD_ERR_FORMAT, err);
+  CHECK(pix == NULL);
+}
+
+TEST(render, out_of_memory) {
+  // every allocation failing in turn: NOMEM (or success), never a crash, nothing leaked; first
+  // while creating a renderer, then while adding a plant and drawing with one
+  vd_vec3 v[4] = {{-0.2, 0, 0.35}, {0.2, 0, 0.35}, {0.2, 0, 0.65}, {-0.2, 0, 0.65}};
+  vd_model* m = quad_plant(v, 2, 5);
+  REQUIRE(m);
+  vd_render_def d = small_def(32, 24);
+  vd_renderer* r = renderer(&d);
+  if (!r) {
+    vd_model_destroy(m);
+    return;
+  }
+  vd_render_destroy(r);
+  r = NULL;
+  vd_error err = {0};
+  for (int budget = 0; budget < 100 && !r; budget++) {
+    vdt_oom_begin(budget);
+    vd_status st = vd_render_create(&d, &r, &err);
+    vdt_oom_end();
+    CHECK(st == VD_OK || st == VD_ERR_NOMEM);
+    CHECK(st == VD_OK || r == NULL);
+  }
+  REQUIRE(r);
+  int done = 0;
+  vd_camera c = cam_y(vd_v3(0, -2, 0.5), 40);
+  for (int budget = 0; budget < 200 && !done; budget++) {
+    vd_render_clear(r);
+    vd_frame f;
+    vdt_oom_begin(budget);
+    vd_status st = vd_render_add_plant(r, m, NULL, NULL, &err);
+    if (!st) st = vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err);
+    vdt_oom_end();
+    CHECK(st == VD_OK || st == VD_ERR_NOMEM);
+    if (st == VD_OK) {
+      done = 1;
+      CHECK_INT(f.label[12 * 32 + 16], 2);
+    }
+  }
+  CHECK(done);
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}
