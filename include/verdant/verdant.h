@@ -17,5 +17,6 @@
 #include "verdant/plant.h"
 #include "verdant/lsys.h"
 #include "verdant/geom.h"
+#include "verdant/sim.h"
 
 #endif
