@@ -61,5 +61,7 @@ vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int asci
 
 // Subcommands.
 int cli_grow(int argc, char** argv);
+int cli_sim(int argc, char** argv);
+int cli_validate(int argc, char** argv);
 
 #endif

@@ -17,6 +17,8 @@ static const char* main_help =
     "\n"
     "commands:\n"
     "  grow      L-system (.lpy) or plant file → plant JSON, OBJ or PLY, with --stats\n"
+    "  sim       plant physics (Cosserat rods): gravity, wind, probes, fracture → frames, events\n"
+    "  validate  the physics against analytic references (--json, --full)\n"
     "\n"
     "Run 'verdant <command> --help' for the options of a command.\n"
     "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
@@ -37,6 +39,8 @@ int main(int argc, char** argv) {
     return EXIT_OK;
   }
   if (!strcmp(cmd, "grow")) return cli_grow(argc - 1, argv + 1);
+  if (!strcmp(cmd, "sim")) return cli_sim(argc - 1, argv + 1);
+  if (!strcmp(cmd, "validate")) return cli_validate(argc - 1, argv + 1);
   fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
   fputs(main_help, stderr);
   return EXIT_USAGE;

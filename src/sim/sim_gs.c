@@ -14,9 +14,13 @@ static void inv_inertia(const vd_sim_model* m, const vd_sim_data* d, int t, doub
     m3_zero(out);
     return;
   }
-  double r[9];
+  // Gauss-Seidel needs the frames to be not much lighter than the nodes they are tied to:
+  // the inertia is floored at that of the segment as a rigid bar, m l^2 / 12 (a small change
+  // of the rotary inertia; the direct solver uses the exact one)
+  double r[9], l = m->seg_len0[t], bar = m->seg_mass[t] * l * l / 12;
+  double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
   m3_from_quat(r, d->seg_quat[t]);
-  m3_inv_inertia(out, r, m->seg_inertia[2 * t], m->seg_inertia[2 * t + 1]);
+  m3_inv_inertia(out, r, ib > bar ? ib : bar, it > bar ? it : bar);
 }
 
 // A = B W B^T for 3x3 matrices (W symmetric)

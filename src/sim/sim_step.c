@@ -225,7 +225,7 @@ vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d) {
 vd_sim_settle_def vd_sim_settle_def_default(void) {
   vd_sim_settle_def s;
   s.statics = 0;
-  s.ke_tol = 1e-7;
+  s.ke_tol = 1e-9;
   s.disp_tol = 1e-9;
   s.max_time = 10;
   s.max_steps = 400;
@@ -245,11 +245,13 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
     c.h = m->opt.dt;
     c.gamma = m->opt.damping / m->opt.dt;
     c.extra_damping = s->extra_damping;
-    double t0 = d->time;
+    // still means below the tolerance for a quarter second in a row (not one turning point)
+    double t0 = d->time, calm = 0;
     while (d->time - t0 < s->max_time) {
       if ((st = step_core(m, d, &c))) break;
       n++;
-      if (n >= 10 && vd_sim_kinetic_energy(m, d) < s->ke_tol) {
+      calm = vd_sim_kinetic_energy(m, d) < s->ke_tol ? calm + c.h : 0;
+      if (calm >= 0.25) {
         ok = 1;
         break;
       }
