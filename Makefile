@@ -26,6 +26,7 @@ test: all
 
 bench: all
 	./$(BUILD)/verdant_bench $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_sim $(BENCH_ARGS)
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant

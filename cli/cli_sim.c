@@ -23,7 +23,7 @@ static const char* sim_help =
     "                          DIR/plant.json (the final plant)\n"
     "      --duration T        simulated time (s); default 1, or 0 after --settle/--statics\n"
     "      --dt H              time step (s), default 0.001\n"
-    "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 2\n"
+    "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 1\n"
     "      --solver S          direct (exact tree solve, default) or gs (XPBD Gauss-Seidel)\n"
     "      --settle            first run damped dynamics until the plant is still\n"
     "      --statics           first solve the static equilibrium directly\n"

@@ -123,7 +123,7 @@ typedef struct vd_sim_opt {
   double friction;            // Coulomb friction coefficient of contacts (-)
 } vd_sim_opt;
 
-// Defaults: dt 1e-3 s, iterations 2, solver direct, gravity (0, 0, -9.81) m/s^2,
+// Defaults: dt 1e-3 s, iterations 1, solver direct, gravity (0, 0, -9.81) m/s^2,
 // air_density 1.226 kg/m^3, wind 0 m/s, gust_amplitude 0, gust_period 2 s, no wind series,
 // drag 1, stokes_viscosity 0 Pa s, damping 0 s, mass_damping 0 1/s, fracture 1, contacts 1,
 // friction 0.5.
@@ -281,14 +281,14 @@ vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d);
 // Settling: what to run and when to stop.
 typedef struct vd_sim_settle_def {
   int statics;           // 1: solve the static equilibrium directly (quasi-static Newton steps)
-  double ke_tol;         // dynamics: stop when kinetic energy < ke_tol (J) ...
+  double ke_tol;         // dynamics: stop when kinetic energy stays < ke_tol for 0.25 s (J) ...
   double disp_tol;       // ... or statics: when the largest node move of a step < disp_tol (m)
   double max_time;       // dynamics: give up after this much simulated time (s)
   int max_steps;         // statics: give up after this many steps
   double extra_damping;  // dynamics: mass damping rate added while settling (1/s)
 } vd_sim_settle_def;
 
-// Defaults: statics 0, ke_tol 1e-7 J, disp_tol 1e-9 m, max_time 10 s, max_steps 400,
+// Defaults: statics 0, ke_tol 1e-9 J, disp_tol 1e-9 m, max_time 10 s, max_steps 400,
 // extra_damping 5 1/s.
 vd_sim_settle_def vd_sim_settle_def_default(void);
 // Settle the state under the current loads. *converged (Nullable) tells whether the tolerance

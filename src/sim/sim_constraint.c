@@ -45,7 +45,7 @@ void sim_joint_eval(const vd_sim_model* m, const vd_sim_data* d, int t, sim_join
   }
   j->bend = 1;
   vd_quat qp = d->seg_quat[p];
-  vd_quat qr = vd_quat_mul(vd_quat_conj(qp), d->seg_quat[t]);
+  vd_quat qr = q_mul(q_conj(qp), d->seg_quat[t]);
   vd_quat q0 = m->seg_rest[t];
   double s = quat_dot(qr, q0) < 0 ? -1.0 : 1.0;
   double lbar = m->seg_lbar[t], k = 2.0 / lbar;
@@ -77,7 +77,7 @@ void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double
     c[3] = c[4] = c[5] = 0;
     return;
   }
-  vd_quat qr = vd_quat_mul(vd_quat_conj(d->seg_quat[p]), d->seg_quat[t]);
+  vd_quat qr = q_mul(q_conj(d->seg_quat[p]), d->seg_quat[t]);
   vd_quat q0 = m->seg_rest[t];
   double s = quat_dot(qr, q0) < 0 ? -1.0 : 1.0, k = 2.0 / m->seg_lbar[t];
   c[3] = k * (s * qr.x - q0.x);

@@ -14,35 +14,49 @@
 // ---------------------------------------------------------------------------------------------
 // 6x6 helpers, kept here so the compiler can unroll them in the hot loops
 
-// inverse of a symmetric positive definite 6x6 matrix; 0 if not positive definite
-static int inv_spd(const double* a, double* inv) {
-  // Cholesky L, then L^-1 (lower), then inv = L^-T L^-1
-  double l[36], li[36];
-  memcpy(l, a, sizeof l);
-  for (int j = 0; j < 6; j++) {
-    double s = l[6 * j + j];
-    for (int k = 0; k < j; k++) s -= l[6 * j + k] * l[6 * j + k];
-    if (!(s > 0)) return 0;
-    double ljj = sqrt(s), in = 1.0 / ljj;
-    l[6 * j + j] = ljj;
-    li[6 * j + j] = in;
-    for (int i = j + 1; i < 6; i++) {
-      double v = l[6 * i + j];
-      for (int k = 0; k < j; k++) v -= l[6 * i + k] * l[6 * j + k];
-      l[6 * i + j] = v * in;
+// inverse of a symmetric 3x3 matrix by cofactors (out may not alias a); 0 if singular
+static inline int inv3_sym(const double* a, double* o) {
+  double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[2] * a[7] - a[1] * a[8], c02 = a[1] * a[5] - a[2] * a[4];
+  double c11 = a[0] * a[8] - a[2] * a[6], c12 = a[2] * a[3] - a[0] * a[5], c22 = a[0] * a[4] - a[1] * a[3];
+  double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+  if (!(det > 0)) return 0;
+  double id = 1.0 / det;
+  o[0] = c00 * id, o[1] = o[3] = c01 * id, o[2] = o[6] = c02 * id;
+  o[4] = c11 * id, o[5] = o[7] = c12 * id, o[8] = c22 * id;
+  return 1;
+}
+
+// inverse of a symmetric positive definite 6x6 matrix [[A, B], [B^T, D]] by its 3x3 blocks:
+// X = A^-1 B, T = D - B^T X (the Schur complement, positive definite), then
+// inv = [[A^-1 + X T^-1 X^T, -X T^-1], [-T^-1 X^T, T^-1]]; 0 if not positive definite
+static int inv_spd(const double* m, double* inv) {
+  double a[9], b[9], dd[9], ai[9], x[9], t[9], ti[9], y[9];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) {
+      a[3 * i + k] = m[6 * i + k];
+      b[3 * i + k] = m[6 * i + 3 + k];
+      dd[3 * i + k] = m[6 * (3 + i) + 3 + k];
     }
-  }
-  for (int i = 1; i < 6; i++)
-    for (int j = 0; j < i; j++) {
-      double s = 0;
-      for (int k = j; k < i; k++) s += l[6 * i + k] * li[6 * k + j];
-      li[6 * i + j] = -s * li[6 * i + i];
+  if (!(a[0] > 0) || !inv3_sym(a, ai)) return 0;
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) x[3 * i + k] = ai[3 * i] * b[k] + ai[3 * i + 1] * b[3 + k] + ai[3 * i + 2] * b[6 + k];
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++) {
+      double v = dd[3 * i + k] - (b[i] * x[k] + b[3 + i] * x[3 + k] + b[6 + i] * x[6 + k]);
+      t[3 * i + k] = t[3 * k + i] = v;
     }
-  for (int i = 0; i < 6; i++)
-    for (int j = 0; j <= i; j++) {
-      double s = 0;
-      for (int k = i; k < 6; k++) s += li[6 * k + i] * li[6 * k + j];
-      inv[6 * i + j] = inv[6 * j + i] = s;
+  if (!(t[0] > 0) || !inv3_sym(t, ti)) return 0;
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) y[3 * i + k] = x[3 * i] * ti[k] + x[3 * i + 1] * ti[3 + k] + x[3 * i + 2] * ti[6 + k];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) {
+      inv[6 * (3 + i) + 3 + k] = ti[3 * i + k];
+      inv[6 * i + 3 + k] = inv[6 * (3 + k) + i] = -y[3 * i + k];
+    }
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++) {
+      double v = ai[3 * i + k] + y[3 * i] * x[3 * k] + y[3 * i + 1] * x[3 * k + 1] + y[3 * i + 2] * x[3 * k + 2];
+      inv[6 * i + k] = inv[6 * k + i] = v;
     }
   return 1;
 }
@@ -95,7 +109,7 @@ static void init_bodies(const vd_sim_model* m, vd_sim_data* d, sim_work* w, doub
     vd_vec3 f = w->node_fext[n];
     g[0] = mass * dx.x - h2 * f.x, g[1] = mass * dx.y - h2 * f.y, g[2] = mass * dx.z - h2 * f.z;
     vd_vec3 om = d->seg_omega[t];
-    vd_vec3 dth = vd_sub(quat_log(vd_quat_mul(d->seg_quat[t], vd_quat_conj(w->seg_prev[t]))),
+    vd_vec3 dth = vd_sub(quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t]))),
                          vd_scale(om, h));
     vd_vec3 io = m3_mul_v(iw, om);
     vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(om, io));

@@ -67,11 +67,11 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
     vd_vec3 d3 = quat_d3(qt);
     vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
     double area = 2 * m->seg_radius[t] * m->seg_len0[t];
-    vd_vec3 f = vd_scale(up, q * m->seg_cd[t] * area * vd_norm(up));
+    vd_vec3 f = vd_scale(up, q * m->seg_cd[t] * area * v_norm(up));
     const double* ln = m->seg_leaf_normal + 3 * t;
     if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
-      vd_vec3 nw = vd_quat_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
-      double a = vd_norm(nw);
+      vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
+      double a = v_norm(nw);
       double un = vd_dot(u, nw) / a;
       f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
     }
@@ -86,6 +86,6 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
     vd_vec3 u = vd_sub(wind, d->node_vel[n]);
     int o2 = m->node_owner[n];
     double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
-    w->node_fext[n] = vd_madd(w->node_fext[n], u, q * cd * VD_PI * r * r * vd_norm(u));
+    w->node_fext[n] = vd_madd(w->node_fext[n], u, q * cd * VD_PI * r * r * v_norm(u));
   }
 }

@@ -62,13 +62,13 @@ void m6_chol_solve(const double* l, double* b) {
 }
 
 vd_quat quat_exp(vd_vec3 v) {
-  double a = vd_norm(v);
+  double a = v_norm(v);
   vd_quat q;
   if (a < 1e-8) {
     // second-order series keeps the map smooth near zero
     q.w = 1 - a * a / 8;
     q.x = 0.5 * v.x, q.y = 0.5 * v.y, q.z = 0.5 * v.z;
-    return vd_quat_normalize(q);
+    return q_normalize(q);
   }
   double s = sin(0.5 * a) / a;
   q.w = cos(0.5 * a);
@@ -86,7 +86,7 @@ vd_vec3 quat_log(vd_quat q) {
 }
 
 vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) {
-  return vd_quat_normalize(vd_quat_mul(quat_exp(v), q));
+  return q_normalize(q_mul(quat_exp(v), q));
 }
 
 vd_quat quat_between(vd_vec3 a, vd_vec3 b) {
@@ -100,6 +100,6 @@ vd_quat quat_between(vd_vec3 a, vd_vec3 b) {
     return q;
   }
   vd_quat q = {1 + c, ax.x, ax.y, ax.z};
-  return vd_quat_normalize(q);
+  return q_normalize(q);
 }
 

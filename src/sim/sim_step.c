@@ -58,8 +58,8 @@ static void check_fracture(const vd_sim_model* m, vd_sim_data* d, double h) {
     // constraint force and moment: the generalised forces J^T lambda / h^2
     vd_vec3 ms = vd_v3(lam[0] / h2, lam[1] / h2, lam[2] / h2);
     vd_vec3 mb = vd_v3(lam[3] / h2, lam[4] / h2, lam[5] / h2);
-    double force = vd_norm(m3_tmul_v(j.a, ms));
-    double moment = j.bend ? vd_norm(m3_tmul_v(j.g, mb)) : 0.0;
+    double force = v_norm(m3_tmul_v(j.a, ms));
+    double moment = j.bend ? v_norm(m3_tmul_v(j.g, mb)) : 0.0;
     double cs = sqrt(j.c[0] * j.c[0] + j.c[1] * j.c[1] + j.c[2] * j.c[2]);
     double cb = sqrt(j.c[3] * j.c[3] + j.c[4] * j.c[4] + j.c[5] * j.c[5]);
     int cause = force > thr[0] ? 0 : moment > thr[1] ? 1 : cs > thr[2] ? 2 : cb > thr[3] ? 3 : -1;
@@ -100,7 +100,7 @@ static double torque_work(const vd_sim_model* m, const vd_sim_data* d, const sim
   double e = 0;
   for (int t = 0; t < m->nseg; t++)
     if (!(m->seg_flags[t] & VD_SIM_FIXED))
-      e += vd_dot(w->seg_text[t], quat_log(vd_quat_mul(d->seg_quat[t], vd_quat_conj(w->seg_prev[t]))));
+      e += vd_dot(w->seg_text[t], quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t]))));
   return e;
 }
 
@@ -153,7 +153,7 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
     double vmax = 0;
     for (int i = 0; i < na; i++)
       if (sim_node_w(m, d, i) > 0) {
-        double s = vd_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
+        double s = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
         if (s > vmax) vmax = s;
       }
     c.ncontact = sim_contacts_find(m, d, 2 * vmax + 0.005, &c.contacts);
@@ -204,7 +204,7 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
       d->seg_omega[t] = vd_v3(0, 0, 0);
       continue;
     }
-    vd_vec3 dq = quat_log(vd_quat_mul(d->seg_quat[t], vd_quat_conj(w->seg_prev[t])));
+    vd_vec3 dq = quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])));
     d->seg_omega[t] = vd_scale(dq, damp / h);
   }
   if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
@@ -276,11 +276,11 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
       // largest move of a node, or of a segment end by its rotation
       double mv = 0;
       for (int i = 0; i < m->nnode_all; i++) {
-        double l = vd_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
+        double l = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
         if (l > mv) mv = l;
       }
       for (int t = 0; t < m->nseg; t++) {
-        double l = vd_norm(quat_log(vd_quat_mul(d->seg_quat[t], vd_quat_conj(w->seg_prev[t])))) * m->seg_len0[t];
+        double l = v_norm(quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])))) * m->seg_len0[t];
         if (l > mv) mv = l;
       }
       double hp = c.h, hn;

@@ -541,7 +541,7 @@ static void case_end_moment(vctx* v) {
     double dd = sqrt((tip.x - pr.tip[0]) * (tip.x - pr.tip[0]) + (tip.z - pr.tip[1]) * (tip.z - pr.tip[1]));
     check(v, nc, "discrete", "tip distance to reference (m)", dd, 0, 1e-6 * rd.len, 1,
           "N = %d, M = 2 pi EI/L; joint moments sin(theta)/flexibility%s", n, ok && pr.ok ? "" : " [not converged]");
-    check(v, nc, "continuum", "tip distance from root / L", vd_norm(tip) / rd.len, 0, 1.0 / n, 1,
+    check(v, nc, "continuum", "tip distance from root / L", v_norm(tip) / rd.len, 0, 1.0 / n, 1,
           "a full circle brings the tip back to the root; tolerance 1/N (end half segment, sin law)");
     built_free(&b);
   }
@@ -588,7 +588,7 @@ static void case_torsion(vctx* v) {
   int ok;
   vd_vec3 tip = rod_statics(&b, vd_v3(0, 0, 0), vd_v3(t, 0, 0), 0, 0, 1, &ok);
   int ts = b.m->node_owner[tip_node(&b)];
-  vd_vec3 rot = quat_log(vd_quat_mul(b.d->seg_quat[ts], vd_quat_conj(b.m->seg_quat0[ts])));
+  vd_vec3 rot = quat_log(q_mul(b.d->seg_quat[ts], q_conj(b.m->seg_quat0[ts])));
   double* flex = vd_malloc((size_t)n * sizeof(double));
   if (!flex) {
     built_free(&b);
