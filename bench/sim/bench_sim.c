@@ -139,6 +139,58 @@ static void solver_run(FILE* csv, const char* name, double young, double rho, vd
   vd_model_destroy(pm);
 }
 
+// machine-speed reference measured in the same run (the machine is shared), as the MuJoCo
+// chain bench does: nanoseconds per step of a dependent chain of floating-point adds, best of 5
+static double calibration_ns(void) {
+  volatile double x = 0;
+  double best = HUGE_VAL;
+  for (int b = 0; b < 5; b++) {
+    double t0 = now();
+    for (int k = 0; k < 10000000; k++) x += 1e-9;
+    best = fmin(best, now() - t0);
+  }
+  return best / 1e7 * 1e9;
+}
+
+// the cantilever of anchors-physics.md 3.1 (L = 1 m, r = 5 mm, rho = 1000, E = 10 GPa) with N
+// segments under gravity at h = 1 ms: steps/s and the tip-load accuracy, for the comparison
+// with MuJoCo capsule chains of N bodies at equal accuracy (same discretisation error)
+static void cantilever_run(FILE* csv, int n) {
+  vd_model* pm = cantilever(1.0, 0.005);
+  vd_sim_def def = vd_sim_def_default();
+  def.segment_length = 1.0 / n;
+  def.clamp_length = 0.01;
+  for (int k = 0; k < VD_SIM_CLASS_COUNT; k++) def.material[k].young = 1e10, def.material[k].density = 1000;
+  vd_sim_model* m = NULL;
+  vd_error e = {0};
+  vd_sim_build(pm, &def, &m, &e);
+  m->opt.drag = 0;
+  // accuracy: 0.5 N tip load against PL^3/3EI (small deflection, linear)
+  vd_sim_data* d = vd_sim_data_create(m);
+  m->opt.gravity = vd_v3(0, 0, 0);
+  d->node_force[m->main_tip] = vd_v3(0, 0, -0.5);
+  vd_sim_settle_def s = vd_sim_settle_def_default();
+  s.statics = 1;
+  s.disp_tol = 1e-13;
+  vd_sim_settle(m, d, &s, NULL, NULL);
+  double ei = 1e10 * 3.14159265358979 * pow(0.005, 4) / 4, lin = 0.5 / (3 * ei);
+  double err = (-d->node_pos[m->main_tip].z - lin) / lin;
+  // speed: released under gravity, 2000 steps
+  vd_sim_data_reset(m, d);
+  m->opt.gravity = vd_v3(0, 0, -9.81);
+  int steps = 2000;
+  double c0 = cpu();
+  for (int k = 0; k < steps; k++) vd_sim_step(m, d);
+  double ct = cpu() - c0;
+  printf("cantilever N = %3d  %9.0f steps/s  %7.2f x real time  tip-load error vs PL^3/3EI %+.2e\n", n, steps / ct,
+         steps / ct * m->opt.dt, err);
+  fprintf(csv, "cantilever,N%d,direct,1,%d,%d,%.6f,,%.1f,%.3f,%.4f,,%.6g\n", n, n, steps, ct, steps / ct,
+          steps / ct * m->opt.dt, 1e6 * ct / steps / n, err);
+  vd_sim_data_destroy(d);
+  vd_sim_model_destroy(m);
+  vd_model_destroy(pm);
+}
+
 int main(int argc, char** argv) {
   const char* csv_path = NULL;
   int quick = 0;
@@ -164,6 +216,12 @@ int main(int argc, char** argv) {
   snprintf(path, sizeof path, "%s/data/tree.lpy", VD_SOURCE_DIR);
   vd_model* tree = grow(path);
   if (!tomato || !tree) return 1;
+  double cal = calibration_ns();
+  printf("== machine: %.3f ns per dependent floating-point add (compare runs with it)\n", cal);
+  fprintf(csv, "calibration,ns_per_dependent_add,,,,,,,,,%.5f,,\n", cal);
+  printf("== cantilevers at dt = 1 ms (direct solver, 1 iteration); CPU time\n");
+  static const int ns[5] = {5, 10, 20, 40, 80};
+  for (int k = 0; k < 5; k++) cantilever_run(csv, ns[k]);
   printf("== plants at dt = 1 ms (sag-free, ground, a probe through the crown); CPU time\n");
   plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 1, quick ? 0.3 : 2.0);
   plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 2, quick ? 0.3 : 1.0);

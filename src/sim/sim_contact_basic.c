@@ -130,7 +130,7 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
       double r = col->shape == VD_SIM_PLANE ? m->node_radius[i] : m->node_sphere[i];
       if (r <= 0) continue;
       if (sim_collider_distance(col, d->node_pos[i], &nrm) - r < margin)
-        c[n++] = (sim_contact){i, -1, 0, r, k, 0};
+        c[n++] = (sim_contact){i, -1, 0, r, k, 0, -1, -1, 0, 0};
     }
     if (col->shape == VD_SIM_PLANE) continue;
     // segment capsules
@@ -141,7 +141,7 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
       double u = seg_param(col, a, b);
       double r = m->seg_radius[t];
       if (sim_collider_distance(col, vd_add(a, vd_scale(vd_sub(b, a), u)), &nrm) - r < margin)
-        c[n++] = (sim_contact){-1, t, u, r, k, 0};
+        c[n++] = (sim_contact){-1, t, u, r, k, 0, -1, -1, 0, 0};
     }
   }
   *out = c;
@@ -155,25 +155,48 @@ typedef struct cpoint {
   double ca, cb, wa, wb, w;
 } cpoint;
 
-static cpoint contact_point(const vd_sim_model* m, const vd_sim_data* d, sim_contact* c) {
+// a rod element (node, or segment at parameter t) as a contact point
+static cpoint element_point(const vd_sim_model* m, const vd_sim_data* d, int node, int seg, double t) {
   cpoint q;
-  if (c->node >= 0) {
-    q.na = q.nb = c->node;
+  if (node >= 0) {
+    q.na = q.nb = node;
     q.ca = 1, q.cb = 0;
-    q.wa = q.wb = sim_node_w(m, d, c->node);
-    q.p = d->node_pos[c->node];
+    q.wa = q.wb = sim_node_w(m, d, node);
+    q.p = d->node_pos[node];
     q.w = q.wa;
     return q;
   }
-  q.na = d->seg_start[c->seg], q.nb = m->seg_node[2 * c->seg + 1];
-  vd_vec3 a = d->node_pos[q.na], b = d->node_pos[q.nb];
-  const vd_sim_collider* col = &d->collider[c->collider];
-  if (col->shape == VD_SIM_SPHERE || col->shape == VD_SIM_CAPSULE) c->t = seg_param(col, a, b);
-  q.ca = 1 - c->t, q.cb = c->t;
+  q.na = d->seg_start[seg], q.nb = m->seg_node[2 * seg + 1];
+  q.ca = 1 - t, q.cb = t;
   q.wa = sim_node_w(m, d, q.na), q.wb = sim_node_w(m, d, q.nb);
-  q.p = vd_add(vd_scale(a, q.ca), vd_scale(b, q.cb));
+  q.p = vd_add(vd_scale(d->node_pos[q.na], q.ca), vd_scale(d->node_pos[q.nb], q.cb));
   q.w = q.ca * q.ca * q.wa + q.cb * q.cb * q.wb;
   return q;
+}
+
+static cpoint contact_point(const vd_sim_model* m, const vd_sim_data* d, sim_contact* c) {
+  if (c->node < 0 && c->collider >= 0) {
+    // follow the closest point on the axis for round colliders
+    const vd_sim_collider* col = &d->collider[c->collider];
+    vd_vec3 a = d->node_pos[d->seg_start[c->seg]], b = d->node_pos[m->seg_node[2 * c->seg + 1]];
+    if (col->shape == VD_SIM_SPHERE || col->shape == VD_SIM_CAPSULE) c->t = seg_param(col, a, b);
+  }
+  if (c->collider < 0 && c->seg >= 0 && c->seg2 >= 0) {
+    // two capsules: the closest points of their axes
+    vd_vec3 a = d->node_pos[d->seg_start[c->seg]], b = d->node_pos[m->seg_node[2 * c->seg + 1]];
+    vd_vec3 e = d->node_pos[d->seg_start[c->seg2]], f = d->node_pos[m->seg_node[2 * c->seg2 + 1]];
+    c->t = closest_t_seg(a, b, e, f);
+    c->t2 = closest_t(e, f, vd_add(a, vd_scale(vd_sub(b, a), c->t)));
+  }
+  return element_point(m, d, c->node, c->seg, c->t);
+}
+
+double sim_contact_gap(const vd_sim_model* m, const vd_sim_data* d, sim_contact* c) {
+  cpoint q = contact_point(m, d, c);
+  vd_vec3 nrm;
+  if (c->collider >= 0) return sim_collider_distance(&d->collider[c->collider], q.p, &nrm) - c->radius;
+  cpoint q2 = element_point(m, d, c->node2, c->seg2, c->t2);
+  return v_norm(vd_sub(q.p, q2.p)) - c->radius - c->radius2;
 }
 
 // move the contact point by dp, sharing the motion by inverse mass
@@ -191,11 +214,23 @@ static void move_point(vd_sim_data* d, const cpoint* q, vd_vec3 dp) {
 void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n) {
   for (int i = 0; i < n; i++) {
     cpoint q = contact_point(m, d, &c[i]);
-    if (q.w <= 0) continue;
     vd_vec3 nrm;
-    double s = sim_collider_distance(&d->collider[c[i].collider], q.p, &nrm) - c[i].radius;
-    if (s >= 0) continue;
-    move_point(d, &q, vd_scale(nrm, -s));
+    if (c[i].collider >= 0) {
+      if (q.w <= 0) continue;
+      double s = sim_collider_distance(&d->collider[c[i].collider], q.p, &nrm) - c[i].radius;
+      if (s >= 0) continue;
+      move_point(d, &q, vd_scale(nrm, -s));
+      c[i].lambda += -s;
+      continue;
+    }
+    // self-contact: push the two elements apart along the line between them, by inverse mass
+    cpoint q2 = element_point(m, d, c[i].node2, c[i].seg2, c[i].t2);
+    vd_vec3 dp = vd_sub(q.p, q2.p);
+    double dist = v_norm(dp), s = dist - c[i].radius - c[i].radius2, w = q.w + q2.w;
+    if (s >= 0 || w <= 0 || dist < 1e-15) continue;
+    nrm = vd_scale(dp, 1.0 / dist);
+    move_point(d, &q, vd_scale(nrm, -s * q.w / w));
+    move_point(d, &q2, vd_scale(nrm, s * q2.w / w));
     c[i].lambda += -s;
   }
 }
@@ -204,7 +239,7 @@ void sim_contacts_friction(const vd_sim_model* m, vd_sim_data* d, sim_contact* c
   const sim_work* w = (const sim_work*)d->work;
   double mu = m->opt.friction;
   for (int i = 0; i < n; i++) {
-    if (c[i].lambda <= 0 || mu <= 0) continue;
+    if (c[i].lambda <= 0 || mu <= 0 || c[i].collider < 0) continue;  // self-contacts: no friction yet
     cpoint q = contact_point(m, d, &c[i]);
     if (q.w <= 0) continue;
     const vd_sim_collider* col = &d->collider[c[i].collider];

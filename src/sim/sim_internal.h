@@ -182,15 +182,19 @@ void sim_tie_get(const vd_sim_model* m, const vd_sim_data* d, int k, int* node, 
 // ---------------------------------------------------------------------------------------------
 // contacts (sim_contact_basic.c until the collide module takes over)
 
-// One contact candidate between a rod element and a collider, found once per step and
-// re-evaluated at every projection.
+// One contact candidate, found once per step and re-evaluated at every projection: a rod
+// element (node sphere or segment capsule) against a collider, or against a second rod element
+// (self-contact: collider -1, the second element in node2 / seg2 / t2 / radius2).
 typedef struct sim_contact {
   int node;        // rod node whose sphere touches, or -1
   int seg;         // rod segment whose capsule touches, or -1 (then t is the parameter)
   double t;        // parameter along seg (0 at its start node)
   double radius;   // radius of the rod element (m)
-  int collider;    // collider index
+  int collider;    // collider index, -1 for a self-contact
   double lambda;   // accumulated normal correction this step (m)
+  int node2, seg2; // second rod element of a self-contact (as node / seg), else -1
+  double t2;       // parameter along seg2
+  double radius2;  // radius of the second element (m)
 } sim_contact;
 
 // Find contact candidates at the current (predicted) state, within margin (m); results go to
@@ -200,6 +204,8 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
 void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n);
 // Coulomb friction on the step's tangential motion at each active contact.
 void sim_contacts_friction(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n, double h);
+// Signed gap of contact c at the current state (m, negative when penetrating).
+double sim_contact_gap(const vd_sim_model* m, const vd_sim_data* d, sim_contact* c);
 // Signed distance from point p to collider k's surface (m) and the outward normal there.
 double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* normal);
 

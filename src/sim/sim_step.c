@@ -171,15 +171,7 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
     sim_contacts_project(m, d, c.contacts, c.ncontact);
     sim_contacts_friction(m, d, c.contacts, c.ncontact, h);
     for (int k = 0; k < c.ncontact; k++) {
-      sim_contact* ct = &c.contacts[k];
-      vd_vec3 p, nrm;
-      if (ct->node >= 0) {
-        p = d->node_pos[ct->node];
-      } else {
-        vd_vec3 a = d->node_pos[d->seg_start[ct->seg]], b = d->node_pos[m->seg_node[2 * ct->seg + 1]];
-        p = vd_add(a, vd_scale(vd_sub(b, a), ct->t));
-      }
-      double s = sim_collider_distance(&d->collider[ct->collider], p, &nrm) - ct->radius;
+      double s = sim_contact_gap(m, d, &c.contacts[k]);
       if (-s > d->max_penetration) d->max_penetration = -s;
     }
   }
