@@ -113,10 +113,10 @@ int cli_validate(int argc, char** argv) {
       cJSON_free(text);
     }
   } else {
-    printf("%-4s  %-30s %-9s %-34s %13s %13s %10s %10s\n", "", "case", "form", "quantity", "measured", "reference",
+    printf("%-4s  %-30s %-9s %-40s %13s %13s %10s %10s\n", "", "case", "form", "quantity", "measured", "reference",
            "error", "tolerance");
     for (int k = 0; k < n; k++)
-      printf("%-4s  %-30s %-9s %-34s %13.6g %13.6g %10.3g %10.3g\n", r[k].pass ? "ok" : "FAIL", r[k].name, r[k].form,
+      printf("%-4s  %-30s %-9s %-40s %13.6g %13.6g %10.3g %10.3g\n", r[k].pass ? "ok" : "FAIL", r[k].name, r[k].form,
              r[k].quantity, r[k].measured, r[k].reference, r[k].error, r[k].tolerance);
     printf("%d checks, %d passed, %d failed (%.1f s)\n", n, n - fails, fails, cli_now() - t0);
   }
