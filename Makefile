@@ -29,6 +29,7 @@ bench: all
 	./$(BUILD)/verdant_bench $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_render $(BENCH_ARGS)
 	bash bench/cloud_bench.sh ./$(BUILD)/verdant $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_sim $(BENCH_ARGS)
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant

@@ -19,5 +19,6 @@
 #include "verdant/geom.h"
 #include "verdant/cloud.h"
 #include "verdant/render.h"
+#include "verdant/sim.h"
 
 #endif
