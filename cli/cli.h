@@ -112,5 +112,7 @@ int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);
 int cli_dataset(int argc, char** argv);
 int cli_render(int argc, char** argv);
+int cli_sim(int argc, char** argv);
+int cli_validate(int argc, char** argv);
 
 #endif

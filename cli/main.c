@@ -20,6 +20,8 @@ static const char* main_help =
     "  cloud     plant → labelled point cloud (PLY, PCD, XYZ/CSV, LAS), scanner effects\n"
     "  dataset   many plants of one model → labelled clouds + manifest, --jobs, --shard i/N\n"
     "  render    plant or point cloud → PNG colour image, depth, label and instance masks\n"
+    "  sim       plant physics (Cosserat rods): gravity, wind, probes, fracture → frames, events\n"
+    "  validate  the physics against analytic references (--json, --full)\n"
     "\n"
     "Run 'verdant <command> --help' for the options of a command.\n"
     "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
@@ -43,6 +45,8 @@ int main(int argc, char** argv) {
   if (!strcmp(cmd, "cloud")) return cli_cloud(argc - 1, argv + 1);
   if (!strcmp(cmd, "dataset")) return cli_dataset(argc - 1, argv + 1);
   if (!strcmp(cmd, "render")) return cli_render(argc - 1, argv + 1);
+  if (!strcmp(cmd, "sim")) return cli_sim(argc - 1, argv + 1);
+  if (!strcmp(cmd, "validate")) return cli_validate(argc - 1, argv + 1);
   fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
   fputs(main_help, stderr);
   return EXIT_USAGE;

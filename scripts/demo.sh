@@ -39,7 +39,20 @@ echo "== rendering pictures (headless: EGL, software rendering without a GPU)"
 "$V" render out/tomato-cloud.ply -o out/tomato-cloud.png --camera orbit:-30:25 --point-size 0.004
 echo "   out/tomato.png (+ .label.png, .instance.png, .depth.png, .json), tomato-instance.png,"
 echo "   tomato-arm.png, tomato-cloud.png"
+echo "== physics: the tomato settles under gravity, then (sag-free) a probe pushes through it"
+"$V" sim data/tomato.lpy --seed 1 --settle --no-progress --stats > out/tomato-settle.json
+"$V" sim data/tomato.lpy --seed 1 --sag-free --duration 1.5 --no-progress \
+  --probe 0.04:0.4,0,0.8:-0.4,0,0.8 -o out/tomato-run --final out/tomato-pushed.obj --stats > out/tomato-probe.json
+python3 - out/tomato-settle.json out/tomato-probe.json <<'PY' || cat out/tomato-settle.json out/tomato-probe.json
+import json, sys
+s, p = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+print(f"   settling: {s['segments']} rod segments, {s['total_mass']:.3f} kg, still after {s['time']:.2f} s; "
+      f"sagged {100 * s['max_displacement']:.1f} cm at most, stem tip {100 * s['tip_displacement']:.1f} cm")
+print(f"   probe: pushed the plant up to {100 * p['max_displacement']:.1f} cm, {p['nevents']} fractures, "
+      f"penetration {p['max_penetration']:.1e} m, {p['steps_per_second']:.0f} steps/s")
+PY
 echo "== results in out/: tomato.obj (+ .mtl, one group and material per label), tomato.ply,"
 echo "   tomato.json (plant file), *-stats.json, pictures; open the OBJ in any mesh viewer;"
 echo "   tomato-cloud.ply (labelled points: label, instance), tomato-scan.ply (8 scans, view and"
-echo "   range per point): open them in CloudCompare, Open3D or MeshLab"
+echo "   range per point): open them in CloudCompare, Open3D or MeshLab;"
+echo "   tomato-run/ (frames, events, final plant) and tomato-pushed.obj from the simulation"

@@ -54,6 +54,10 @@ typedef struct vd_label {
   float rgb[3];                  // display colour in [0, 1]
 } vd_label;
 
+// Fill a label entry: id, name (truncated), organ kind from the name, colour by organ kind
+// (fruit red, leaf green, ...) or from the palette by id when the organ is unknown.
+void vd_label_init(vd_label* l, int id, const char* name);
+
 // segment flags
 #define VD_SEG_GC 1u    // part of a generalised cylinder: joins its parent's end ring smoothly
 #define VD_SEG_TIP 2u   // nothing continues from node1 on the same axis (an axis tip)

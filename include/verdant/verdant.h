@@ -19,6 +19,7 @@
 #include "verdant/geom.h"
 #include "verdant/cloud.h"
 #include "verdant/render.h"
+#include "verdant/sim.h"
 #include "verdant/collide.h"
 
 #endif

@@ -128,12 +128,7 @@ static vd_status comment_line(reader* r, const char* s, size_t len, int line) {
   while (n && (end[n - 1] == '\r' || end[n - 1] == ' ')) end[--n] = 0;
   if (!vd_grow((void**)&r->labels, &r->cap_label, r->nlabel + 1, sizeof(vd_label)))
     return vd_error_set(r->err, VD_ERR_NOMEM, r->path, 0, 0, "out of memory");
-  vd_label* l = &r->labels[r->nlabel++];
-  memset(l, 0, sizeof *l);
-  l->id = (int)id;
-  snprintf(l->name, sizeof l->name, "%s", end);
-  l->organ = vd_organ_from_name(l->name);
-  vd_plant_default_rgb(l->id, l->rgb);
+  vd_label_init(&r->labels[r->nlabel++], (int)id, end);
   return VD_OK;
 }
 
@@ -586,13 +581,10 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
       for (unsigned e = 0; e + 16 <= vlen; e += 16) {
         if (!vd_grow((void**)&r->labels, &r->cap_label, r->nlabel + 1, sizeof(vd_label)))
           return vd_error_set(r->err, VD_ERR_NOMEM, r->path, 0, 0, "out of memory");
-        vd_label* l = &r->labels[r->nlabel++];
-        memset(l, 0, sizeof *l);
-        l->id = b[pos + e];
-        memcpy(l->name, b + pos + e + 1, 15);
-        l->name[15] = 0;
-        l->organ = vd_organ_from_name(l->name);
-        vd_plant_default_rgb(l->id, l->rgb);
+        char name[16];
+        memcpy(name, b + pos + e + 1, 15);
+        name[15] = 0;
+        vd_label_init(&r->labels[r->nlabel++], b[pos + e], name);
       }
     } else if (spec && rec == 4) {
       int at = 0;

@@ -251,6 +251,13 @@ static void label_rgb(const vd_label* l, float rgb[3]) {
   }
 }
 
+void vd_label_init(vd_label* l, int id, const char* name) {
+  memset(l, 0, sizeof *l);
+  l->id = id;
+  label_set_name(l, name ? name : "");
+  label_rgb(l, l->rgb);
+}
+
 vd_status vd_plant_set_label(vd_plant_spec* s, int id, const char* name) {
   if (!s || !name || id < 0) return VD_ERR_ARG;
   int k = label_lower_bound(s->label, s->nlabel, id);

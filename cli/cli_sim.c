@@ -1,0 +1,768 @@
+// SPDX-License-Identifier: MIT
+// verdant sim: a plant as Cosserat rods under gravity, wind, probes and pulls; frames, events,
+// the final plant and a JSON summary.
+#define _POSIX_C_SOURCE 200809L
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+static const char* sim_help =
+    "usage: verdant sim PLANT [-o DIR] [options]\n"
+    "\n"
+    "Simulate a plant (.lpy or plant .json) as Cosserat rods (XPBD, direct tree solver) and\n"
+    "write frames, fracture events and the final plant to DIR; --stats prints a JSON summary.\n"
+    "\n"
+    "run:\n"
+    "  -o, --output DIR        write DIR/frames.bin (or .jsonl), DIR/rod.json, DIR/events.csv,\n"
+    "                          DIR/plant.json (the final plant)\n"
+    "      --duration T        simulated time (s); default 1, or 0 after --settle/--statics\n"
+    "      --dt H              time step (s), default 0.001\n"
+    "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 1\n"
+    "      --solver S          direct (exact tree solve, default) or gs (XPBD Gauss-Seidel)\n"
+    "      --settle            first run damped dynamics until the plant is still\n"
+    "      --statics           first solve the static equilibrium directly\n"
+    "      --ke-tol E          --settle stops when the kinetic energy stays below E (J), 1e-9\n"
+    "      --sag-free          rest shape solved so that the modelled shape is the equilibrium\n"
+    "      --stake S           tie the main stem to a fixed stake every S metres (greenhouse string)\n"
+    "model:\n"
+    "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
+    "      --young [C=]E       Young's modulus (Pa) of all classes, or of class C\n"
+    "      --density [C=]RHO   density (kg/m^3); --poisson [C=]NU Poisson ratio\n"
+    "                          classes: green wood pedicel leaf fruit flower root\n"
+    "      --break-force [C=]F     joints break above this force (N); 'inf' disables\n"
+    "      --break-moment [C=]M    ... or above this moment (N m)\n"
+    "      --break-strain [C=]CS,CB  ... or when |C_s| > CS or |C_b| > CB (1/m), Gazebo Plants' form\n"
+    "      --no-fracture       nothing breaks\n"
+    "loads:\n"
+    "      --gravity X,Y,Z     gravity (m/s^2), default 0,0,-9.81\n"
+    "      --wind X,Y,Z        mean wind (m/s); pressure 0.613 |v|^2 Pa on the drag areas\n"
+    "      --gust A,P          gusts: wind * (1 + A sin(2 pi t / P)), P in s\n"
+    "      --wind-file CSV     wind time series: rows t,vx,vy,vz (s, m/s), replaces --wind\n"
+    "      --no-drag           no aerodynamic forces at all (no wind, no air drag)\n"
+    "      --stokes ETA        extra Stokes drag 6 pi ETA r v (Pa s): numerical damping only\n"
+    "      --damping TAU       material (stiffness-proportional) damping time (s), default 0\n"
+    "      --mass-damping C    velocity damping rate (1/s), default 0\n"
+    "contacts and probes:\n"
+    "      --ground Z          ground plane at height Z (m), default 0; --no-ground for none\n"
+    "      --probe R:X0,Y0,Z0:X1,Y1,Z1[:T0:T1]\n"
+    "                          kinematic sphere of radius R (m) moving from P0 to P1 (m) between\n"
+    "                          T0 and T1 (s, default the whole run); repeatable\n"
+    "      --pull ORGAN=FX,FY,FZ   force (N) on an organ (LABEL or LABEL#INSTANCE, e.g. fruit#12),\n"
+    "                          ramped from 0 over --ramp seconds; repeatable\n"
+    "      --move ORGAN=DX,DY,DZ   displace an organ (m) by a stiff tie, ramped over --ramp\n"
+    "      --ramp T            ramp time of pulls and moves (s); default the run's duration\n"
+    "output:\n"
+    "      --frames F          bin (default), jsonl or none\n"
+    "      --fps N             frames per simulated second, default 30\n"
+    "      --final FILE        also write the final plant as .json, .obj or .ply\n"
+    "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
+    "                          their initial positions), tip_displacement (m, end of the main\n"
+    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n";
+
+// ---------------------------------------------------------------------------------------------
+// option values
+
+static int parse_num(const char* s, double* out) {
+  if (!s || !*s) return 0;
+  if (!strcmp(s, "inf") || !strcmp(s, "INF")) {
+    *out = INFINITY;
+    return 1;
+  }
+  char* end;
+  errno = 0;
+  double v = strtod(s, &end);
+  if (errno || *end || !isfinite(v)) return 0;
+  *out = v;
+  return 1;
+}
+
+// "a,b,c" -> n numbers
+static int parse_list(const char* s, double* out, int n) {
+  char buf[256];
+  if (!s || strlen(s) >= sizeof buf) return 0;
+  strcpy(buf, s);
+  char* p = buf;
+  for (int i = 0; i < n; i++) {
+    char* c = i < n - 1 ? strchr(p, ',') : NULL;
+    if (i < n - 1 && !c) return 0;
+    if (c) *c = 0;
+    if (!parse_num(p, &out[i]) || !isfinite(out[i])) return 0;
+    p = c ? c + 1 : p + strlen(p);
+  }
+  return 1;
+}
+
+typedef struct probe {
+  double r;
+  vd_vec3 p0, p1;
+  double t0, t1;  // t1 < 0: the whole run
+  int id;
+} probe;
+
+typedef struct pull {
+  char organ[64];
+  int instance;
+  vd_vec3 v;
+  int move;  // 0 force, 1 displacement
+  int node, tie;
+} pull;
+
+typedef struct sim_opts {
+  cli_plant_opts po;
+  const char* out;
+  double duration;
+  int duration_set;
+  int settle, statics, stats;
+  double ke_tol;
+  const char* frames;
+  double fps;
+  const char* final;
+  double ground;
+  int no_ground;
+  probe probe[16];
+  int nprobe;
+  pull pull[16];
+  int npull;
+  double ramp;
+  int ramp_set;
+  const char* wind_file;
+  vd_sim_def def;
+  vd_sim_opt opt;
+} sim_opts;
+
+// class-prefixed value: "C=V" sets class C, "V" sets every class; returns 0 on a bad value
+static int class_value(const char* cmd, const char* opt, const char* val, vd_sim_def* def, size_t field, int ncomp,
+                       int positive) {
+  const char* eq = strchr(val, '=');
+  int c0 = 0, c1 = VD_SIM_CLASS_COUNT;
+  const char* num = val;
+  if (eq) {
+    char name[32];
+    size_t n = (size_t)(eq - val);
+    if (n >= sizeof name) n = sizeof name - 1;
+    memcpy(name, val, n);
+    name[n] = 0;
+    vd_sim_class c = vd_sim_class_parse(name);
+    if (c == VD_SIM_CLASS_COUNT) {
+      cli_usage_error(cmd, "%s: unknown class '%s' (green, wood, pedicel, leaf, fruit, flower, root)", opt, name);
+      return 0;
+    }
+    c0 = c, c1 = c + 1;
+    num = eq + 1;
+  }
+  double v[2];
+  int ok = ncomp == 1 ? parse_num(num, &v[0]) : parse_list(num, v, ncomp);
+  for (int k = 0; ok && k < ncomp; k++) ok = positive ? v[k] > 0 : 1;
+  if (!ok) {
+    cli_usage_error(cmd, "%s expects %s[CLASS=]%s, got '%s'", opt, "", ncomp == 1 ? "NUMBER" : "NUMBER,NUMBER", val);
+    return 0;
+  }
+  for (int c = c0; c < c1; c++) {
+    double* dst = (double*)((char*)&def->material[c] + field);
+    for (int k = 0; k < ncomp; k++) dst[k] = v[k];
+  }
+  return 1;
+}
+
+static int parse_probe(const char* s, probe* p) {
+  char buf[256];
+  if (strlen(s) >= sizeof buf) return 0;
+  strcpy(buf, s);
+  char* part[5];
+  int n = 0;
+  for (char* q = strtok(buf, ":"); q && n < 5; q = strtok(NULL, ":")) part[n++] = q;
+  if (n != 3 && n != 5) return 0;
+  double a[3], b[3];
+  if (!parse_num(part[0], &p->r) || !(p->r > 0) || !parse_list(part[1], a, 3) || !parse_list(part[2], b, 3)) return 0;
+  p->p0 = vd_v3(a[0], a[1], a[2]), p->p1 = vd_v3(b[0], b[1], b[2]);
+  p->t0 = 0, p->t1 = -1;
+  if (n == 5 && (!parse_num(part[3], &p->t0) || !parse_num(part[4], &p->t1) || !(p->t1 > p->t0) || p->t0 < 0)) return 0;
+  return 1;
+}
+
+static int parse_pull(const char* s, pull* p, int move) {
+  const char* eq = strchr(s, '=');
+  if (!eq || eq == s || (size_t)(eq - s) >= sizeof p->organ) return 0;
+  memcpy(p->organ, s, (size_t)(eq - s));
+  p->organ[eq - s] = 0;
+  p->instance = 0;
+  char* hash = strchr(p->organ, '#');
+  if (hash) {
+    char* end;
+    long v = strtol(hash + 1, &end, 10);
+    if (*end || v < 1) return 0;
+    p->instance = (int)v;
+    *hash = 0;
+  }
+  double v[3];
+  if (!parse_list(eq + 1, v, 3)) return 0;
+  p->v = vd_v3(v[0], v[1], v[2]);
+  p->move = move;
+  return 1;
+}
+
+// wind time series: CSV rows t,vx,vy,vz (a header line is skipped); errors name the line
+static vd_status read_wind(const char* path, double** rows, int* n, vd_error* err) {
+  char* text;
+  size_t len;
+  vd_status st = vd_file_read(path, &text, &len, err);
+  if (st) return st;
+  int cap = 0, cnt = 0, line = 0;
+  double* r = NULL;
+  char* p = text;
+  while (*p && !st) {
+    line++;
+    char* e = strchr(p, '\n');
+    if (e) *e = 0;
+    char* s = p;
+    while (*s == ' ' || *s == '\t' || *s == '\r') s++;
+    if (*s && *s != '#' && !(line == 1 && (*s < '0' || *s > '9') && *s != '-' && *s != '.')) {
+      double v[4];
+      char* cr = strchr(s, '\r');
+      if (cr) *cr = 0;
+      if (!parse_list(s, v, 4))
+        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "expected 't,vx,vy,vz' (s, m/s)");
+      else if (cnt && v[0] < r[4 * (cnt - 1)])
+        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "time %g goes backwards", v[0]);
+      else if (!vd_grow((void**)&r, &cap, cnt + 1, 4 * sizeof(double)))
+        st = vd_error_set(err, VD_ERR_NOMEM, path, line, 0, "out of memory");
+      else
+        memcpy(r + 4 * cnt++, v, sizeof v);
+    }
+    p = e ? e + 1 : p + strlen(p);
+  }
+  vd_free(text, len + 1);
+  if (!st && !cnt) st = vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "no wind rows (t,vx,vy,vz)");
+  if (st) {
+    vd_free(r, (size_t)cap * 4 * sizeof(double));
+    return st;
+  }
+  // shrink to the exact size so the caller frees cnt rows
+  double* x = vd_realloc(r, (size_t)cap * 4 * sizeof(double), (size_t)cnt * 4 * sizeof(double));
+  if (!x) {
+    vd_free(r, (size_t)cap * 4 * sizeof(double));
+    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  }
+  *rows = x;
+  *n = cnt;
+  return VD_OK;
+}
+
+// ---------------------------------------------------------------------------------------------
+// outputs
+
+typedef struct outputs {
+  vd_outfile frames;
+  int frames_open, jsonl;
+  float* fbuf;
+  size_t fbuf_n;
+  unsigned char* bbuf;
+} outputs;
+
+static void put_u32(unsigned char* b, uint32_t v) {
+  for (int k = 0; k < 4; k++) b[k] = (unsigned char)(v >> (8 * k));
+}
+
+static void put_f64(unsigned char* b, double d) {
+  uint64_t u;
+  memcpy(&u, &d, 8);
+  for (int k = 0; k < 8; k++) b[k] = (unsigned char)(u >> (8 * k));
+}
+
+static void put_f32(unsigned char* b, float f) {
+  uint32_t u;
+  memcpy(&u, &f, 4);
+  put_u32(b, u);
+}
+
+static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir, int jsonl, vd_error* err) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/frames.%s", dir, jsonl ? "jsonl" : "bin");
+  vd_status st = vd_outfile_open(&o->frames, path, err);
+  if (st) return st;
+  o->frames_open = 1;
+  o->jsonl = jsonl;
+  if (!jsonl) {
+    // header: magic, version, node count, segment count, reserved (little-endian)
+    unsigned char h[24];
+    memcpy(h, "VDSIMFRM", 8);
+    put_u32(h + 8, VD_SIM_FRAMES_VERSION);
+    put_u32(h + 12, (uint32_t)m->nnode_all);
+    put_u32(h + 16, (uint32_t)m->nseg);
+    put_u32(h + 20, 0);
+    fwrite(h, 1, sizeof h, o->frames.fp);
+    o->fbuf_n = 8 + 4 * (3 * (size_t)m->nnode_all + 4 * (size_t)m->nseg) + (size_t)m->nseg;
+    o->bbuf = vd_malloc(o->fbuf_n);
+    if (!o->bbuf) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  }
+  return VD_OK;
+}
+
+static void frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d) {
+  FILE* f = o->frames.fp;
+  if (o->jsonl) {
+    fprintf(f, "{\"t\":%.9g,\"pos\":[", d->time);
+    for (int i = 0; i < m->nnode_all; i++)
+      fprintf(f, "%s%.7g,%.7g,%.7g", i ? "," : "", d->node_pos[i].x, d->node_pos[i].y, d->node_pos[i].z);
+    fputs("],\"quat\":[", f);
+    for (int t = 0; t < m->nseg; t++)
+      fprintf(f, "%s%.7g,%.7g,%.7g,%.7g", t ? "," : "", d->seg_quat[t].w, d->seg_quat[t].x, d->seg_quat[t].y,
+              d->seg_quat[t].z);
+    fputs("],\"broken\":[", f);
+    int first = 1;
+    for (int t = 0; t < m->nseg; t++)
+      if (d->seg_broken[t]) fprintf(f, "%s%d", first ? "" : ",", t), first = 0;
+    fputs("]}\n", f);
+    return;
+  }
+  unsigned char* b = o->bbuf;
+  put_f64(b, d->time);
+  b += 8;
+  for (int i = 0; i < m->nnode_all; i++, b += 12)
+    put_f32(b, (float)d->node_pos[i].x), put_f32(b + 4, (float)d->node_pos[i].y), put_f32(b + 8, (float)d->node_pos[i].z);
+  for (int t = 0; t < m->nseg; t++, b += 16) {
+    vd_quat q = d->seg_quat[t];
+    put_f32(b, (float)q.w), put_f32(b + 4, (float)q.x), put_f32(b + 8, (float)q.y), put_f32(b + 12, (float)q.z);
+  }
+  for (int t = 0; t < m->nseg; t++) *b++ = (unsigned char)(d->seg_broken[t] ? 1 : 0);
+  fwrite(o->bbuf, 1, o->fbuf_n, f);
+}
+
+// the rod topology that frames refer to
+static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, const char* dir, vd_error* err) {
+  cJSON* root = cJSON_CreateObject();
+  if (!root) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  cJSON_AddStringToObject(root, "format", "verdant-rod");
+  cJSON_AddNumberToObject(root, "version", VD_SIM_FRAMES_VERSION);
+  cJSON_AddNumberToObject(root, "nodes", m->nnode_all);
+  cJSON_AddNumberToObject(root, "segments", m->nseg);
+  cJSON* np = cJSON_AddArrayToObject(root, "node_pos0");
+  for (int i = 0; i < m->nnode_all; i++) {
+    cJSON_AddItemToArray(np, cJSON_CreateNumber(m->node_pos0[i].x));
+    cJSON_AddItemToArray(np, cJSON_CreateNumber(m->node_pos0[i].y));
+    cJSON_AddItemToArray(np, cJSON_CreateNumber(m->node_pos0[i].z));
+  }
+  cJSON_AddItemToObject(root, "node_sphere", cJSON_CreateDoubleArray(m->node_sphere, m->nnode_all));
+  cJSON_AddItemToObject(root, "seg_node", cJSON_CreateIntArray(m->seg_node, 2 * m->nseg));
+  cJSON_AddItemToObject(root, "seg_spare", cJSON_CreateIntArray(m->seg_spare, m->nseg));
+  cJSON_AddItemToObject(root, "seg_radius", cJSON_CreateDoubleArray(m->seg_radius, m->nseg));
+  cJSON_AddItemToObject(root, "seg_label", cJSON_CreateIntArray(m->seg_label, m->nseg));
+  cJSON_AddItemToObject(root, "seg_instance", cJSON_CreateIntArray(m->seg_instance, m->nseg));
+  cJSON* cls = cJSON_AddArrayToObject(root, "seg_class");
+  for (int t = 0; t < m->nseg; t++) cJSON_AddItemToArray(cls, cJSON_CreateString(vd_sim_class_name(m->seg_class[t])));
+  cJSON* labels = cJSON_AddObjectToObject(root, "labels");
+  for (int k = 0; k < plant->nlabel; k++) {
+    char id[16];
+    snprintf(id, sizeof id, "%d", plant->labels[k].id);
+    cJSON_AddStringToObject(labels, id, plant->labels[k].name);
+  }
+  char* text = cJSON_PrintUnformatted(root);
+  cJSON_Delete(root);
+  if (!text) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  char path[4096];
+  snprintf(path, sizeof path, "%s/rod.json", dir);
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (!st) {
+    fputs(text, f.fp);
+    fputc('\n', f.fp);
+    st = vd_outfile_commit(&f, err);
+  }
+  cJSON_free(text);
+  return st;
+}
+
+static const char* label_name(const vd_model* plant, int id) {
+  const vd_label* l = vd_model_find_label(plant, id);
+  return l ? l->name : "";
+}
+
+static const char* cause_name(int c) {
+  static const char* n[4] = {"force", "moment", "strain_cs", "strain_cb"};
+  return c >= 0 && c < 4 ? n[c] : "?";
+}
+
+static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const char* dir, vd_error* err) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/events.csv", dir);
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (st) return st;
+  fputs("time_s,segment,node,label,label_name,instance,class,force_N,moment_Nm,cs,cb_per_m,cause\n", f.fp);
+  for (int k = 0; k < d->nevent; k++) {
+    const vd_sim_event* e = &d->event[k];
+    fprintf(f.fp, "%.6f,%d,%d,%d,%s,%d,%s,%.6g,%.6g,%.6g,%.6g,%s\n", e->time, e->seg, e->node, e->label,
+            label_name(plant, e->label), e->instance, vd_sim_class_name(e->cls), e->force, e->moment, e->cs, e->cb,
+            cause_name(e->cause));
+  }
+  return vd_outfile_commit(&f, err);
+}
+
+// ---------------------------------------------------------------------------------------------
+// the summary
+
+static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant, double wall, int64_t steps,
+                       int settled, int settle_steps) {
+  cJSON* root = cJSON_CreateObject();
+  if (!root) return 0;
+  int node;
+  double md = vd_sim_max_displacement(m, d, &node);
+  double tip = m->main_tip >= 0 ? vd_norm(vd_sub(d->node_pos[m->main_tip], m->node_pos0[m->main_tip])) : 0;
+  cJSON_AddNumberToObject(root, "max_displacement", md);
+  cJSON_AddNumberToObject(root, "max_displacement_node", node);
+  cJSON_AddNumberToObject(root, "tip_displacement", tip);
+  cJSON_AddNumberToObject(root, "kinetic_energy", vd_sim_kinetic_energy(m, d));
+  cJSON* ev = cJSON_AddArrayToObject(root, "events");
+  for (int k = 0; k < d->nevent; k++) {
+    const vd_sim_event* e = &d->event[k];
+    cJSON* o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "time", e->time);
+    cJSON_AddNumberToObject(o, "segment", e->seg);
+    cJSON_AddStringToObject(o, "label", label_name(plant, e->label));
+    cJSON_AddNumberToObject(o, "instance", e->instance);
+    cJSON_AddStringToObject(o, "class", vd_sim_class_name(e->cls));
+    cJSON_AddNumberToObject(o, "force", e->force);
+    cJSON_AddNumberToObject(o, "moment", e->moment);
+    cJSON_AddStringToObject(o, "cause", cause_name(e->cause));
+    cJSON_AddItemToArray(ev, o);
+  }
+  cJSON_AddNumberToObject(root, "nevents", d->nevent);
+  cJSON_AddNumberToObject(root, "steps", (double)steps);
+  cJSON_AddNumberToObject(root, "time", d->time);
+  cJSON_AddNumberToObject(root, "wall_seconds", wall);
+  cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? steps / wall : 0);
+  cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? steps * m->opt.dt / wall : 0);
+  if (settle_steps >= 0) {
+    cJSON_AddBoolToObject(root, "settled", settled);
+    cJSON_AddNumberToObject(root, "settle_steps", settle_steps);
+  }
+  cJSON_AddNumberToObject(root, "nodes", m->nnode);
+  cJSON_AddNumberToObject(root, "segments", m->nseg);
+  cJSON_AddNumberToObject(root, "total_mass", m->total_mass);
+  cJSON_AddNumberToObject(root, "max_penetration", d->max_penetration);
+  cJSON_AddNumberToObject(root, "sag_free_out_of_reach", m->nsagfree_clamped);
+  cJSON_AddNumberToObject(root, "warnings", (double)d->nwarning);
+  char* text = cJSON_Print(root);
+  cJSON_Delete(root);
+  if (!text) return 0;
+  fputs(text, stdout);
+  fputc('\n', stdout);
+  cJSON_free(text);
+  return 1;
+}
+
+static void progress_bar(double t, double total) {
+  int w = 30, fill = total > 0 ? (int)(t / total * w) : w;
+  if (fill > w) fill = w;
+  char bar[64];
+  for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
+  bar[w] = 0;
+  fprintf(stderr, "\rsimulating [%s] %.2f / %.2f s", bar, t, total);
+  fflush(stderr);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+static int parse_args(int argc, char** argv, sim_opts* o) {
+  const char* cmd = "sim";
+  for (int i = 1; i < argc; i++) {
+    const char* a = argv[i];
+    int r = cli_plant_opt(&o->po, cmd, argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+#define VAL()                                                                                     \
+  do {                                                                                            \
+    if (i + 1 >= argc) return cli_usage_error(cmd, "%s needs a value", a);                        \
+    val = argv[++i];                                                                              \
+  } while (0)
+#define NUM(dst, cond, what)                                                                      \
+  do {                                                                                            \
+    VAL();                                                                                        \
+    double x_;                                                                                    \
+    if (!parse_num(val, &x_) || !isfinite(x_) || !(cond)) return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val); \
+    dst = x_;                                                                                     \
+  } while (0)
+    const char* val = NULL;
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      VAL();
+      o->out = val;
+    } else if (!strcmp(a, "--duration")) {
+      NUM(o->duration, x_ >= 0, "a time >= 0 (s)");
+      o->duration_set = 1;
+    } else if (!strcmp(a, "--dt")) {
+      NUM(o->opt.dt, x_ > 0 && x_ <= 1, "a time step in (0, 1] (s)");
+    } else if (!strcmp(a, "--iterations")) {
+      NUM(o->opt.iterations, x_ >= 1 && x_ <= 10000 && x_ == floor(x_), "an integer in 1..10000");
+    } else if (!strcmp(a, "--solver")) {
+      VAL();
+      if (!strcmp(val, "direct")) o->opt.solver = VD_SIM_DIRECT;
+      else if (!strcmp(val, "gs")) o->opt.solver = VD_SIM_GS;
+      else return cli_usage_error(cmd, "--solver expects direct or gs, got '%s'", val);
+    } else if (!strcmp(a, "--settle")) {
+      o->settle = 1;
+    } else if (!strcmp(a, "--statics")) {
+      o->statics = 1;
+    } else if (!strcmp(a, "--ke-tol")) {
+      NUM(o->ke_tol, x_ > 0, "an energy > 0 (J)");
+    } else if (!strcmp(a, "--sag-free")) {
+      o->def.sag_free = 1;
+    } else if (!strcmp(a, "--stake")) {
+      NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
+    } else if (!strcmp(a, "--segment-length")) {
+      NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
+    } else if (!strcmp(a, "--young")) {
+      VAL();
+      if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, young), 1, 1)) return EXIT_USAGE;
+    } else if (!strcmp(a, "--density")) {
+      VAL();
+      if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, density), 1, 1)) return EXIT_USAGE;
+    } else if (!strcmp(a, "--poisson")) {
+      VAL();
+      if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, poisson), 1, 0)) return EXIT_USAGE;
+    } else if (!strcmp(a, "--break-force")) {
+      VAL();
+      if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, break_force), 1, 1)) return EXIT_USAGE;
+    } else if (!strcmp(a, "--break-moment")) {
+      VAL();
+      if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, break_moment), 1, 1)) return EXIT_USAGE;
+    } else if (!strcmp(a, "--break-strain")) {
+      VAL();
+      if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, break_cs), 2, 1)) return EXIT_USAGE;
+    } else if (!strcmp(a, "--no-fracture")) {
+      o->opt.fracture = 0;
+    } else if (!strcmp(a, "--gravity") || !strcmp(a, "--wind")) {
+      VAL();
+      double v[3];
+      if (!parse_list(val, v, 3)) return cli_usage_error(cmd, "%s expects X,Y,Z (%s), got '%s'", a, a[2] == 'g' ? "m/s^2" : "m/s", val);
+      if (a[2] == 'g') o->opt.gravity = o->def.gravity = vd_v3(v[0], v[1], v[2]);
+      else o->opt.wind = vd_v3(v[0], v[1], v[2]);
+    } else if (!strcmp(a, "--gust")) {
+      VAL();
+      double v[2];
+      if (!parse_list(val, v, 2) || !(v[1] > 0)) return cli_usage_error(cmd, "--gust expects AMPLITUDE,PERIOD (-, s > 0), got '%s'", val);
+      o->opt.gust_amplitude = v[0], o->opt.gust_period = v[1];
+    } else if (!strcmp(a, "--wind-file")) {
+      VAL();
+      o->wind_file = val;
+    } else if (!strcmp(a, "--no-drag")) {
+      o->opt.drag = 0;
+    } else if (!strcmp(a, "--stokes")) {
+      NUM(o->opt.stokes_viscosity, x_ >= 0, "a viscosity >= 0 (Pa s)");
+    } else if (!strcmp(a, "--damping")) {
+      NUM(o->opt.damping, x_ >= 0, "a time >= 0 (s)");
+    } else if (!strcmp(a, "--mass-damping")) {
+      NUM(o->opt.mass_damping, x_ >= 0, "a rate >= 0 (1/s)");
+    } else if (!strcmp(a, "--ground")) {
+      NUM(o->ground, 1, "a height (m)");
+      o->no_ground = 0;
+    } else if (!strcmp(a, "--no-ground")) {
+      o->no_ground = 1;
+    } else if (!strcmp(a, "--probe")) {
+      VAL();
+      if (o->nprobe == 16) return cli_usage_error(cmd, "too many --probe options (16 at most)");
+      if (!parse_probe(val, &o->probe[o->nprobe]))
+        return cli_usage_error(cmd, "--probe expects R:X0,Y0,Z0:X1,Y1,Z1[:T0:T1] (m, s; R > 0, T1 > T0), got '%s'", val);
+      o->nprobe++;
+    } else if (!strcmp(a, "--pull") || !strcmp(a, "--move")) {
+      VAL();
+      if (o->npull == 16) return cli_usage_error(cmd, "too many --pull/--move options (16 at most)");
+      if (!parse_pull(val, &o->pull[o->npull], a[2] == 'm'))
+        return cli_usage_error(cmd, "%s expects ORGAN[#INSTANCE]=X,Y,Z (%s), got '%s'", a, a[2] == 'm' ? "m" : "N", val);
+      o->npull++;
+    } else if (!strcmp(a, "--ramp")) {
+      NUM(o->ramp, x_ >= 0, "a time >= 0 (s)");
+      o->ramp_set = 1;
+    } else if (!strcmp(a, "--frames")) {
+      VAL();
+      if (strcmp(val, "bin") && strcmp(val, "jsonl") && strcmp(val, "none"))
+        return cli_usage_error(cmd, "--frames expects bin, jsonl or none, got '%s'", val);
+      o->frames = val;
+    } else if (!strcmp(a, "--fps")) {
+      NUM(o->fps, x_ > 0 && x_ <= 100000, "a rate in (0, 100000] (1/s)");
+    } else if (!strcmp(a, "--final")) {
+      VAL();
+      if (!cli_has_ext(val, ".json") && !cli_has_ext(val, ".obj") && !cli_has_ext(val, ".ply"))
+        return cli_usage_error(cmd, "--final '%s': unknown format (use .json, .obj or .ply)", val);
+      o->final = val;
+    } else if (!strcmp(a, "--stats")) {
+      o->stats = 1;
+    } else if (a[0] == '-' && a[1]) {
+      return cli_usage_error(cmd, "unknown option '%s'", a);
+    } else if (!o->po.path) {
+      o->po.path = a;
+    } else {
+      return cli_usage_error(cmd, "unexpected argument '%s'", a);
+    }
+#undef NUM
+#undef VAL
+  }
+  return EXIT_OK;
+}
+
+int cli_sim(int argc, char** argv) {
+  for (int i = 1; i < argc; i++)
+    if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+      fputs(sim_help, stdout);
+      fputs(cli_plant_help, stdout);
+      return EXIT_OK;
+    }
+  sim_opts o;
+  memset(&o, 0, sizeof o);
+  cli_plant_opts_init(&o.po);
+  o.def = vd_sim_def_default();
+  o.opt = vd_sim_opt_default();
+  o.duration = 1.0;
+  o.ke_tol = 1e-9;
+  o.fps = 30;
+  int rc = parse_args(argc, argv, &o);
+  if (rc) return rc;
+  if (!o.po.path) return cli_usage_error("sim", "missing PLANT (an .lpy or plant .json file)");
+  if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
+  if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
+  if (!o.frames) o.frames = "bin";
+  // load, compile, build
+  vd_error err = {0};
+  vd_plant_spec* spec = NULL;
+  vd_model* plant = NULL;
+  vd_sim_model* m = NULL;
+  vd_sim_data* d = NULL;
+  double* wind = NULL;
+  int nwind = 0;
+  outputs out;
+  memset(&out, 0, sizeof out);
+  cli_grow_info info;
+  int code = EXIT_OK;
+  vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
+  if (!st) cli_grow_info_free(&info);
+  if (!st && o.wind_file) st = read_wind(o.wind_file, &wind, &nwind, &err);
+  if (!st) st = vd_plant_compile(spec, &plant, &err);
+  if (!st) st = vd_sim_build(plant, &o.def, &m, &err);
+  if (!st) {
+    vd_vec3 g = m->opt.gravity;
+    m->opt = o.opt;
+    m->opt.gravity = g;
+    m->opt.wind_series = wind;
+    m->opt.nwind = nwind;
+    d = vd_sim_data_create(m);
+    if (!d) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  // organs to pull, colliders
+  for (int k = 0; !st && k < o.npull; k++) {
+    pull* p = &o.pull[k];
+    p->node = vd_sim_find_organ(m, plant, p->organ, p->instance);
+    if (p->node < 0)
+      st = vd_error_set(&err, VD_ERR_VALUE, o.po.path, 0, 0, "no organ '%s'%s%.0d in the plant (labels or organ names)",
+                        p->organ, p->instance ? "#" : "", p->instance);
+    else if (p->move && (p->tie = vd_sim_add_tie(d, p->node, d->node_pos[p->node], 1e-5)) < 0)
+      st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  if (!st && !o.no_ground) {
+    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o.ground), vd_quat_identity(), vd_v3(0, 0, 0)};
+    vd_sim_add_collider(d, &c);
+  }
+  for (int k = 0; !st && k < o.nprobe; k++) {
+    vd_sim_collider c = {VD_SIM_SPHERE, {o.probe[k].r, 0, 0}, o.probe[k].p0, vd_quat_identity(), vd_v3(0, 0, 0)};
+    o.probe[k].id = vd_sim_add_collider(d, &c);
+  }
+  if (st) {
+    code = cli_report("sim", &err, st);
+    goto done;
+  }
+  // output folder: failing to write is a failed run (exit 1), not bad input
+  if (o.out) {
+    if (mkdir(o.out, 0777) && errno != EEXIST)
+      st = vd_error_set(&err, VD_ERR_IO, o.out, 0, 0, "cannot create the output folder: %s", strerror(errno));
+    if (!st) st = write_rod_json(m, plant, o.out, &err);
+    if (!st && strcmp(o.frames, "none")) st = frames_begin(&out, m, o.out, !strcmp(o.frames, "jsonl"), &err);
+    if (st) {
+      cli_report("sim", &err, st);
+      code = EXIT_FAIL;
+      goto done;
+    }
+  }
+  {
+    double t0 = cli_now();
+    int settled = 0, settle_steps = -1;
+    int64_t steps0 = d->nstep;
+    // settling first
+    if (o.settle || o.statics) {
+      vd_sim_settle_def sd = vd_sim_settle_def_default();
+      sd.statics = o.statics;
+      sd.ke_tol = o.ke_tol;
+      if (o.po.progress) fprintf(stderr, "settling...\n");
+      st = vd_sim_settle(m, d, &sd, &settled, &settle_steps);
+    }
+    // the timed run with probes and pulls
+    double start = d->time, total = o.duration, next_frame = start;
+    double ramp = o.ramp_set ? o.ramp : total;
+    int show = o.po.progress && total / m->opt.dt > 2000;
+    if (out.frames_open) frames_write(&out, m, d), next_frame += 1.0 / o.fps;
+    while (!st && d->time - start < total - 0.5 * m->opt.dt) {
+      double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
+      for (int k = 0; k < o.npull; k++) {
+        pull* p = &o.pull[k];
+        if (p->move)
+          d->tie[p->tie].target = vd_madd(m->node_pos0[p->node], p->v, f);
+        else
+          d->node_force[p->node] = vd_scale(p->v, f);
+      }
+      for (int k = 0; k < o.nprobe; k++) {
+        const probe* pr = &o.probe[k];
+        double t1 = pr->t1 < 0 ? total : pr->t1, s = (t + m->opt.dt - pr->t0) / (t1 - pr->t0);
+        s = s < 0 ? 0 : s > 1 ? 1 : s;
+        vd_sim_set_collider_pose(m, d, pr->id, vd_add(pr->p0, vd_scale(vd_sub(pr->p1, pr->p0), s)), vd_quat_identity());
+      }
+      st = vd_sim_step(m, d);
+      if (out.frames_open && d->time >= next_frame - 1e-12) {
+        frames_write(&out, m, d);
+        next_frame += 1.0 / o.fps;
+      }
+      if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);
+    }
+    if (show) progress_bar(total, total), fputc('\n', stderr);
+    double wall = cli_now() - t0;
+    if (st) {
+      vd_error_set(&err, st, "", 0, 0, "the simulation became unstable at t = %.4f s (non-finite state); try a smaller --dt",
+                   d->time);
+      code = cli_report("sim", &err, st);
+      code = EXIT_FAIL;
+      goto done;
+    }
+    // outputs
+    if (out.frames_open) {
+      st = vd_outfile_commit(&out.frames, &err);
+      out.frames_open = 0;
+    }
+    if (!st && o.out) st = write_events(d, plant, o.out, &err);
+    if (!st && (o.out || o.final)) {
+      vd_sim_to_spec(m, d, spec);
+      if (o.out) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/plant.json", o.out);
+        st = vd_plant_write_json(spec, path, &err);
+      }
+      if (!st && o.final) st = cli_write_plant(spec, o.final, 0, &err);
+    }
+    if (st) {
+      cli_report("sim", &err, st);
+      code = EXIT_FAIL;
+      goto done;
+    }
+    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps)) code = EXIT_FAIL;
+  }
+done:
+  if (out.frames_open) vd_outfile_abort(&out.frames);
+  vd_free(out.bbuf, out.fbuf_n);
+  vd_sim_data_destroy(d);
+  vd_sim_model_destroy(m);
+  vd_model_destroy(plant);
+  vd_plant_spec_destroy(spec);
+  vd_free(wind, (size_t)nwind * 4 * sizeof(double));
+  return code;
+}

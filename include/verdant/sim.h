@@ -1,0 +1,355 @@
+// SPDX-License-Identifier: MIT
+// verdant sim: plant physics with Cosserat rods (Kugelstadt & Schömer 2016) in XPBD form
+// (Macklin et al. 2016), solved either by Gauss-Seidel iterations or exactly by a linear-time
+// direct solver over the plant's tree (Deul et al. 2018; Baraff 1996). SI units throughout.
+//
+// A plant (vd_model) is turned into a rod model (vd_sim_model) by vd_sim_build: its axes are
+// resampled to rod segments of about def.segment_length, keeping junctions, tips, organ changes,
+// attachment points and abscission nodes as key nodes; positions live on nodes, one quaternion
+// per segment; each segment carries a stretch-shear constraint and a bend-twist constraint with
+// its parent segment. Leaves become small rod graphs (midrib and two side veins), fruits spheres
+// on a stalk segment; the first def.clamp_length of every root segment is clamped. The rod
+// model is const; a vd_sim_data holds the state (positions, frames, velocities, multipliers,
+// colliders, ties, events), so one model drives many states.
+//
+// Ownership: the caller owns models and states; vd_sim_data borrows its model, which must
+// outlive it. opt (inside the model) may be changed between steps; nothing else.
+//
+// Usage:
+//   vd_sim_def def = vd_sim_def_default();           // materials, segment length, sag-free
+//   vd_sim_model* sm; vd_sim_build(plant_model, &def, &sm, &err);
+//   vd_sim_data* sd = vd_sim_data_create(sm);
+//   for (int i = 0; i < 1000; i++) vd_sim_step(sm, sd);  // 1 s at opt.dt = 1 ms
+//   vd_sim_to_plant(sm, sd, plant_model, plant_data);    // deformed plant for meshes/clouds
+#ifndef VERDANT_SIM_H
+#define VERDANT_SIM_H
+
+#include "verdant/core.h"
+#include "verdant/plant.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VD_SIM_FRAMES_VERSION 1  // version of the binary and JSON Lines frame formats
+#define VD_SIM_MAX_COLLIDERS 64  // most external colliders one state holds
+
+// Material classes: each rod segment takes its material from one of these.
+typedef enum vd_sim_class {
+  VD_SIM_GREEN = 0,  // green (herbaceous) stem: organ stem, other
+  VD_SIM_WOOD,       // lignified stem: organ stem whose label says trunk, branch, wood, twig, bole
+  VD_SIM_PEDICEL,    // pedicels and peduncles (fruit stalks)
+  VD_SIM_LEAF,       // petioles, rachises and leaf veins
+  VD_SIM_FRUIT,      // fruit spheres and their calyx joint
+  VD_SIM_FLOWER,     // flowers and buds
+  VD_SIM_ROOT,       // roots (clamped in the soil unless def.clamp_roots is 0)
+  VD_SIM_CLASS_COUNT
+} vd_sim_class;
+
+// Lower-case name of a material class ("green", "wood", "pedicel", ...).
+const char* vd_sim_class_name(vd_sim_class c);
+// Class for a name as written by vd_sim_class_name, or VD_SIM_CLASS_COUNT if none.
+vd_sim_class vd_sim_class_parse(const char* name);
+
+// Material of one class. INFINITY disables a fracture threshold.
+typedef struct vd_sim_material {
+  double young;         // Young's modulus E (Pa)
+  double poisson;       // Poisson ratio nu (-); shear modulus G = E / (2 (1 + nu))
+  double density;       // density rho (kg/m^3)
+  double break_force;   // a joint breaks when its constraint force exceeds this (N)
+  double break_moment;  // ... or its constraint moment exceeds this (N m)
+  double break_cs;      // ... or |C_s| (stretch-shear strain, -) exceeds this (the paper's C_s^max)
+  double break_cb;      // ... or |C_b| (Darboux vector change, 1/m) exceeds this (C_b^max)
+  double drag_cd;       // drag coefficient of the segment (cylinder) or sphere (-)
+} vd_sim_material;
+
+// Rod-model settings for vd_sim_build.
+typedef struct vd_sim_def {
+  double segment_length;          // target rod segment length sigma_distance (m)
+  double clamp_length;            // length of each root segment held fixed, like a pot (m)
+  int clamp_roots;                // 1: segments of organ root are fixed (no soil model yet)
+  vd_sim_material material[VD_SIM_CLASS_COUNT];  // per class; see vd_sim_def_default
+  double leaf_areal_density;      // mass of leaf lamina per area (kg/m^2)
+  double leaf_vein_ratio;         // midrib radius at the leaf base / blade length (-)
+  double leaf_plate_cd;           // drag coefficient of the lamina, normal flow (-)
+  int leaf_graphs;                // 1: leaf meshes become rod graphs; 0: rigid on their node
+  int sag_free;                   // 1: rest shape solved so the modelled shape is in equilibrium
+  vd_vec3 gravity;                // gravity used by sag_free and copied to opt.gravity (m/s^2)
+  double stake_spacing;           // tie the main stem to a fixed stake every this length (m), 0 off
+  double stake_stiffness;         // stiffness of each stake tie (N/m)
+} vd_sim_def;
+
+// Defaults (sources in docs/physics.md):
+//   segment_length 0.02 m, clamp_length 0.01 m, clamp_roots 1, leaf_graphs 1, sag_free 0,
+//   gravity (0, 0, -9.81) m/s^2, stake_spacing 0 m (off), stake_stiffness 1e4 N/m,
+//   leaf_areal_density 0.22 kg/m^2, leaf_vein_ratio 0.015, leaf_plate_cd 1.17;
+//   materials            E (Pa)   nu    rho (kg/m^3)  drag cd   fracture
+//     green stem         1e9      0.3   1000          1.2       never
+//     wood               1e10     0.3   900           1.2       never
+//     pedicel            5e8      0.3   1000          1.2       abscission joint: 6.5 N, 1e-2 N m
+//     leaf               5e8      0.3   900           1.2       never
+//     fruit              5e6      0.3   800           0.47      calyx joint: 1.5 N
+//     flower             1e8      0.3   500           0.47      never
+//     root               1e10     0.3   900           1.2       never
+//   break_cs and break_cb are INFINITY (off) for every class.
+vd_sim_def vd_sim_def_default(void);
+
+// Solver for the constraint projection.
+typedef enum vd_sim_solver {
+  VD_SIM_DIRECT = 0,  // exact linear-time tree solve per Newton iteration (Deul et al. 2018)
+  VD_SIM_GS           // XPBD Gauss-Seidel sweeps (Macklin et al. 2016), multipliers accumulated
+} vd_sim_solver;
+
+// Run settings: stored in the model, may be changed between steps.
+typedef struct vd_sim_opt {
+  double dt;                  // time step h (s)
+  int iterations;             // Newton iterations (direct) or sweeps (gs) per step
+  vd_sim_solver solver;       // constraint solver
+  vd_vec3 gravity;            // gravitational acceleration (m/s^2)
+  double air_density;         // rho_air (kg/m^3); wind pressure P = rho_air |v|^2 / 2 = 0.613 |v|^2
+  vd_vec3 wind;               // mean wind velocity (m/s)
+  double gust_amplitude;      // gusts: wind * (1 + a sin(2 pi t / gust_period)), a (-)
+  double gust_period;         // gust period (s)
+  const double* wind_series;  // Nullable: time series rows (t s, vx, vy, vz m/s), linear in t,
+                              // replaces wind and gusts; owned by the caller (nwind rows x 4)
+  int nwind;                  // rows of wind_series
+  int drag;                   // 1: aerodynamic forces (wind and quadratic air drag) on
+                              // segments, spheres and leaf laminae; 0: none
+  double stokes_viscosity;    // Stokes drag 6 pi eta r v (Pa s); numerical damping only, 0 off
+  double damping;             // stiffness-proportional (Rayleigh) damping time tau (s)
+  double mass_damping;        // velocity damping rate c: v /= 1 + c h (1/s)
+  int fracture;               // 1: joints break at their thresholds
+  int contacts;               // 1: colliders are projected
+  double friction;            // Coulomb friction coefficient of contacts (-)
+} vd_sim_opt;
+
+// Defaults: dt 1e-3 s, iterations 1, solver direct, gravity (0, 0, -9.81) m/s^2,
+// air_density 1.226 kg/m^3, wind 0 m/s, gust_amplitude 0, gust_period 2 s, no wind series,
+// drag 1, stokes_viscosity 0 Pa s, damping 0 s, mass_damping 0 1/s, fracture 1, contacts 1,
+// friction 0.5.
+vd_sim_opt vd_sim_opt_default(void);
+
+// rod segment flags
+#define VD_SIM_FIXED 1u      // kinematic: clamped (position and frame)
+#define VD_SIM_FRUITSEG 2u   // stalk from a pedicel tip to a fruit (or bud) centre
+#define VD_SIM_LEAFSEG 4u    // part of a leaf rod graph
+#define VD_SIM_CONNECT 8u    // connector bridging a gap between a parent and its child
+#define VD_SIM_ABSCISSION 16u  // its joint with the parent is a pedicel abscission node
+
+// The rod model: compiled once, read-only. Arrays live in one block.
+typedef struct vd_sim_model {
+  int nnode;              // rod nodes
+  int nseg;               // rod segments (each with a stretch-shear and a bend-twist constraint)
+  int nspare;             // spare nodes, one per breakable joint, used when it breaks
+  int nnode_all;          // nnode + nspare
+  int ntie;               // stake ties
+  int nbind_node, nbind_seg, nbind_sphere, nbind_vert;  // plant elements bound to the rods
+  vd_sim_opt opt;         // run settings (may be changed between steps)
+  // nodes (nnode_all; spare nodes after the first nnode)
+  vd_vec3* node_pos0;     // modelled position (m)
+  double* node_mass;      // lumped mass (kg)
+  double* node_radius;    // contact sphere radius (m)
+  int* node_owner;        // segment that ends at the node, -1 for fixed root nodes and spares
+  int* node_fixed;        // 1 when the node is kinematic
+  double* node_sphere;    // drag sphere radius at the node, 0 if none (m)
+  // segments (nseg)
+  int* seg_node;          // start and end node (nseg x 2)
+  int* seg_parent;        // parent segment of the bend-twist constraint, -1 if none
+  unsigned* seg_flags;    // VD_SIM_* flags
+  int* seg_class;         // vd_sim_class
+  int* seg_label;         // semantic label id of the plant element it came from
+  int* seg_instance;      // organ instance id
+  int* seg_plant;         // plant segment it resamples, -1 for leaves, fruits, connectors
+  int* seg_spare;         // spare node used if its joint breaks, -1 if unbreakable
+  int* seg_order;         // post-order index: children before parents (nseg)
+  double* seg_len0;       // rest length l0 (m)
+  double* seg_radius;     // radius (m)
+  double* seg_mass;       // mass of the segment's own material, lumped half on each node (kg)
+  vd_quat* seg_quat0;     // modelled frame: d3 (z) along the segment (initial state)
+  vd_quat* seg_rest;      // rest relative rotation conj(q_parent) q (bend-twist rest, augmented)
+  double* seg_lbar;       // Darboux length l-bar = (l_parent + l) / 2 of the joint (m)
+  double* seg_cs;         // stretch-shear compliance of C_s (shear, shear, stretch) (nseg x 3)
+  double* seg_cb;         // bend-twist compliance of C_b (bend, bend, twist) (nseg x 3)
+  double* seg_inertia;    // rotary inertia about d1/d2 and about d3 (kg m^2) (nseg x 2)
+  double* seg_break;      // thresholds: force N, moment N m, C_s, C_b 1/m (nseg x 4)
+  double* seg_cd;         // drag coefficient (-)
+  double* seg_leaf_normal;// lamina normal in the segment frame, area-weighted (nseg x 3)
+  // stake ties (ntie)
+  int* tie_node;          // tied node
+  vd_vec3* tie_anchor;    // fixed anchor point (m)
+  double* tie_compliance; // compliance (m/N)
+  // bindings: where each plant element sits on the rods (for vd_sim_to_plant)
+  int* bind_node_seg;     // plant node -> rod segment (-1: rod node bind_node_ref) (nbind_node)
+  int* bind_node_ref;     // rod node when bound to a node, else unused (nbind_node)
+  vd_vec3* bind_node_local;  // offset in the segment's modelled frame from its start node (m)
+  int* bind_seg_seg;      // plant segment -> rod segment whose rotation it follows (nbind_seg)
+  vd_quat* bind_seg_local;   // conj(rod modelled frame) * plant frame (nbind_seg)
+  int* bind_sphere_node;  // plant sphere -> rod node at its centre (nbind_sphere)
+  int* bind_sphere_seg;   // ... and the segment whose frame it follows (-1 none)
+  int* bind_vert_seg;     // mesh vertex -> rod segment (nbind_vert)
+  vd_vec3* bind_vert_local;  // offset in that segment's modelled frame from its start node (m)
+  int main_tip;           // node at the end of the main axis (for tip_displacement), -1 if none
+  double leaf_cd;         // drag coefficient of leaf laminae, normal flow (-)
+  int nsagfree_clamped;   // joints whose sag-free rest curvature was out of reach (too heavy)
+  double total_mass;      // sum of node masses (kg)
+  size_t nbytes;          // size of the single allocation
+} vd_sim_model;
+
+// An external collider, moved by the caller (one-way coupling: the plant does not push it).
+typedef enum vd_sim_shape {
+  VD_SIM_PLANE = 0,  // half-space below the plane through pos with normal +z of quat
+  VD_SIM_SPHERE,     // sphere of radius size[0] at pos
+  VD_SIM_CAPSULE,    // capsule of radius size[0], half-length size[1] along z of quat
+  VD_SIM_BOX         // box of half-extents size[0..2] in the frame of quat
+} vd_sim_shape;
+
+typedef struct vd_sim_collider {
+  vd_sim_shape shape;  // shape kind
+  double size[3];      // shape sizes (m), see vd_sim_shape
+  vd_vec3 pos;         // position (m)
+  vd_quat quat;        // orientation
+  vd_vec3 vel;         // velocity (m/s), set by vd_sim_set_collider_pose from pose changes
+} vd_sim_collider;
+
+// One fracture: the joint of segment seg with its parent broke at time t.
+typedef struct vd_sim_event {
+  double time;        // simulation time (s)
+  int seg;            // rod segment detached from its parent
+  int node;           // node where it broke
+  int label;          // label id of the segment
+  int instance;       // organ instance id of the segment
+  int cls;            // vd_sim_class of the segment
+  double force;       // constraint force at breaking (N)
+  double moment;      // constraint moment at breaking (N m)
+  double cs, cb;      // |C_s| (-) and |C_b| (1/m) at breaking
+  int cause;          // 0 force, 1 moment, 2 C_s, 3 C_b
+} vd_sim_event;
+
+// A user tie: a node pulled toward a target point by a spring (a displacement pull).
+typedef struct vd_sim_tie {
+  int node;           // rod node
+  vd_vec3 target;     // target point (m), may move each step
+  double compliance;  // 1 / stiffness (m/N), > 0
+} vd_sim_tie;
+
+// The state of one rod model.
+typedef struct vd_sim_data {
+  int nnode_all, nseg;     // sizes copied from the model
+  double time;             // simulation time (s)
+  int64_t nstep;           // steps taken
+  vd_vec3* node_pos;       // position (m) (nnode_all)
+  vd_vec3* node_vel;       // velocity (m/s) (nnode_all)
+  vd_vec3* node_force;     // external force set by the caller, kept across steps (N) (nnode_all)
+  double* node_mass;       // current lumped mass, changes when a joint breaks (kg) (nnode_all)
+  vd_quat* seg_quat;       // frame (nseg)
+  vd_vec3* seg_omega;      // angular velocity, world frame (rad/s) (nseg)
+  vd_vec3* seg_torque;     // external torque set by the caller (N m) (nseg)
+  double* seg_lambda;      // accumulated multipliers: stretch-shear 3, bend-twist 3 (nseg x 6)
+  int* seg_broken;         // 1 when the joint with the parent has broken (nseg)
+  int* seg_start;          // current start node: seg_node[2s] or its spare after breaking (nseg)
+  vd_sim_collider collider[VD_SIM_MAX_COLLIDERS];  // external colliders
+  int ncollider;           // colliders in use
+  vd_sim_tie* tie;         // user ties (ntie, capacity cap_tie)
+  int ntie, cap_tie;
+  vd_sim_event* event;     // fracture events since the last reset (nevent, at most nseg)
+  int nevent;
+  int ncontact;            // contacts found in the last step
+  double max_penetration;  // deepest penetration left after the last step (m)
+  int64_t nwarning;        // numerical warnings (non-finite state, arena failure)
+  void* work;              // solver scratch (private)
+  size_t work_bytes;       // size of work
+  vd_arena arena;          // per-step scratch (contacts)
+  size_t nbytes;           // size of the state block
+} vd_sim_data;
+
+// Build the rod model of a compiled plant. Errors name the offending element.
+vd_status vd_sim_build(const vd_model* plant, const vd_sim_def* def, vd_sim_model** out,
+                       vd_error* err);
+// Free a rod model (NULL is fine).
+void vd_sim_model_destroy(vd_sim_model* m);
+// New state at the modelled shape, at rest; NULL when out of memory.
+vd_sim_data* vd_sim_data_create(const vd_sim_model* m);
+// Put a state back at the modelled shape (colliders and ties are kept, events cleared).
+void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d);
+// Free a state (NULL is fine).
+void vd_sim_data_destroy(vd_sim_data* d);
+
+// Advance one time step of m->opt.dt. Non-finite states are counted in d->nwarning and the
+// state is put back to the previous step; returns VD_ERR_VALUE then, else VD_OK.
+vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d);
+
+// Settling: what to run and when to stop.
+typedef struct vd_sim_settle_def {
+  int statics;           // 1: solve the static equilibrium directly (quasi-static Newton steps)
+  double ke_tol;         // dynamics: stop when kinetic energy stays < ke_tol for 0.25 s (J) ...
+  double disp_tol;       // ... or statics: when the largest node move of a step < disp_tol (m)
+  double max_time;       // dynamics: give up after this much simulated time (s)
+  int max_steps;         // statics: give up after this many steps
+  double extra_damping;  // dynamics: mass damping rate added while settling (1/s)
+} vd_sim_settle_def;
+
+// Defaults: statics 0, ke_tol 1e-9 J, disp_tol 1e-9 m, max_time 10 s, max_steps 400,
+// extra_damping 5 1/s.
+vd_sim_settle_def vd_sim_settle_def_default(void);
+// Settle the state under the current loads. *converged (Nullable) tells whether the tolerance
+// was met; *steps (Nullable) the steps taken. Fractures may happen on the way.
+vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_settle_def* def,
+                        int* converged, int* steps);
+
+// Add an external collider; returns its index or -1 when VD_SIM_MAX_COLLIDERS are in use.
+int vd_sim_add_collider(vd_sim_data* d, const vd_sim_collider* c);
+// Move collider i to a new pose for the next step; its velocity becomes (pos - old) / dt.
+void vd_sim_set_collider_pose(const vd_sim_model* m, vd_sim_data* d, int i, vd_vec3 pos, vd_quat q);
+// Add a user tie (compliance > 0); returns its index or -1 when out of memory.
+int vd_sim_add_tie(vd_sim_data* d, int node, vd_vec3 target, double compliance);
+
+// Node that represents an organ: the sphere centre of a fruit, else the node of the organ
+// farthest from the root. label may be a label name or an organ name; instance 0 picks the
+// first instance carrying it. Returns -1 when nothing matches.
+int vd_sim_find_organ(const vd_sim_model* m, const vd_model* plant, const char* label, int instance);
+// Kinetic energy of the state (J).
+double vd_sim_kinetic_energy(const vd_sim_model* m, const vd_sim_data* d);
+// Largest distance of any node from its modelled position (m); *node (Nullable) gets the node.
+double vd_sim_max_displacement(const vd_sim_model* m, const vd_sim_data* d, int* node);
+
+// Write the deformed plant into a plant state (node, segment frames, spheres, mesh vertices,
+// broken segments); plant must be the model m was built from.
+void vd_sim_to_plant(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant,
+                     vd_data* out);
+// Same into an editable spec (positions, sphere centres, mesh vertices, segment up vectors);
+// spec must be the one plant was compiled from.
+void vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec);
+
+// ---------------------------------------------------------------------------------------------
+// validation against analytic references (docs/validation.md)
+
+// One checked quantity.
+typedef struct vd_validate_result {
+  char name[64];     // case name ("cantilever_tip_load")
+  char form[16];     // "discrete" (the discrete model's exact value) or "continuum"
+  char quantity[48]; // what is compared ("tip deflection (m)")
+  double measured;   // simulated value
+  double reference;  // reference value
+  double error;      // relative error |measured - reference| / |reference| (or absolute, see note)
+  double tolerance;  // allowed error
+  int pass;          // 1 when error <= tolerance
+  char note[160];    // sizes and the reference's source
+} vd_validate_result;
+
+// Validation settings.
+typedef struct vd_validate_def {
+  int full;            // 1: the full sweep (finer rods, more cases), else the quick sizes
+  const char* filter;  // Nullable: run only cases whose name contains this text
+  void (*progress)(void* user, const char* name);  // Nullable: called before each case
+  void* user;          // passed to progress
+  const vd_model* plant;  // Nullable: also run the sag-free gate on this plant (e.g. the tomato)
+} vd_validate_def;
+
+// Run the validation cases; *out (free with vd_free(*out, *n * sizeof **out)) gets the results.
+vd_status vd_sim_validate(const vd_validate_def* def, vd_validate_result** out, int* n,
+                          vd_error* err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: MIT
+// External loads of a step: gravity on the lumped node masses, the caller's forces and
+// torques, aerodynamic forces from the wind and the plant's own motion, optional Stokes drag.
+//
+// Aerodynamics: dynamic pressure P = rho_air |u|^2 / 2 (= 0.613 |u|^2 for rho_air = 1.226
+// kg/m^3, the ASCE 7 velocity pressure) on the relative air velocity u = wind - v, quadratic
+// in |u| at plant Reynolds numbers (10^2 - 10^5): cylinders see the normal component of u on
+// their projected area 2 r l with C_d ~ 1.2, spheres C_d ~ 0.47 on pi r^2, leaf laminae the
+// normal component on their area with C_d ~ 1.17. Stokes drag 6 pi eta r v holds only for
+// Re < 1 (a 5 mm stem at 0.1 m/s in air already has Re ~ 30), so it is offered as optional
+// numerical damping, never as the air model.
+#include "sim_internal.h"
+
+vd_vec3 sim_wind_at(const vd_sim_opt* o, double t) {
+  // a time series replaces the mean wind and the gusts; linear between rows, held at the ends
+  if (o->wind_series && o->nwind > 0) {
+    const double* w = o->wind_series;
+    if (t <= w[0] || o->nwind == 1) return vd_v3(w[1], w[2], w[3]);
+    for (int i = 1; i < o->nwind; i++) {
+      const double* a = w + 4 * (i - 1);
+      const double* b = w + 4 * i;
+      if (t <= b[0]) {
+        double s = b[0] > a[0] ? (t - a[0]) / (b[0] - a[0]) : 1.0;
+        return vd_v3(a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]));
+      }
+    }
+    const double* z = w + 4 * (o->nwind - 1);
+    return vd_v3(z[1], z[2], z[3]);
+  }
+  double f = 1.0;
+  if (o->gust_period > 0) f += o->gust_amplitude * sin(2 * VD_PI * t / o->gust_period);
+  return vd_scale(o->wind, f);
+}
+
+// velocity of a node (zero when kinematic)
+static vd_vec3 node_v(const vd_sim_model* m, const vd_sim_data* d, int n) {
+  return sim_node_w(m, d, n) > 0 ? d->node_vel[n] : vd_v3(0, 0, 0);
+}
+
+void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
+  const vd_sim_opt* o = &m->opt;
+  int nn = m->nnode_all;
+  // gravity and the caller's loads
+  for (int n = 0; n < nn; n++) {
+    double mass = d->node_mass[n];
+    w->node_fext[n] = sim_node_w(m, d, n) > 0 ? vd_add(vd_scale(o->gravity, mass), d->node_force[n])
+                                              : vd_v3(0, 0, 0);
+  }
+  for (int t = 0; t < m->nseg; t++) w->seg_text[t] = d->seg_torque[t];
+  // Stokes drag (numerical damping only)
+  if (o->stokes_viscosity > 0)
+    for (int n = 0; n < nn; n++)
+      if (sim_node_w(m, d, n) > 0)
+        w->node_fext[n] = vd_madd(w->node_fext[n], d->node_vel[n],
+                                  -6 * VD_PI * o->stokes_viscosity * m->node_radius[n]);
+  if (!o->drag) return;
+  vd_vec3 wind = sim_wind_at(o, d->time);
+  double q = 0.5 * o->air_density;
+  // segments: cylinders in cross flow, leaf laminae as plates
+  for (int t = 0; t < m->nseg; t++) {
+    if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
+    int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
+    double wa = sim_node_w(m, d, na), wb = sim_node_w(m, d, nb);
+    if (wa <= 0 && wb <= 0) continue;
+    vd_vec3 u = vd_sub(wind, vd_scale(vd_add(node_v(m, d, na), node_v(m, d, nb)), 0.5));
+    vd_quat qt = d->seg_quat[t];
+    vd_vec3 d3 = quat_d3(qt);
+    vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
+    double area = 2 * m->seg_radius[t] * m->seg_len0[t];
+    vd_vec3 f = vd_scale(up, q * m->seg_cd[t] * area * v_norm(up));
+    const double* ln = m->seg_leaf_normal + 3 * t;
+    if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
+      vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
+      double a = v_norm(nw);
+      double un = vd_dot(u, nw) / a;
+      f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
+    }
+    // half to each end that moves (all of it when the other end is held)
+    double sa = wa > 0 ? (wb > 0 ? 0.5 : 1.0) : 0.0;
+    w->node_fext[na] = vd_madd(w->node_fext[na], f, sa);
+    w->node_fext[nb] = vd_madd(w->node_fext[nb], f, 1.0 - sa);
+  }
+  // spheres (fruits, buds) on their centre node
+  for (int n = 0; n < nn; n++) {
+    if (m->node_sphere[n] <= 0 || sim_node_w(m, d, n) <= 0) continue;
+    vd_vec3 u = vd_sub(wind, d->node_vel[n]);
+    int o2 = m->node_owner[n];
+    double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
+    w->node_fext[n] = vd_madd(w->node_fext[n], u, q * cd * VD_PI * r * r * v_norm(u));
+  }
+}

@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: MIT
+// Private pieces of the sim module: small dense math (3x3, 6x6), quaternion maps, the
+// constraint evaluation shared by both solvers, the solvers, contacts, forces, sag-free.
+#ifndef VERDANT_SIM_INTERNAL_H
+#define VERDANT_SIM_INTERNAL_H
+
+#include <math.h>
+#include <string.h>
+
+#include "verdant/sim.h"
+
+// ---------------------------------------------------------------------------------------------
+// 3x3 matrices, row-major double[9]
+
+static inline void m3_zero(double* a) { memset(a, 0, 9 * sizeof(double)); }
+static inline void m3_ident(double* a, double s) {
+  m3_zero(a);
+  a[0] = a[4] = a[8] = s;
+}
+// rotation matrix of a unit quaternion
+static inline void m3_from_quat(double* r, vd_quat q) {
+  double w = q.w, x = q.x, y = q.y, z = q.z;
+  r[0] = 1 - 2 * (y * y + z * z), r[1] = 2 * (x * y - w * z), r[2] = 2 * (x * z + w * y);
+  r[3] = 2 * (x * y + w * z), r[4] = 1 - 2 * (x * x + z * z), r[5] = 2 * (y * z - w * x);
+  r[6] = 2 * (x * z - w * y), r[7] = 2 * (y * z + w * x), r[8] = 1 - 2 * (x * x + y * y);
+}
+static inline vd_vec3 m3_mul_v(const double* a, vd_vec3 v) {
+  return vd_v3(a[0] * v.x + a[1] * v.y + a[2] * v.z, a[3] * v.x + a[4] * v.y + a[5] * v.z,
+               a[6] * v.x + a[7] * v.y + a[8] * v.z);
+}
+static inline vd_vec3 m3_tmul_v(const double* a, vd_vec3 v) {
+  return vd_v3(a[0] * v.x + a[3] * v.y + a[6] * v.z, a[1] * v.x + a[4] * v.y + a[7] * v.z,
+               a[2] * v.x + a[5] * v.y + a[8] * v.z);
+}
+// c = a b
+static inline void m3_mul(double* c, const double* a, const double* b) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
+}
+// c = a^T
+static inline void m3_transpose(double* c, const double* a) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) c[3 * i + j] = a[3 * j + i];
+}
+// cross-product matrix [v]x
+static inline void m3_skew(double* a, vd_vec3 v) {
+  a[0] = 0, a[1] = -v.z, a[2] = v.y;
+  a[3] = v.z, a[4] = 0, a[5] = -v.x;
+  a[6] = -v.y, a[7] = v.x, a[8] = 0;
+}
+// solve the symmetric positive definite 3x3 system a x = b (a is not changed); 0 if singular
+int m3_solve_spd(const double* a, vd_vec3 b, vd_vec3* x);
+// world inverse inertia R diag(1/ib, 1/ib, 1/it) R^T of a rod segment with frame r (0 if fixed)
+void m3_inv_inertia(double* out, const double* r, double ib, double it);
+
+// ---------------------------------------------------------------------------------------------
+// 6x6 matrices, row-major double[36]; Cholesky factors stored in place (lower triangle)
+
+// in-place Cholesky a = L L^T; returns 0 if not positive definite
+int m6_cholesky(double* a);
+// solve L L^T x = b in place (b has 6 entries)
+void m6_chol_solve(const double* l, double* b);
+
+// ---------------------------------------------------------------------------------------------
+// quaternions: inline copies of the core operations for the hot loops
+
+static inline vd_quat q_mul(vd_quat a, vd_quat b) {
+  vd_quat q = {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+               a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+  return q;
+}
+static inline vd_quat q_conj(vd_quat q) {
+  vd_quat c = {q.w, -q.x, -q.y, -q.z};
+  return c;
+}
+static inline vd_quat q_normalize(vd_quat q) {
+  double n = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  if (!(n > 0)) return vd_quat_identity();
+  double in = 1.0 / n;
+  vd_quat r = {q.w * in, q.x * in, q.y * in, q.z * in};
+  return r;
+}
+// v rotated by the unit quaternion q
+static inline vd_vec3 q_rotate(vd_quat q, vd_vec3 v) {
+  // t = 2 (u x v), v' = v + w t + u x t
+  vd_vec3 u = {q.x, q.y, q.z};
+  vd_vec3 t = vd_scale(vd_cross(u, v), 2.0);
+  return vd_add(vd_add(v, vd_scale(t, q.w)), vd_cross(u, t));
+}
+static inline double v_norm(vd_vec3 a) { return sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
+
+// rotation by the rotation vector v (exponential map)
+vd_quat quat_exp(vd_vec3 v);
+// rotation vector of q (logarithm map), shortest (|angle| <= pi)
+vd_vec3 quat_log(vd_quat q);
+// q rotated by the world rotation vector v: exp(v) q, normalised
+vd_quat quat_rotate_by(vd_quat q, vd_vec3 v);
+static inline double quat_dot(vd_quat a, vd_quat b) { return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline vd_vec3 quat_im(vd_quat q) { return vd_v3(q.x, q.y, q.z); }
+// d3 (z axis) of a frame
+static inline vd_vec3 quat_d3(vd_quat q) {
+  return vd_v3(2 * (q.x * q.z + q.w * q.y), 2 * (q.y * q.z - q.w * q.x), 1 - 2 * (q.x * q.x + q.y * q.y));
+}
+// smallest rotation taking unit vector a to unit vector b
+vd_quat quat_between(vd_vec3 a, vd_vec3 b);
+
+// ---------------------------------------------------------------------------------------------
+// constraint evaluation (both solvers use these; sim_constraint.c)
+
+// One joint linearised at the current state: segment t's stretch-shear rows (0..2, material
+// frame) and the bend-twist rows with its parent (3..5, parent's frame).
+typedef struct sim_joint {
+  double c[6];       // constraint values
+  double alpha[6];   // compliance (before dividing by h^2)
+  double a[9];       // d C_s / d x_end = R^T / l0 (also -d C_s / d x_start)
+  double b[9];       // d C_s / d theta_t = R^T [e / l0]x
+  double g[9];       // d C_b / d theta_t (d C_b / d theta_parent = -g)
+  int bend;          // 1 when the bend-twist rows are active
+  int parent_body;   // parent body: segment, nseg + spare index, or -1 when kinematic
+} sim_joint;
+
+// Evaluate joint t (segment t must not be fixed).
+void sim_joint_eval(const vd_sim_model* m, const vd_sim_data* d, int t, sim_joint* j);
+// Constraint values only (for damping and fracture checks).
+void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double c[6]);
+
+// ---------------------------------------------------------------------------------------------
+// solver scratch kept in vd_sim_data::work
+
+typedef struct sim_work {
+  vd_vec3* node_prev;   // positions at the start of the step (nnode_all)
+  vd_quat* seg_prev;    // frames at the start of the step (nseg)
+  vd_vec3* node_fext;   // total external force this step (N) (nnode_all)
+  vd_vec3* seg_text;    // total external torque this step (N m) (nseg)
+  double* c_prev;       // constraint values at the start of the step (nseg x 6)
+  double* lambda_save;  // multipliers before a statics step, to undo it (nseg x 6)
+  int* spare_of;        // spare index -> segment (nspare)
+  // direct solver (bodies: nseg segments then nspare spares)
+  double* h;            // body matrices, then their inverses (nbody x 36)
+  double* gb;           // body right-hand sides (nbody x 6)
+  double* dy;           // body updates (nbody x 6)
+  double* s;            // inverses of the joint Schur matrices (nseg x 36)
+  double* r;            // joint right-hand sides (nseg x 6)
+  double* x;            // H_child^-1 J_child^T (nseg x 36)
+  double* dl;           // joint multiplier updates (nseg x 6)
+  sim_joint* joint;     // joints linearised this iteration (nseg)
+  double* tie_lambda;   // multipliers of model and user ties (ntie_all x 3)
+  int cap_tie_lambda;   // capacity of tie_lambda (rows)
+  int model_ties;       // stake ties of the model (the first rows)
+  int gravity_only;     // scratch flag
+} sim_work;
+
+// Allocate the work block for a model; NULL when out of memory. *bytes gets its size.
+sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes);
+
+struct sim_contact;
+
+// Per-step context shared by the solvers.
+typedef struct sim_step_ctx {
+  double h;                      // time step (s)
+  double gamma;                  // damping factor tau / h
+  int statics;                   // 1: quasi-static step (no inertia carried)
+  double extra_damping;          // mass damping added by settling (1/s)
+  struct sim_contact* contacts;  // contact candidates of this step
+  int ncontact;                  // their count
+} sim_step_ctx;
+
+// Both solvers: project all constraints for one step (positions and frames in d are moved).
+void sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
+void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
+
+// inverse mass of a node (0 when kinematic)
+static inline double sim_node_w(const vd_sim_model* m, const vd_sim_data* d, int n) {
+  return m->node_fixed[n] || d->node_mass[n] <= 0 ? 0.0 : 1.0 / d->node_mass[n];
+}
+// Ties (stake ties of the model, then user ties): node, target, compliance of tie k.
+int sim_tie_count(const vd_sim_model* m, const vd_sim_data* d);
+void sim_tie_get(const vd_sim_model* m, const vd_sim_data* d, int k, int* node, vd_vec3* target,
+                 double* compliance);
+
+// ---------------------------------------------------------------------------------------------
+// contacts (sim_contact_basic.c until the collide module takes over)
+
+// One contact candidate, found once per step and re-evaluated at every projection: a rod
+// element (node sphere or segment capsule) against a collider, or against a second rod element
+// (self-contact: collider -1, the second element in node2 / seg2 / t2 / radius2).
+typedef struct sim_contact {
+  int node;        // rod node whose sphere touches, or -1
+  int seg;         // rod segment whose capsule touches, or -1 (then t is the parameter)
+  double t;        // parameter along seg (0 at its start node)
+  double radius;   // radius of the rod element (m)
+  int collider;    // collider index, -1 for a self-contact
+  double lambda;   // accumulated normal correction this step (m)
+  int node2, seg2; // second rod element of a self-contact (as node / seg), else -1
+  double t2;       // parameter along seg2
+  double radius2;  // radius of the second element (m)
+} sim_contact;
+
+// Find contact candidates at the current (predicted) state, within margin (m); results go to
+// the arena. Returns the count (0 when none or the arena fails; failures counted as warnings).
+int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_contact** out);
+// Project contacts: push penetrating rod elements out of the colliders (compliance 0).
+void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n);
+// Coulomb friction on the step's tangential motion at each active contact.
+void sim_contacts_friction(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n, double h);
+// Signed gap of contact c at the current state (m, negative when penetrating).
+double sim_contact_gap(const vd_sim_model* m, const vd_sim_data* d, sim_contact* c);
+// Signed distance from point p to collider k's surface (m) and the outward normal there.
+double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* normal);
+
+// ---------------------------------------------------------------------------------------------
+// forces (sim_forces.c)
+
+// Wind velocity at time t (m/s).
+vd_vec3 sim_wind_at(const vd_sim_opt* o, double t);
+// Accumulate external forces and torques of this step into w->node_fext and w->seg_text.
+void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w);
+
+// ---------------------------------------------------------------------------------------------
+// building helpers
+
+// Sag-free rest state: given the modelled shape in m, adjust rest lengths, frames and rest
+// relative rotations so it is the static equilibrium under gravity (sim_sagfree.c). Returns
+// the number of joints where the required rest curvature was out of reach (clamped).
+int sim_sagfree(vd_sim_model* m, vd_vec3 gravity);
+
+// segment start node at the current state
+static inline int sim_seg_start(const vd_sim_data* d, const vd_sim_model* m, int t) {
+  (void)m;
+  return d->seg_start[t];
+}
+
+#endif

@@ -1,0 +1,306 @@
+// SPDX-License-Identifier: MIT
+// One time step: loads, prediction, contact candidates, constraint projection (direct or
+// Gauss-Seidel), velocities from the position change (implicit Euler, as XPBD), fracture
+// checks. Settling runs steps until the plant is still, or solves statics directly.
+#include "sim_internal.h"
+
+// does the state hold only finite numbers?
+static int finite_state(const vd_sim_model* m, const vd_sim_data* d) {
+  for (int i = 0; i < m->nnode_all; i++) {
+    vd_vec3 p = d->node_pos[i];
+    if (!isfinite(p.x + p.y + p.z)) return 0;
+  }
+  for (int t = 0; t < m->nseg; t++) {
+    vd_quat q = d->seg_quat[t];
+    if (!isfinite(q.w + q.x + q.y + q.z)) return 0;
+  }
+  return 1;
+}
+
+// detach segment t from its parent: its start moves to its spare node
+static void break_joint(const vd_sim_model* m, vd_sim_data* d, int t, double force, double moment,
+                        double cs, double cb, int cause) {
+  int a = d->seg_start[t], k = m->seg_spare[t];
+  double share = 0.5 * m->seg_mass[t];
+  if (share < 1e-6) share = 1e-6;
+  if (d->node_mass[a] > 2 * share) d->node_mass[a] -= share;
+  d->node_mass[k] = share;
+  d->node_pos[k] = d->node_pos[a];
+  d->node_vel[k] = sim_node_w(m, d, a) > 0 ? d->node_vel[a] : vd_v3(0, 0, 0);
+  d->node_force[k] = vd_v3(0, 0, 0);
+  d->seg_start[t] = k;
+  d->seg_broken[t] = 1;
+  double* lam = d->seg_lambda + 6 * t;
+  lam[3] = lam[4] = lam[5] = 0;
+  vd_sim_event* e = &d->event[d->nevent++];
+  e->time = d->time;
+  e->seg = t;
+  e->node = a;
+  e->label = m->seg_label[t];
+  e->instance = m->seg_instance[t];
+  e->cls = m->seg_class[t];
+  e->force = force;
+  e->moment = moment;
+  e->cs = cs;
+  e->cb = cb;
+  e->cause = cause;
+}
+
+// joints whose force, moment or strain passed their threshold break (each once)
+static void check_fracture(const vd_sim_model* m, vd_sim_data* d, double h) {
+  double h2 = h * h;
+  for (int t = 0; t < m->nseg; t++) {
+    if (m->seg_spare[t] < 0 || d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;
+    const double* thr = m->seg_break + 4 * t;
+    const double* lam = d->seg_lambda + 6 * t;
+    sim_joint j;
+    sim_joint_eval(m, d, t, &j);
+    // constraint force and moment: the generalised forces J^T lambda / h^2
+    vd_vec3 ms = vd_v3(lam[0] / h2, lam[1] / h2, lam[2] / h2);
+    vd_vec3 mb = vd_v3(lam[3] / h2, lam[4] / h2, lam[5] / h2);
+    double force = v_norm(m3_tmul_v(j.a, ms));
+    double moment = j.bend ? v_norm(m3_tmul_v(j.g, mb)) : 0.0;
+    double cs = sqrt(j.c[0] * j.c[0] + j.c[1] * j.c[1] + j.c[2] * j.c[2]);
+    double cb = sqrt(j.c[3] * j.c[3] + j.c[4] * j.c[4] + j.c[5] * j.c[5]);
+    int cause = force > thr[0] ? 0 : moment > thr[1] ? 1 : cs > thr[2] ? 2 : cb > thr[3] ? 3 : -1;
+    if (cause >= 0) break_joint(m, d, t, force, moment, cs, cb, cause);
+  }
+}
+
+// potential energy of the current state under the loads in w (J): elastic energy of every
+// constraint and tie, minus the work of the external forces (torques: see torque_work, their
+// potential is not single-valued once a segment turns past pi)
+static double potential_energy(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w) {
+  double e = 0;
+  for (int t = 0; t < m->nseg; t++) {
+    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
+    double c[6];
+    sim_joint_values(m, d, t, c);
+    for (int k = 0; k < 3; k++) e += 0.5 * c[k] * c[k] / m->seg_cs[3 * t + k];
+    if (!d->seg_broken[t] && m->seg_parent[t] >= 0)
+      for (int k = 0; k < 3; k++) e += 0.5 * c[3 + k] * c[3 + k] / m->seg_cb[3 * t + k];
+  }
+  int ntie = sim_tie_count(m, d);
+  for (int k = 0; k < ntie; k++) {
+    int n;
+    vd_vec3 target;
+    double comp;
+    sim_tie_get(m, d, k, &n, &target, &comp);
+    if (sim_node_w(m, d, n) <= 0) continue;
+    vd_vec3 cc = vd_sub(d->node_pos[n], target);
+    e += 0.5 * vd_dot(cc, cc) / comp;
+  }
+  for (int i = 0; i < m->nnode_all; i++)
+    if (sim_node_w(m, d, i) > 0) e -= vd_dot(w->node_fext[i], d->node_pos[i]);
+  return e;
+}
+
+// work of the external torques over the last step (rotations since the step's start)
+static double torque_work(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w) {
+  double e = 0;
+  for (int t = 0; t < m->nseg; t++)
+    if (!(m->seg_flags[t] & VD_SIM_FIXED))
+      e += vd_dot(w->seg_text[t], quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t]))));
+  return e;
+}
+
+// the step itself; statics: start from the current state, no inertia carried over
+static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* cin) {
+  sim_work* w = (sim_work*)d->work;
+  sim_step_ctx c = *cin;
+  double h = c.h;
+  int na = m->nnode_all, ns = m->nseg;
+  vd_arena_reset(&d->arena);
+  // loads at the start of the step
+  sim_forces(m, d, w);
+  memcpy(w->node_prev, d->node_pos, (size_t)na * sizeof(vd_vec3));
+  memcpy(w->seg_prev, d->seg_quat, (size_t)ns * sizeof(vd_quat));
+  if (c.gamma > 0)
+    for (int t = 0; t < ns; t++)
+      if (!(m->seg_flags[t] & VD_SIM_FIXED)) sim_joint_values(m, d, t, w->c_prev + 6 * t);
+  if (c.statics) {
+    for (int i = 0; i < na; i++) d->node_vel[i] = vd_v3(0, 0, 0);
+    for (int t = 0; t < ns; t++) d->seg_omega[t] = vd_v3(0, 0, 0);
+  } else {
+    // prediction: semi-implicit Euler on velocities, then positions and frames
+    memset(d->seg_lambda, 0, (size_t)ns * 6 * sizeof(double));
+    memset(w->tie_lambda, 0, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
+    for (int i = 0; i < na; i++) {
+      double wi = sim_node_w(m, d, i);
+      if (wi <= 0) continue;
+      vd_vec3 v = vd_madd(d->node_vel[i], w->node_fext[i], h * wi);
+      d->node_pos[i] = vd_madd(d->node_pos[i], v, h);
+    }
+    for (int t = 0; t < ns; t++) {
+      if (m->seg_flags[t] & VD_SIM_FIXED) continue;
+      double r[9], iinv[9];
+      m3_from_quat(r, d->seg_quat[t]);
+      double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
+      m3_inv_inertia(iinv, r, ib, it);
+      vd_vec3 om = d->seg_omega[t];
+      // I omega in world axes: ib omega + (it - ib) (d3 . omega) d3
+      vd_vec3 d3 = vd_v3(r[2], r[5], r[8]);
+      vd_vec3 io = vd_madd(vd_scale(om, ib), d3, (it - ib) * vd_dot(d3, om));
+      vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(om, io));
+      vd_vec3 op = vd_madd(om, m3_mul_v(iinv, tq), h);
+      d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_scale(op, h));
+    }
+  }
+  // contact candidates near the predicted state
+  c.contacts = NULL;
+  c.ncontact = 0;
+  if (m->opt.contacts && d->ncollider) {
+    double vmax = 0;
+    for (int i = 0; i < na; i++)
+      if (sim_node_w(m, d, i) > 0) {
+        double s = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
+        if (s > vmax) vmax = s;
+      }
+    c.ncontact = sim_contacts_find(m, d, 2 * vmax + 0.005, &c.contacts);
+  }
+  // constraints
+  // statics needs the primal residual that only the direct solver keeps
+  if (m->opt.solver == VD_SIM_GS && !c.statics)
+    sim_solve_gs(m, d, &c);
+  else
+    sim_solve_direct(m, d, &c);
+  // contacts have the last word (no penetration), then friction
+  d->ncontact = c.ncontact;
+  d->max_penetration = 0;
+  if (c.ncontact) {
+    sim_contacts_project(m, d, c.contacts, c.ncontact);
+    sim_contacts_friction(m, d, c.contacts, c.ncontact, h);
+    for (int k = 0; k < c.ncontact; k++) {
+      double s = sim_contact_gap(m, d, &c.contacts[k]);
+      if (-s > d->max_penetration) d->max_penetration = -s;
+    }
+  }
+  if (!finite_state(m, d)) {
+    // put the previous state back and report
+    memcpy(d->node_pos, w->node_prev, (size_t)na * sizeof(vd_vec3));
+    memcpy(d->seg_quat, w->seg_prev, (size_t)ns * sizeof(vd_quat));
+    d->nwarning++;
+    return VD_ERR_VALUE;
+  }
+  // velocities from the step's motion
+  double damp = 1.0 / (1.0 + (m->opt.mass_damping + c.extra_damping) * h);
+  for (int i = 0; i < na; i++) {
+    if (sim_node_w(m, d, i) <= 0 || c.statics) {
+      d->node_vel[i] = vd_v3(0, 0, 0);
+      continue;
+    }
+    d->node_vel[i] = vd_scale(vd_sub(d->node_pos[i], w->node_prev[i]), damp / h);
+  }
+  for (int t = 0; t < ns; t++) {
+    if ((m->seg_flags[t] & VD_SIM_FIXED) || c.statics) {
+      d->seg_omega[t] = vd_v3(0, 0, 0);
+      continue;
+    }
+    vd_vec3 dq = quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])));
+    d->seg_omega[t] = vd_scale(dq, damp / h);
+  }
+  if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
+  for (int k = 0; k < d->ncollider; k++) d->collider[k].vel = vd_v3(0, 0, 0);
+  d->time += c.statics ? 0.0 : h;
+  d->nstep++;
+  return VD_OK;
+}
+
+vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d) {
+  sim_step_ctx c;
+  memset(&c, 0, sizeof c);
+  c.h = m->opt.dt;
+  c.gamma = m->opt.damping / m->opt.dt;
+  return step_core(m, d, &c);
+}
+
+vd_sim_settle_def vd_sim_settle_def_default(void) {
+  vd_sim_settle_def s;
+  s.statics = 0;
+  s.ke_tol = 1e-9;
+  s.disp_tol = 1e-9;
+  s.max_time = 10;
+  s.max_steps = 400;
+  s.extra_damping = 5;
+  return s;
+}
+
+vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_settle_def* s, int* converged,
+                        int* steps) {
+  sim_work* w = (sim_work*)d->work;
+  int ok = 0, n = 0;
+  vd_status st = VD_OK;
+  if (!s->statics) {
+    // dynamics with extra damping until the kinetic energy is small
+    sim_step_ctx c;
+    memset(&c, 0, sizeof c);
+    c.h = m->opt.dt;
+    c.gamma = m->opt.damping / m->opt.dt;
+    c.extra_damping = s->extra_damping;
+    // still means below the tolerance for a quarter second in a row (not one turning point)
+    double t0 = d->time, calm = 0;
+    while (d->time - t0 < s->max_time) {
+      if ((st = step_core(m, d, &c))) break;
+      n++;
+      calm = vd_sim_kinetic_energy(m, d) < s->ke_tol ? calm + c.h : 0;
+      if (calm >= 0.25) {
+        ok = 1;
+        break;
+      }
+    }
+  } else {
+    // quasi-static steps (proximal Newton): a step that lowers the potential energy is kept
+    // and h grows four-fold, one that raises it is undone and h shrinks; with h large the
+    // inertial term M / h^2 vanishes and each step is a Newton step on the statics
+    sim_step_ctx c;
+    memset(&c, 0, sizeof c);
+    c.statics = 1;
+    c.h = 1.0;
+    memset(d->seg_lambda, 0, (size_t)m->nseg * 6 * sizeof(double));
+    memset(w->tie_lambda, 0, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
+    sim_forces(m, d, w);
+    double e0 = potential_energy(m, d, w), hcap = 1e4;
+    while (n < s->max_steps) {
+      memcpy(w->lambda_save, d->seg_lambda, (size_t)m->nseg * 6 * sizeof(double));
+      if ((st = step_core(m, d, &c))) break;
+      n++;
+      double e1 = potential_energy(m, d, w) - torque_work(m, d, w);
+      // largest move of a node, or of a segment end by its rotation
+      double mv = 0;
+      for (int i = 0; i < m->nnode_all; i++) {
+        double l = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
+        if (l > mv) mv = l;
+      }
+      for (int t = 0; t < m->nseg; t++) {
+        double l = v_norm(quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])))) * m->seg_len0[t];
+        if (l > mv) mv = l;
+      }
+      double hp = c.h, hn;
+      if (e1 > e0 + 1e-12 * (fabs(e0) + 1e-12) && mv > s->disp_tol) {
+        memcpy(d->node_pos, w->node_prev, (size_t)m->nnode_all * sizeof(vd_vec3));
+        memcpy(d->seg_quat, w->seg_prev, (size_t)m->nseg * sizeof(vd_quat));
+        memcpy(d->seg_lambda, w->lambda_save, (size_t)m->nseg * 6 * sizeof(double));
+        hn = hp * 0.25;
+        hcap = hp * 0.5;  // the trust region remembers the failure
+        if (hn < 1e-5) break;
+      } else {
+        e0 = e1 + torque_work(m, d, w);
+        if (mv < s->disp_tol) {
+          ok = 1;
+          break;
+        }
+        hn = hp * 4 > hcap ? hcap : hp * 4;
+        if (hn < hp) hn = hp;
+      }
+      // multipliers are forces times h^2: keep the forces across the change of h
+      double sc = (hn / hp) * (hn / hp);
+      for (int k = 0; k < 6 * m->nseg; k++) d->seg_lambda[k] *= sc;
+      for (int k = 0; k < 3 * w->cap_tie_lambda; k++) w->tie_lambda[k] *= sc;
+      c.h = hn;
+    }
+    if (m->opt.fracture) check_fracture(m, d, c.h);
+  }
+  if (converged) *converged = ok;
+  if (steps) *steps = n;
+  return st;
+}

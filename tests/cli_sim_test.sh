@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# End-to-end tests of `verdant sim` and `verdant validate`: exit codes, errors that name what
+# is wrong, the outputs (frames, rod topology, events, final plant, stats) and no partial
+# output on failure. Usage: cli_sim_test.sh VERDANT_BINARY SOURCE_DIR
+set -u
+V="$1"
+SRC="$2"
+T=$(mktemp -d /tmp/verdant_cli_sim.XXXXXX)
+trap 'rm -rf "$T"' EXIT
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); echo "ok   $1"; }
+bad() { fail=$((fail + 1)); echo "FAIL $1"; }
+
+expect() {
+  local name="$1" code="$2"
+  shift 2
+  "$@" >"$T/out" 2>"$T/err"
+  local rc=$?
+  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
+}
+expect_err() {
+  if grep -Eq -e "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
+}
+# json_check NAME PYTHON-EXPRESSION-ON-d: the last run's stdout is JSON satisfying the expression
+json_check() {
+  if python3 -c "import json,sys; d=json.load(open('$T/out')); sys.exit(0 if ($2) else 1)" 2>/dev/null; then
+    ok "$1"
+  else
+    bad "$1 ($(head -c 300 "$T/out"))"
+  fi
+}
+
+# a small plant: two internodes, a leaf, a fruit on a pedicel with a knuckle
+cat >"$T/p.lpy" <<'EOF'
+LABELS = {1: "stem", 2: "leaf", 3: "pedicel", 4: "fruit"}
+module I, Leaf, Ped, Fruit
+Axiom: SetWidth(0.004) I(0.1) [ +(50) Leaf(0.08) ] I(0.1) [ &(70) Ped(0.01) Ped(0.01) Fruit(0.012) ] I(0.08)
+interpretation:
+I(l) --> ;(1) F(l, 0.004)
+Leaf(s) --> ;(2) F(0.03, 0.001) ~l(s)
+Ped(l) --> ;(3) F(l, 0.0009)
+Fruit(r) --> ;(4) f(r) @O(r)
+endlsystem
+EOF
+
+expect "sim help" 0 "$V" sim --help
+expect "validate help" 0 "$V" validate --help
+expect "sim without plant" 2 "$V" sim --stats
+expect "sim nothing to do" 2 "$V" sim "$T/p.lpy"
+expect "sim unknown option" 2 "$V" sim "$T/p.lpy" --stats --bogus
+expect "sim bad dt" 2 "$V" sim "$T/p.lpy" --stats --dt -1
+expect_err "bad dt named" "--dt"
+expect "sim bad solver" 2 "$V" sim "$T/p.lpy" --stats --solver magic
+expect "sim bad class" 2 "$V" sim "$T/p.lpy" --stats --young bark=1e9
+expect_err "bad class named" "unknown class 'bark'"
+expect "sim bad young" 2 "$V" sim "$T/p.lpy" --stats --young -5
+expect "sim bad vector" 2 "$V" sim "$T/p.lpy" --stats --wind 1,2
+expect "sim bad probe" 2 "$V" sim "$T/p.lpy" --stats --probe 0.1:0,0,0
+expect "sim bad pull" 2 "$V" sim "$T/p.lpy" --stats --pull fruit
+expect "sim unknown organ" 2 "$V" sim "$T/p.lpy" --stats --pull cherry=0,0,1
+expect_err "unknown organ named" "no organ 'cherry'"
+expect "sim missing plant" 2 "$V" sim "$T/none.lpy" --stats
+expect "sim bad poisson" 2 "$V" sim "$T/p.lpy" --stats --poisson 0.7
+expect_err "bad poisson says why" "Poisson"
+printf 't,vx,vy,vz\n0,0,1,0\n1,0,x,0\n' >"$T/badwind.csv"
+expect "sim bad wind file" 2 "$V" sim "$T/p.lpy" --stats --wind-file "$T/badwind.csv"
+expect_err "wind file line named" "badwind.csv:3:"
+
+# stats: the documented fields
+expect "sim stats" 0 "$V" sim "$T/p.lpy" --duration 0.05 --stats
+json_check "stats fields" "all(k in d for k in ['max_displacement','tip_displacement','kinetic_energy','events','steps_per_second','steps','time'])"
+json_check "stats steps" "d['steps'] == 50 and abs(d['time'] - 0.05) < 1e-9"
+
+# settle and sag-free
+expect "sim settle" 0 "$V" sim "$T/p.lpy" --settle --stats
+json_check "settled" "d['settled'] is True and d['kinetic_energy'] < 1e-6"
+expect "sim sag-free" 0 "$V" sim "$T/p.lpy" --sag-free --settle --stats
+json_check "sag-free stays" "d['max_displacement'] < 1e-3"
+expect "sim statics" 0 "$V" sim "$T/p.lpy" --statics --stats
+json_check "statics converged" "d['settled'] is True"
+
+# outputs: frames (binary and JSON Lines), rod topology, events, final plant
+expect "sim outputs" 0 "$V" sim "$T/p.lpy" --duration 0.1 --fps 100 -o "$T/run" --final "$T/final.ply"
+for f in frames.bin rod.json events.csv plant.json; do
+  if [ -s "$T/run/$f" ]; then ok "wrote $f"; else bad "wrote $f"; fi
+done
+if [ -s "$T/final.ply" ]; then ok "wrote final ply"; else bad "wrote final ply"; fi
+if python3 - "$T/run" <<'PY'
+import json, struct, sys
+d = sys.argv[1]
+rod = json.load(open(d + "/rod.json"))
+b = open(d + "/frames.bin", "rb").read()
+magic, ver, nn, ns, _ = struct.unpack("<8sIIII", b[:24])
+assert magic == b"VDSIMFRM" and ver == 1 and nn == rod["nodes"] and ns == rod["segments"]
+size = 8 + 12 * nn + 16 * ns + ns
+assert (len(b) - 24) % size == 0 and (len(b) - 24) // size == 11, (len(b) - 24) / size
+t0 = struct.unpack("<d", b[24:32])[0]
+assert t0 == 0.0
+json.load(open(d + "/plant.json"))
+PY
+then ok "frame layout"; else bad "frame layout"; fi
+expect "sim jsonl" 0 "$V" sim "$T/p.lpy" --duration 0.02 --frames jsonl -o "$T/runj"
+if python3 -c "
+import json; lines = open('$T/runj/frames.jsonl').read().splitlines()
+f = [json.loads(l) for l in lines]; assert len(f) >= 1 and all(k in f[0] for k in ('t','pos','quat','broken'))"; then
+  ok "jsonl frames"
+else
+  bad "jsonl frames"
+fi
+
+# a pull on the fruit breaks its calyx once; the event is in the stats and the CSV
+expect "sim pull fracture" 0 "$V" sim "$T/p.lpy" --duration 0.5 --pull fruit=0,0,-4 --ramp 0.4 -o "$T/runp" --stats
+json_check "one fracture" "d['nevents'] == 1 and d['events'][0]['label'] in ('fruit', 'pedicel')"
+if [ "$(wc -l <"$T/runp/events.csv")" -eq 2 ]; then ok "events csv row"; else bad "events csv row"; fi
+
+# probes and wind run; a probe through the plant leaves no penetration
+expect "sim probe" 0 "$V" sim "$T/p.lpy" --duration 0.3 --probe 0.03:0.1,0.1,0.15:-0.1,-0.1,0.15 --wind 3,0,0 --gust 0.3,0.5 --stats
+json_check "probe no penetration" "d['max_penetration'] < 1e-4"
+
+# failures leave nothing behind: an unwritable output folder
+mkdir -p "$T/ro"
+chmod 500 "$T/ro"
+if [ "$(id -u)" -ne 0 ]; then
+  expect "unwritable output" 1 "$V" sim "$T/p.lpy" --duration 0.01 -o "$T/ro/run"
+else
+  ok "unwritable output (skipped as root)"
+fi
+
+# validate: a subset as JSON, all passing, with the documented fields
+expect "validate json" 0 "$V" validate --json --case cantilever_tip --no-progress
+json_check "validate fields" "len(d) == 2 and all(set(r) >= {'name','measured','reference','error','tolerance','pass'} and r['pass'] for r in d)"
+expect "validate table" 0 "$V" validate --case torsion --no-progress
+expect "validate bad option" 2 "$V" validate --frobnicate
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
