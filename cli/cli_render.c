@@ -135,10 +135,10 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
     if (r > 0) continue;
     // options with a value
     const char* val = NULL;
-    static const char* with_value[] = {"-o",     "--output",   "--camera",      "--eye",
-                                       "--lookat", "--up",     "--fov",         "--size",
+    static const char* with_value[] = {"-o",         "--output",      "--camera",     "--eye",
+                                       "--lookat",   "--up",          "--fov",        "--size",
                                        "--color-by", "--supersample", "--point-size", "--robot",
-                                       "--time", "--mp4",      "--fps",         "--range"};
+                                       "--time",     "--mp4",         "--fps",        "--range"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
       if (!strcmp(a, with_value[k])) {
         if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
@@ -157,7 +157,8 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
         return cli_usage_error("render", "--lookat expects X,Y,Z in metres, got '%s'", val);
       has_lookat = 1;
     } else if (!strcmp(a, "--up")) {
-      if (!parse_vec(val, &o->up)) return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
+      if (!parse_vec(val, &o->up))
+        return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
     } else if (!strcmp(a, "--fov")) {
       if (!parse_num(val, &o->fov) || o->fov <= 0 || o->fov >= 180)
         return cli_usage_error("render", "--fov expects degrees in (0, 180), got '%s'", val);
@@ -165,7 +166,8 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       int w, h;
       char tail;
       if (sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
-        return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'", val);
+        return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'",
+                               val);
       o->def.width = w, o->def.height = h;
     } else if (!strcmp(a, "--color-by")) {
       if (!strcmp(val, "label"))
@@ -177,15 +179,17 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       else if (!strcmp(val, "displacement"))
         o->style.color_by = VD_COLOR_DISPLACEMENT;
       else
-        return cli_usage_error("render", "--color-by expects label, instance, stress or displacement, got '%s'",
-                               val);
+        return cli_usage_error(
+            "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
     } else if (!strcmp(a, "--range")) {
       char* end;
       errno = 0;
       double lo = strtod(val, &end), hi = 0;
       int ok = end != val && *end == ',' && !errno && isfinite(lo);
       if (ok) ok = parse_num(end + 1, &hi) && hi > lo;
-      if (!ok) return cli_usage_error("render", "--range expects MIN,MAX with MIN < MAX (Pa or m), got '%s'", val);
+      if (!ok)
+        return cli_usage_error("render",
+                               "--range expects MIN,MAX with MIN < MAX (Pa or m), got '%s'", val);
       o->style.range_min = lo, o->style.range_max = hi;
     } else if (!strcmp(a, "--supersample")) {
       double k;
@@ -194,18 +198,22 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       o->def.supersample = (int)k;
     } else if (!strcmp(a, "--point-size")) {
       if (!parse_num(val, &o->point_size) || o->point_size <= 0)
-        return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'", val);
+        return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'",
+                               val);
     } else if (!strcmp(a, "--robot")) {
       o->def.robot_mjcf = val;
     } else if (!strcmp(a, "--time")) {
-      if (!parse_num(val, &o->time)) return cli_usage_error("render", "--time expects a time in seconds, got '%s'", val);
+      if (!parse_num(val, &o->time))
+        return cli_usage_error("render", "--time expects a time in seconds, got '%s'", val);
       o->has_time = 1;
     } else if (!strcmp(a, "--mp4")) {
-      if (!cli_has_ext(val, ".mp4")) return cli_usage_error("render", "--mp4 '%s' must end in .mp4", val);
+      if (!cli_has_ext(val, ".mp4"))
+        return cli_usage_error("render", "--mp4 '%s' must end in .mp4", val);
       o->mp4 = val;
     } else if (!strcmp(a, "--fps")) {
       if (!parse_num(val, &o->fps) || o->fps <= 0 || o->fps > 1000)
-        return cli_usage_error("render", "--fps expects a frame rate in (0, 1000] (1/s), got '%s'", val);
+        return cli_usage_error("render", "--fps expects a frame rate in (0, 1000] (1/s), got '%s'",
+                               val);
     } else if (!strcmp(a, "--depth")) {
       o->depth = 1;
     } else if (!strcmp(a, "--masks")) {
@@ -229,8 +237,9 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
     }
   }
   if (!parse_camera(camera_text, &o->kind, &o->az, &o->el))
-    return cli_usage_error("render", "--camera expects front, side, top or orbit[:AZ[:EL]] (degrees), got '%s'",
-                           camera_text);
+    return cli_usage_error(
+        "render", "--camera expects front, side, top or orbit[:AZ[:EL]] (degrees), got '%s'",
+        camera_text);
   if (o->has_eye != has_lookat) return cli_usage_error("render", "--eye and --lookat go together");
   return EXIT_OK;
 }
@@ -245,10 +254,12 @@ vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi) {
     cam.zfar = 100 * dist + 60;
     return cam;
   }
-  cam = vd_camera_preset(o->kind, o->az * VD_PI / 180, o->el * VD_PI / 180, lo, hi, o->def.width, o->def.height);
+  cam = vd_camera_preset(o->kind, o->az * VD_PI / 180, o->el * VD_PI / 180, lo, hi, o->def.width,
+                         o->def.height);
   if (o->fov != 45) {
     // keep the fitted view, narrow or widen the lens: move along the axis to keep the framing
-    double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2), f1 = tan(o->fov * VD_PI / 360);
+    double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2),
+           f1 = tan(o->fov * VD_PI / 360);
     vd_vec3 dir = vd_normalize(vd_sub(cam.eye, cam.lookat));
     cam.eye = vd_madd(cam.lookat, dir, d * f0 / f1);
     cam.fovy = o->fov * VD_PI / 180;
@@ -275,7 +286,8 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
     files[nf++] = "color", files[nf++] = base_name(out);
     if (depth) files[nf++] = "depth", files[nf++] = base_name(p_depth);
     if (masks)
-      files[nf++] = "label", files[nf++] = base_name(p_label), files[nf++] = "instance", files[nf++] = base_name(p_inst);
+      files[nf++] = "label", files[nf++] = base_name(p_label), files[nf++] = "instance",
+      files[nf++] = base_name(p_inst);
     files[nf] = NULL;
     st = vd_render_write_json(f, files, p_json, err);
   }
@@ -299,25 +311,31 @@ int cli_render(int argc, char** argv) {
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc;
   if (!o.po.path)
-    return cli_usage_error("render", "missing PLANT, CLOUD or RUN/ (.lpy, plant .json, a .ply/.pcd/.xyz/.csv/.las "
-                                     "cloud, or a folder of 'verdant sim -o')");
+    return cli_usage_error(
+        "render", "missing PLANT, CLOUD or RUN/ (.lpy, plant .json, a .ply/.pcd/.xyz/.csv/.las "
+                  "cloud, or a folder of 'verdant sim -o')");
   // a simulation run
   struct stat sb;
   if (stat(o.po.path, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_render_run(&o);
   if (!o.out) return cli_usage_error("render", "missing -o OUT.png");
-  if (!cli_has_ext(o.out, ".png")) return cli_usage_error("render", "output '%s' must end in .png", o.out);
+  if (!cli_has_ext(o.out, ".png"))
+    return cli_usage_error("render", "output '%s' must end in .png", o.out);
   if (o.has_time || o.mp4 || o.fps > 0)
-    return cli_usage_error("render", "--time, --mp4 and --fps apply to simulation runs (a folder of 'verdant sim -o')");
+    return cli_usage_error(
+        "render",
+        "--time, --mp4 and --fps apply to simulation runs (a folder of 'verdant sim -o')");
   // point clouds in any format the cloud module reads; everything else is a plant
-  int is_cloud = cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") || cli_has_ext(o.po.path, ".xyz") ||
-                 cli_has_ext(o.po.path, ".csv") || cli_has_ext(o.po.path, ".las");
+  int is_cloud = cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") ||
+                 cli_has_ext(o.po.path, ".xyz") || cli_has_ext(o.po.path, ".csv") ||
+                 cli_has_ext(o.po.path, ".las");
   vd_render_style style = o.style;
   if (is_cloud && style.color_by != VD_COLOR_LABEL && style.color_by != VD_COLOR_INSTANCE)
     return cli_usage_error("render", "a point cloud is coloured by label or instance");
   if (!is_cloud && style.color_by == VD_COLOR_STRESS)
-    return cli_usage_error("render",
-                           "--color-by stress needs a simulation state (a run folder of 'verdant sim -o RUN/'); "
-                           "a plant at rest carries no stress");
+    return cli_usage_error(
+        "render",
+        "--color-by stress needs a simulation state (a run folder of 'verdant sim -o RUN/'); "
+        "a plant at rest carries no stress");
   vd_render_def def = o.def;
   // load what is drawn
   vd_error err = {0};
@@ -332,7 +350,8 @@ int cli_render(int argc, char** argv) {
   int code = EXIT_OK;
   if (is_cloud) {
     st = vd_cloud_read(o.po.path, &cl, &err);
-    if (!st && cl.n > INT32_MAX) st = vd_error_set(&err, VD_ERR_LIMIT, o.po.path, 0, 0, "more than 2^31 points");
+    if (!st && cl.n > INT32_MAX)
+      st = vd_error_set(&err, VD_ERR_LIMIT, o.po.path, 0, 0, "more than 2^31 points");
   } else {
     st = cli_load_plant(&o.po, &plant, &ginfo, &err);
     if (!st) st = vd_plant_compile(plant, &model, &err);
@@ -368,8 +387,8 @@ int cli_render(int argc, char** argv) {
   vd_vec3 lo, hi;
   vd_render_bounds(r, &lo, &hi);
   vd_camera cam = cli_render_camera(&o, lo, hi);
-  unsigned layers =
-      VD_LAYER_COLOR | (o.depth ? VD_LAYER_DEPTH : 0) | (o.masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
+  unsigned layers = VD_LAYER_COLOR | (o.depth ? VD_LAYER_DEPTH : 0) |
+                    (o.masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
   vd_frame f;
   st = vd_render_draw(r, &cam, layers, &f, &err);
   if (st) {
@@ -378,7 +397,8 @@ int cli_render(int argc, char** argv) {
   }
   st = cli_frame_write(&f, o.out, o.depth, o.masks, &err);
   if (st)
-    code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL) : cli_report("render", &err, st);
+    code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL)
+                           : cli_report("render", &err, st);
 done:
   vd_render_destroy(r);
   vd_model_destroy(model);

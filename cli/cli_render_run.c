@@ -39,17 +39,23 @@ static void box_add(box* b, vd_vec3 p, double r) {
 }
 
 // the plant state's points and the colliders drawn (planes are not)
-static void box_frame(box* b, const vd_model* m, const vd_data* d, const vd_sim_collider* col, int ncol) {
-  for (int i = 0; i < m->nnode; i++) box_add(b, vd_v3(d->node_pos[3 * i], d->node_pos[3 * i + 1], d->node_pos[3 * i + 2]), 0);
+static void box_frame(box* b, const vd_model* m, const vd_data* d, const vd_sim_collider* col,
+                      int ncol) {
+  for (int i = 0; i < m->nnode; i++)
+    box_add(b, vd_v3(d->node_pos[3 * i], d->node_pos[3 * i + 1], d->node_pos[3 * i + 2]), 0);
   for (int i = 0; i < m->nsphere; i++)
-    box_add(b, vd_v3(d->sphere_pos[3 * i], d->sphere_pos[3 * i + 1], d->sphere_pos[3 * i + 2]), m->sphere_radius[i]);
-  for (int i = 0; i < m->nvert; i++) box_add(b, vd_v3(d->vert_pos[3 * i], d->vert_pos[3 * i + 1], d->vert_pos[3 * i + 2]), 0);
+    box_add(b, vd_v3(d->sphere_pos[3 * i], d->sphere_pos[3 * i + 1], d->sphere_pos[3 * i + 2]),
+            m->sphere_radius[i]);
+  for (int i = 0; i < m->nvert; i++)
+    box_add(b, vd_v3(d->vert_pos[3 * i], d->vert_pos[3 * i + 1], d->vert_pos[3 * i + 2]), 0);
   for (int c = 0; c < ncol; c++) {
     const vd_sim_collider* k = &col[c];
-    double r = k->shape == VD_SIM_SPHERE    ? k->size[0]
-               : k->shape == VD_SIM_CAPSULE ? k->size[0] + k->size[1]
-               : k->shape == VD_SIM_BOX     ? sqrt(k->size[0] * k->size[0] + k->size[1] * k->size[1] + k->size[2] * k->size[2])
-                                            : -1;
+    double r =
+        k->shape == VD_SIM_SPHERE    ? k->size[0]
+        : k->shape == VD_SIM_CAPSULE ? k->size[0] + k->size[1]
+        : k->shape == VD_SIM_BOX
+            ? sqrt(k->size[0] * k->size[0] + k->size[1] * k->size[1] + k->size[2] * k->size[2])
+            : -1;
     if (r >= 0) box_add(b, k->pos, r);
   }
 }
@@ -104,16 +110,42 @@ typedef struct video {
 // start ffmpeg reading w x h RGB frames at fps from a pipe into a temporary file beside path
 static vd_status video_start(video* v, const char* path, int w, int h, double fps, vd_error* err) {
   int fd[2];
-  if (pipe(fd) != 0) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot make a pipe: %s", strerror(errno));
+  if (pipe(fd) != 0)
+    return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot make a pipe: %s", strerror(errno));
   snprintf(v->tmp, sizeof v->tmp, "%s.tmp.%ld", path, (long)getpid());
   char size[64], rate[64];
   snprintf(size, sizeof size, "%dx%d", w, h);
   snprintf(rate, sizeof rate, "%.6g", fps);
   // H.264 needs even sizes: pad by a pixel where the image is odd
-  char* argv[] = {"ffmpeg", "-hide_banner", "-loglevel", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt",
-                  "rgb24", "-s", size, "-framerate", rate, "-i", "pipe:0", "-an", "-vf",
-                  "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-movflags",
-                  "+faststart", "-f", "mp4", v->tmp, NULL};
+  char* argv[] = {"ffmpeg",
+                  "-hide_banner",
+                  "-loglevel",
+                  "error",
+                  "-nostdin",
+                  "-y",
+                  "-f",
+                  "rawvideo",
+                  "-pix_fmt",
+                  "rgb24",
+                  "-s",
+                  size,
+                  "-framerate",
+                  rate,
+                  "-i",
+                  "pipe:0",
+                  "-an",
+                  "-vf",
+                  "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                  "-c:v",
+                  "libx264",
+                  "-pix_fmt",
+                  "yuv420p",
+                  "-movflags",
+                  "+faststart",
+                  "-f",
+                  "mp4",
+                  v->tmp,
+                  NULL};
   // -nostdin only stops ffmpeg reading keys from the terminal; the frames come through pipe:0
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
@@ -159,8 +191,8 @@ static vd_status video_finish(video* v, const char* path, int ok, vd_error* err)
 // ---------------------------------------------------------------------------------------------
 // the index of a folder of frames
 
-static vd_status write_index(const cli_render_opts* o, const cli_run* run, const char* dir, const vd_frame* f,
-                             vd_error* err) {
+static vd_status write_index(const cli_render_opts* o, const cli_run* run, const char* dir,
+                             const vd_frame* f, vd_error* err) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   static const char* by[4] = {"label", "instance", "stress", "displacement"};
@@ -183,14 +215,17 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
     cJSON_AddNumberToObject(e, "time", vd_sim_frames_time(run->frames, k));
     snprintf(name, sizeof name, "frame_%05d.png", k);
     cJSON_AddStringToObject(e, "color", name);
-    if (o->depth) snprintf(name, sizeof name, "frame_%05d.depth.png", k), cJSON_AddStringToObject(e, "depth", name);
+    if (o->depth)
+      snprintf(name, sizeof name, "frame_%05d.depth.png", k),
+          cJSON_AddStringToObject(e, "depth", name);
     if (o->masks) {
       snprintf(name, sizeof name, "frame_%05d.label.png", k);
       cJSON_AddStringToObject(e, "label", name);
       snprintf(name, sizeof name, "frame_%05d.instance.png", k);
       cJSON_AddStringToObject(e, "instance", name);
     }
-    if (o->depth || o->masks) snprintf(name, sizeof name, "frame_%05d.json", k), cJSON_AddStringToObject(e, "camera", name);
+    if (o->depth || o->masks)
+      snprintf(name, sizeof name, "frame_%05d.json", k), cJSON_AddStringToObject(e, "camera", name);
     cJSON_AddItemToArray(frames, e);
   }
   char* text = cJSON_Print(root);
@@ -213,7 +248,8 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
 // the command
 
 // the colliders of a frame as solids (planes are the floor's business)
-static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int ncol, vd_error* err) {
+static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int ncol,
+                               vd_error* err) {
   vd_status st = VD_OK;
   for (int c = 0; c < ncol && !st; c++) {
     const vd_sim_collider* k = &col[c];
@@ -235,15 +271,17 @@ int cli_render_run(const cli_render_opts* o) {
   // what to write
   int single = o->out && cli_has_ext(o->out, ".png");
   const char* folder = o->out && !single ? o->out : NULL;
-  if (!o->out && !o->mp4) return cli_usage_error(cmd, "missing -o OUT.png, -o DIR/ or --mp4 OUT.mp4 for the run");
+  if (!o->out && !o->mp4)
+    return cli_usage_error(cmd, "missing -o OUT.png, -o DIR/ or --mp4 OUT.mp4 for the run");
   if (o->has_time && !single) return cli_usage_error(cmd, "--time picks the frame of -o OUT.png");
   if (o->po.steps >= 0 || o->po.seed || o->po.nset || o->po.nlabel)
-    return cli_usage_error(cmd, "-n, --seed, --set and --label apply to .lpy plants; a run holds its plant");
-  if (o->po.path && (o->out && !strcmp(o->out, o->po.path)))
-    return cli_usage_error(cmd, "the output folder is the run folder");
+    return cli_usage_error(
+        cmd, "-n, --seed, --set and --label apply to .lpy plants; a run holds its plant");
   const char* mp4 = o->mp4;
   if (mp4 && !on_path("ffmpeg")) {
-    fprintf(stderr, "verdant render: --mp4 %s skipped: ffmpeg is not installed (Debian: apt-get install ffmpeg)\n",
+    fprintf(stderr,
+            "verdant render: --mp4 %s skipped: ffmpeg is not installed (Debian: apt-get install "
+            "ffmpeg)\n",
             mp4);
     if (!o->out) return EXIT_FAIL;
     mp4 = NULL;
@@ -258,7 +296,7 @@ int cli_render_run(const cli_render_opts* o) {
   video vid;
   memset(&vid, 0, sizeof vid);
   int progress = o->po.progress;
-  int writing = 0;  // the failure, if any, is in writing the outputs
+  int writing = 0; // the failure, if any, is in writing the outputs
   if ((st = cli_run_open(o->po.path, &run, &err))) return cli_report(cmd, &err, st);
   const vd_model* pm = run.plant;
   int want = o->has_time ? vd_sim_frames_nearest(run.frames, o->time) : run.nframe - 1;
@@ -287,12 +325,14 @@ int cli_render_run(const cli_render_opts* o) {
         if (isfinite(stress[j])) vmax = fmax(vmax, stress[j]);
     }
   }
-  if (value && !(style.range_max > style.range_min) && vmax > 0) style.range_min = 0, style.range_max = vmax;
+  if (value && !(style.range_max > style.range_min) && vmax > 0)
+    style.range_min = 0, style.range_max = vmax;
   style.ref = ref;
   style.seg_stress = stress;
   // the renderer, with room for every organ instance and collider
   vd_render_def def = o->def;
-  if (pm->ninstance + VD_SIM_MAX_COLLIDERS + 16 > def.max_geoms) def.max_geoms = pm->ninstance + VD_SIM_MAX_COLLIDERS + 16;
+  if (pm->ninstance + VD_SIM_MAX_COLLIDERS + 16 > def.max_geoms)
+    def.max_geoms = pm->ninstance + VD_SIM_MAX_COLLIDERS + 16;
   if ((st = vd_render_create(&def, &r, &err))) {
     code = st == VD_ERR_UNSUPPORTED || st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(st);
     cli_report(cmd, &err, st);
@@ -302,7 +342,9 @@ int cli_render_run(const cli_render_opts* o) {
   // the camera: fitted to the run's box and what the renderer holds (a robot)
   vd_camera cam;
   {
-    if ((st = cli_run_load(&run, 0, &err)) || (st = vd_render_add_plant(r, pm, run.pstate, &style, &err))) goto fail;
+    if ((st = cli_run_load(&run, 0, &err)) ||
+        (st = vd_render_add_plant(r, pm, run.pstate, &style, &err)))
+      goto fail;
     vd_vec3 lo, hi;
     vd_render_bounds(r, &lo, &hi);
     if (bx.any) lo = vd_vmin(lo, bx.lo), hi = vd_vmax(hi, bx.hi);
@@ -310,19 +352,21 @@ int cli_render_run(const cli_render_opts* o) {
   }
   writing = 1;
   if (folder && mkdir(folder, 0777) != 0 && errno != EEXIST) {
-    st = vd_error_set(&err, VD_ERR_IO, folder, 0, 0, "cannot create the folder: %s", strerror(errno));
+    st = vd_error_set(&err, VD_ERR_IO, folder, 0, 0, "cannot create the folder: %s",
+                      strerror(errno));
     goto fail;
   }
   // frames: one, or every one into the folder and the video
-  unsigned layers =
-      VD_LAYER_COLOR | (o->depth ? VD_LAYER_DEPTH : 0) | (o->masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
+  unsigned layers = VD_LAYER_COLOR | (o->depth ? VD_LAYER_DEPTH : 0) |
+                    (o->masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
   if (mp4) {
     double fps = o->fps;
     if (!(fps > 0)) {
-      double span = vd_sim_frames_time(run.frames, run.nframe - 1) - vd_sim_frames_time(run.frames, 0);
+      double span =
+          vd_sim_frames_time(run.frames, run.nframe - 1) - vd_sim_frames_time(run.frames, 0);
       fps = run.nframe > 1 && span > 0 ? (run.nframe - 1) / span : 30;
     }
-    signal(SIGPIPE, SIG_IGN);  // a failing ffmpeg shows as a write error, not a dead verdant
+    signal(SIGPIPE, SIG_IGN); // a failing ffmpeg shows as a write error, not a dead verdant
     if ((st = video_start(&vid, mp4, def.width, def.height, fps, &err))) goto fail;
   }
   vd_frame f;
@@ -345,8 +389,10 @@ int cli_render_run(const cli_render_opts* o) {
       snprintf(path, sizeof path, "%s/frame_%05d.png", folder, k);
       if ((st = cli_frame_write(&f, path, o->depth, o->masks, &err))) goto fail;
     }
-    if (single && k == want && (st = cli_frame_write(&f, o->out, o->depth, o->masks, &err))) goto fail;
-    if (vid.pipe && fwrite(f.rgb, 3, (size_t)f.width * f.height, vid.pipe) != (size_t)f.width * f.height) {
+    if (single && k == want && (st = cli_frame_write(&f, o->out, o->depth, o->masks, &err)))
+      goto fail;
+    if (vid.pipe &&
+        fwrite(f.rgb, 3, (size_t)f.width * f.height, vid.pipe) != (size_t)f.width * f.height) {
       st = vd_error_set(&err, VD_ERR_IO, mp4, 0, 0, "ffmpeg stopped reading frames");
       goto fail;
     }

@@ -18,7 +18,9 @@
 // build settings (rod.json "build")
 
 // a number, or null for an infinite threshold
-static cJSON* num_or_inf(double v) { return isinf(v) && v > 0 ? cJSON_CreateNull() : cJSON_CreateNumber(v); }
+static cJSON* num_or_inf(double v) {
+  return isinf(v) && v > 0 ? cJSON_CreateNull() : cJSON_CreateNumber(v);
+}
 
 cJSON* cli_sim_def_json(const vd_sim_def* def) {
   cJSON* o = cJSON_CreateObject();
@@ -76,8 +78,11 @@ vd_status cli_sim_def_parse(const cJSON* o, const char* path, vd_sim_def* def, v
   static const char* ints[4] = {"clamp_roots", "leaf_graphs", "sag_free", NULL};
   st = get_num(o, "segment_length", 0, &def->segment_length, path, "build", err);
   if (!st) st = get_num(o, "clamp_length", 0, &def->clamp_length, path, "build", err);
-  for (int k = 0; !st && ints[k]; k++) st = get_num(o, ints[k], 0, &flags[k], path, "build", err);
-  if (!st) def->clamp_roots = (int)flags[0], def->leaf_graphs = (int)flags[1], def->sag_free = (int)flags[2];
+  for (int k = 0; !st && ints[k]; k++)
+    st = get_num(o, ints[k], 0, &flags[k], path, "build", err);
+  if (!st)
+    def->clamp_roots = (int)flags[0], def->leaf_graphs = (int)flags[1],
+    def->sag_free = (int)flags[2];
   if (!st) st = get_num(o, "leaf_areal_density", 0, &def->leaf_areal_density, path, "build", err);
   if (!st) st = get_num(o, "leaf_vein_ratio", 0, &def->leaf_vein_ratio, path, "build", err);
   if (!st) st = get_num(o, "leaf_plate_cd", 0, &def->leaf_plate_cd, path, "build", err);
@@ -86,12 +91,14 @@ vd_status cli_sim_def_parse(const cJSON* o, const char* path, vd_sim_def* def, v
   if (st) return st;
   const cJSON* g = cJSON_GetObjectItemCaseSensitive(o, "gravity");
   if (!cJSON_IsArray(g) || cJSON_GetArraySize(g) != 3)
-    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "build.gravity: expected [x, y, z] (m/s^2)");
+    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                        "build.gravity: expected [x, y, z] (m/s^2)");
   double gv[3];
   for (int k = 0; k < 3; k++) {
     const cJSON* x = cJSON_GetArrayItem(g, k);
     if (!cJSON_IsNumber(x))
-      return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "build.gravity: expected [x, y, z] (m/s^2)");
+      return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                          "build.gravity: expected [x, y, z] (m/s^2)");
     gv[k] = x->valuedouble;
   }
   def->gravity = vd_v3(gv[0], gv[1], gv[2]);
@@ -101,7 +108,8 @@ vd_status cli_sim_def_parse(const cJSON* o, const char* path, vd_sim_def* def, v
     const cJSON* e = cJSON_GetObjectItemCaseSensitive(mats, name);
     char where[64];
     snprintf(where, sizeof where, "build.materials.%s", name);
-    if (!cJSON_IsObject(e)) return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "%s: missing", where);
+    if (!cJSON_IsObject(e))
+      return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "%s: missing", where);
     vd_sim_material* mt = &def->material[c];
     st = get_num(e, "young", 0, &mt->young, path, where, err);
     if (!st) st = get_num(e, "poisson", 0, &mt->poisson, path, where, err);
@@ -124,9 +132,11 @@ void cli_colliders_write(FILE* fp, const vd_sim_data* d) {
   fprintf(fp, "{\"t\":%.9g,\"colliders\":[", d->time);
   for (int i = 0; i < d->ncollider; i++) {
     const vd_sim_collider* c = &d->collider[i];
-    fprintf(fp, "%s{\"shape\":\"%s\",\"size\":[%.9g,%.9g,%.9g],\"pos\":[%.9g,%.9g,%.9g],\"quat\":[%.9g,%.9g,%.9g,%.9g]}",
-            i ? "," : "", shape_names[c->shape], c->size[0], c->size[1], c->size[2], c->pos.x, c->pos.y, c->pos.z,
-            c->quat.w, c->quat.x, c->quat.y, c->quat.z);
+    fprintf(fp,
+            "%s{\"shape\":\"%s\",\"size\":[%.9g,%.9g,%.9g],\"pos\":[%.9g,%.9g,%.9g],\"quat\":[%.9g,"
+            "%.9g,%.9g,%.9g]}",
+            i ? "," : "", shape_names[c->shape], c->size[0], c->size[1], c->size[2], c->pos.x,
+            c->pos.y, c->pos.z, c->quat.w, c->quat.x, c->quat.y, c->quat.z);
   }
   fputs("]}\n", fp);
 }
@@ -164,12 +174,15 @@ static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
       continue;
     }
     if (frame >= run->nframe) {
-      st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "more lines than the run's %d frames", run->nframe);
+      st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "more lines than the run's %d frames",
+                        run->nframe);
       break;
     }
     cJSON* o = cJSON_ParseWithLength(p, n);
     const cJSON* list = cJSON_GetObjectItemCaseSensitive(o, "colliders");
-    if (!cJSON_IsArray(list)) st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "expected {\"t\": T, \"colliders\": [...]}");
+    if (!cJSON_IsArray(list))
+      st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0,
+                        "expected {\"t\": T, \"colliders\": [...]}");
     const cJSON* c;
     int idx = 0;
     cJSON_ArrayForEach(c, list) {
@@ -181,9 +194,12 @@ static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
       for (int k = 0; k < 4 && cJSON_IsString(shape); k++)
         if (!strcmp(shape->valuestring, shape_names[k])) kind = k;
       double q[4], pos[3];
-      if (kind < 0 || !get_vec(c, "size", col.size, 3) || !get_vec(c, "pos", pos, 3) || !get_vec(c, "quat", q, 4)) {
+      if (kind < 0 || !get_vec(c, "size", col.size, 3) || !get_vec(c, "pos", pos, 3) ||
+          !get_vec(c, "quat", q, 4)) {
         st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0,
-                          "collider %d: expected shape (plane, sphere, capsule, box), size [3], pos [3], quat [4]", idx);
+                          "collider %d: expected shape (plane, sphere, capsule, box), size [3], "
+                          "pos [3], quat [4]",
+                          idx);
         break;
       }
       col.shape = (vd_sim_shape)kind;
@@ -204,7 +220,8 @@ static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
   }
   vd_free(text, len + 1);
   if (!st && frame != run->nframe)
-    st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "%d lines for the run's %d frames", frame, run->nframe);
+    st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "%d lines for the run's %d frames", frame,
+                      run->nframe);
   return st;
 }
 
@@ -212,22 +229,26 @@ static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
 // reading a run
 
 // rod.json's sizes and rest positions against the rebuilt model
-static vd_status check_rod(const cJSON* rod, const vd_sim_model* m, const char* path, vd_error* err) {
+static vd_status check_rod(const cJSON* rod, const vd_sim_model* m, const char* path,
+                           vd_error* err) {
   const cJSON* nodes = cJSON_GetObjectItemCaseSensitive(rod, "nodes");
   const cJSON* segs = cJSON_GetObjectItemCaseSensitive(rod, "segments");
   const cJSON* pos0 = cJSON_GetObjectItemCaseSensitive(rod, "node_pos0");
   int ok = cJSON_IsNumber(nodes) && cJSON_IsNumber(segs) && nodes->valuedouble == m->nnode_all &&
-           segs->valuedouble == m->nseg && cJSON_IsArray(pos0) && cJSON_GetArraySize(pos0) == 3 * m->nnode_all;
+           segs->valuedouble == m->nseg && cJSON_IsArray(pos0) &&
+           cJSON_GetArraySize(pos0) == 3 * m->nnode_all;
   const cJSON* x = ok ? pos0->child : NULL;
   for (int i = 0; ok && i < m->nnode_all; i++) {
     double p[3] = {m->node_pos0[i].x, m->node_pos0[i].y, m->node_pos0[i].z};
-    for (int k = 0; k < 3 && ok; k++, x = x->next) ok = cJSON_IsNumber(x) && fabs(x->valuedouble - p[k]) <= 1e-9;
+    for (int k = 0; k < 3 && ok; k++, x = x->next)
+      ok = cJSON_IsNumber(x) && fabs(x->valuedouble - p[k]) <= 1e-9;
   }
   if (!ok)
-    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
-                        "the rod model rebuilt from plant_initial.json and the build settings differs from "
-                        "this file (%d nodes, %d segments rebuilt): was the run made by another verdant?",
-                        m->nnode_all, m->nseg);
+    return vd_error_set(
+        err, VD_ERR_FORMAT, path, 0, 0,
+        "the rod model rebuilt from plant_initial.json and the build settings differs from "
+        "this file (%d nodes, %d segments rebuilt): was the run made by another verdant?",
+        m->nnode_all, m->nseg);
   return VD_OK;
 }
 
@@ -235,7 +256,8 @@ vd_status cli_run_open(const char* dir, cli_run* run, vd_error* err) {
   memset(run, 0, sizeof *run);
   snprintf(run->dir, sizeof run->dir, "%s", dir);
   size_t n = strlen(run->dir);
-  while (n > 1 && run->dir[n - 1] == '/') run->dir[--n] = 0;
+  while (n > 1 && run->dir[n - 1] == '/')
+    run->dir[--n] = 0;
   char path[4200];
   // rod.json: the build settings
   snprintf(path, sizeof path, "%s/rod.json", run->dir);
@@ -248,7 +270,8 @@ vd_status cli_run_open(const char* dir, cli_run* run, vd_error* err) {
   const cJSON* format = cJSON_GetObjectItemCaseSensitive(rod, "format");
   if (!cJSON_IsString(format) || strcmp(format->valuestring, "verdant-rod")) {
     cJSON_Delete(rod);
-    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "not a verdant rod file (\"format\": \"verdant-rod\")");
+    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                        "not a verdant rod file (\"format\": \"verdant-rod\")");
   }
   vd_sim_def def;
   st = cli_sim_def_parse(cJSON_GetObjectItemCaseSensitive(rod, "build"), path, &def, err);
@@ -263,14 +286,16 @@ vd_status cli_run_open(const char* dir, cli_run* run, vd_error* err) {
   if (!st) {
     run->state = vd_sim_data_create(run->sim);
     run->pstate = vd_data_create(run->plant);
-    if (!run->state || !run->pstate) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (!run->state || !run->pstate)
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   // the frames: binary or JSON Lines
   if (!st) {
     snprintf(path, sizeof path, "%s/frames.bin", run->dir);
     if (access(path, F_OK) != 0) snprintf(path, sizeof path, "%s/frames.jsonl", run->dir);
     if (access(path, F_OK) != 0)
-      st = vd_error_set(err, VD_ERR_IO, run->dir, 0, 0, "no frames.bin or frames.jsonl (made with --frames none?)");
+      st = vd_error_set(err, VD_ERR_IO, run->dir, 0, 0,
+                        "no frames.bin or frames.jsonl (made with --frames none?)");
     else
       st = vd_sim_frames_open(path, &run->frames, err);
   }

@@ -26,7 +26,8 @@ static vd_model* cantilever(double len, double r, int with_fruit) {
   vd_plant_set_label(s, 1, "stem");
   if (with_fruit) {
     vd_sphere_spec f = vd_sphere_spec_default();
-    f.center = vd_v3(len + 0.01, 0, 0), f.radius = 0.01, f.parent = s1, f.node = c, f.label = 2, f.instance = 3;
+    f.center = vd_v3(len + 0.01, 0, 0), f.radius = 0.01, f.parent = s1, f.node = c, f.label = 2,
+    f.instance = 3;
     vd_plant_add_sphere(s, &f);
     vd_plant_set_label(s, 2, "fruit");
   }
@@ -41,12 +42,14 @@ static vd_sim_def rod_def(double sigma, double young) {
   vd_sim_def def = vd_sim_def_default();
   def.segment_length = sigma;
   def.clamp_length = 0.01;
-  for (int k = 0; k < VD_SIM_CLASS_COUNT; k++) def.material[k].young = young, def.material[k].density = 1000;
+  for (int k = 0; k < VD_SIM_CLASS_COUNT; k++)
+    def.material[k].young = young, def.material[k].density = 1000;
   return def;
 }
 
 static void put_u32(FILE* f, uint32_t v) {
-  unsigned char b[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16), (unsigned char)(v >> 24)};
+  unsigned char b[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
+                        (unsigned char)(v >> 24)};
   fwrite(b, 1, 4, f);
 }
 
@@ -60,16 +63,20 @@ static void put_f32(FILE* f, double d) {
 static void put_f64(FILE* f, double d) {
   uint64_t u;
   memcpy(&u, &d, 8);
-  for (int k = 0; k < 8; k++) fputc((int)(u >> (8 * k)) & 255, f);
+  for (int k = 0; k < 8; k++)
+    fputc((int)(u >> (8 * k)) & 255, f);
 }
 
 // append a frame record of state d (docs/formats.md, frames.bin)
 static void bin_record(FILE* f, const vd_sim_model* m, const vd_sim_data* d) {
   put_f64(f, d->time);
-  for (int i = 0; i < m->nnode_all; i++) put_f32(f, d->node_pos[i].x), put_f32(f, d->node_pos[i].y), put_f32(f, d->node_pos[i].z);
+  for (int i = 0; i < m->nnode_all; i++)
+    put_f32(f, d->node_pos[i].x), put_f32(f, d->node_pos[i].y), put_f32(f, d->node_pos[i].z);
   for (int t = 0; t < m->nseg; t++)
-    put_f32(f, d->seg_quat[t].w), put_f32(f, d->seg_quat[t].x), put_f32(f, d->seg_quat[t].y), put_f32(f, d->seg_quat[t].z);
-  for (int t = 0; t < m->nseg; t++) fputc(d->seg_broken[t] ? 1 : 0, f);
+    put_f32(f, d->seg_quat[t].w), put_f32(f, d->seg_quat[t].x), put_f32(f, d->seg_quat[t].y),
+        put_f32(f, d->seg_quat[t].z);
+  for (int t = 0; t < m->nseg; t++)
+    fputc(d->seg_broken[t] ? 1 : 0, f);
 }
 
 static void bin_header(FILE* f, const vd_sim_model* m) {
@@ -84,11 +91,12 @@ static void bin_header(FILE* f, const vd_sim_model* m) {
 static void jsonl_record(FILE* f, const vd_sim_model* m, const vd_sim_data* d) {
   fprintf(f, "{\"t\":%.9g,\"pos\":[", d->time);
   for (int i = 0; i < m->nnode_all; i++)
-    fprintf(f, "%s%.9g,%.9g,%.9g", i ? "," : "", d->node_pos[i].x, d->node_pos[i].y, d->node_pos[i].z);
+    fprintf(f, "%s%.9g,%.9g,%.9g", i ? "," : "", d->node_pos[i].x, d->node_pos[i].y,
+            d->node_pos[i].z);
   fputs("],\"quat\":[", f);
   for (int t = 0; t < m->nseg; t++)
-    fprintf(f, "%s%.9g,%.9g,%.9g,%.9g", t ? "," : "", d->seg_quat[t].w, d->seg_quat[t].x, d->seg_quat[t].y,
-            d->seg_quat[t].z);
+    fprintf(f, "%s%.9g,%.9g,%.9g,%.9g", t ? "," : "", d->seg_quat[t].w, d->seg_quat[t].x,
+            d->seg_quat[t].y, d->seg_quat[t].z);
   fputs("],\"broken\":[", f);
   for (int t = 0, first = 1; t < m->nseg; t++)
     if (d->seg_broken[t]) fprintf(f, "%s%d", first ? "" : ",", t), first = 0;
@@ -137,7 +145,8 @@ static int run3_make(run3* r) {
 }
 
 static void run3_free(run3* r) {
-  for (int k = 0; k < 3; k++) vd_sim_data_destroy(r->s[k]);
+  for (int k = 0; k < 3; k++)
+    vd_sim_data_destroy(r->s[k]);
   vd_sim_model_destroy(r->m);
   vd_model_destroy(r->plant);
 }
@@ -151,11 +160,13 @@ static const char* tmp_path(const char* name) {
 }
 
 // the loaded state has the frame's positions, frames, broken joints; the deformed plant agrees
-static void check_loaded(const run3* r, const vd_sim_data* want, const vd_sim_data* got, double tol) {
+static void check_loaded(const run3* r, const vd_sim_data* want, const vd_sim_data* got,
+                         double tol) {
   const vd_sim_model* m = r->m;
   CHECK_NEAR(got->time, want->time, 1e-12);
   double dp = 0, dq = 0;
-  for (int i = 0; i < m->nnode_all; i++) dp = fmax(dp, vd_norm(vd_sub(got->node_pos[i], want->node_pos[i])));
+  for (int i = 0; i < m->nnode_all; i++)
+    dp = fmax(dp, vd_norm(vd_sub(got->node_pos[i], want->node_pos[i])));
   for (int t = 0; t < m->nseg; t++) {
     vd_quat a = got->seg_quat[t], b = want->seg_quat[t];
     dq = fmax(dq, fabs(a.w - b.w) + fabs(a.x - b.x) + fabs(a.y - b.y) + fabs(a.z - b.z));
@@ -171,8 +182,10 @@ static void check_loaded(const run3* r, const vd_sim_data* want, const vd_sim_da
   vd_sim_to_plant(m, want, r->plant, pa);
   vd_sim_to_plant(m, got, r->plant, pb);
   double d = 0;
-  for (int i = 0; i < 3 * r->plant->nsphere; i++) d = fmax(d, fabs(pa->sphere_pos[i] - pb->sphere_pos[i]));
-  for (int i = 0; i < 3 * r->plant->nnode; i++) d = fmax(d, fabs(pa->node_pos[i] - pb->node_pos[i]));
+  for (int i = 0; i < 3 * r->plant->nsphere; i++)
+    d = fmax(d, fabs(pa->sphere_pos[i] - pb->sphere_pos[i]));
+  for (int i = 0; i < 3 * r->plant->nnode; i++)
+    d = fmax(d, fabs(pa->node_pos[i] - pb->node_pos[i]));
   CHECK(d < 10 * tol);
   vd_data_destroy(pa);
   vd_data_destroy(pb);
@@ -186,13 +199,15 @@ TEST(frames, binary_round_trip) {
   REQUIRE(run3_make(&r));
   REQUIRE(r.s[2]->time > 0.39);
   int nbroken = 0;
-  for (int t = 0; t < r.m->nseg; t++) nbroken += r.s[2]->seg_broken[t];
-  CHECK_INT(nbroken, 1);  // the fruit came off in the last frame
+  for (int t = 0; t < r.m->nseg; t++)
+    nbroken += r.s[2]->seg_broken[t];
+  CHECK_INT(nbroken, 1); // the fruit came off in the last frame
   const char* path = tmp_path("frames.bin");
   FILE* f = fopen(path, "wb");
   REQUIRE(f);
   bin_header(f, r.m);
-  for (int k = 0; k < 3; k++) bin_record(f, r.m, r.s[k]);
+  for (int k = 0; k < 3; k++)
+    bin_record(f, r.m, r.s[k]);
   fclose(f);
   vd_sim_frames* fr = NULL;
   vd_error e = {0};
@@ -240,7 +255,7 @@ TEST(frames, jsonl_round_trip) {
   REQUIRE(f);
   for (int k = 0; k < 3; k++) {
     jsonl_record(f, r.m, r.s[k]);
-    if (k == 0) fputs("   \n", f);  // blank lines are skipped
+    if (k == 0) fputs("   \n", f); // blank lines are skipped
   }
   fclose(f);
   vd_sim_frames* fr = NULL;
@@ -279,7 +294,8 @@ TEST(frames, bad_files) {
   FILE* f = fopen(good, "wb");
   REQUIRE(f);
   bin_header(f, r.m);
-  for (int k = 0; k < 3; k++) bin_record(f, r.m, r.s[k]);
+  for (int k = 0; k < 3; k++)
+    bin_record(f, r.m, r.s[k]);
   fclose(f);
   char* bytes;
   size_t len;
@@ -289,14 +305,14 @@ TEST(frames, bad_files) {
   CHECK_STATUS(vd_sim_frames_open(tmp_path("missing.bin"), &fr, &e), VD_ERR_IO, e);
   CHECK(fr == NULL);
   CHECK_STATUS(vd_sim_frames_open(put_file("short.bin", bytes, 10), &fr, &e), VD_ERR_FORMAT, e);
-  e = (vd_error){0};  // (an error record keeps its first error)
+  e = (vd_error){0}; // (an error record keeps its first error)
   CHECK_STATUS(vd_sim_frames_open(put_file("cut.bin", bytes, len - 5), &fr, &e), VD_ERR_FORMAT, e);
   CHECK(strstr(e.msg, "truncated") != NULL);
   char* copy = malloc(len);
   REQUIRE(copy);
   memcpy(copy, bytes, len), copy[0] = 'X';
   CHECK_STATUS(vd_sim_frames_open(put_file("magic.bin", copy, len), &fr, &e), VD_ERR_FORMAT, e);
-  memcpy(copy, bytes, len), copy[8] = 7;  // version 7
+  memcpy(copy, bytes, len), copy[8] = 7; // version 7
   CHECK_STATUS(vd_sim_frames_open(put_file("version.bin", copy, len), &fr, &e), VD_ERR_FORMAT, e);
   // time going backwards: frame 2 at t = 0
   memcpy(copy, bytes, len), memset(copy + 24 + 2 * rec, 0, 8);
@@ -322,13 +338,16 @@ TEST(frames, bad_files) {
   CHECK_STATUS(vd_sim_frames_load(fr, 0, r.m, d, &e), VD_ERR_FORMAT, e);
   vd_sim_frames_close(fr);
   // JSON Lines: the error names the line
-  const char* bad = "{\"t\":0,\"pos\":[0,0,0],\"quat\":[1,0,0,0],\"broken\":[]}\n{\"t\":1,\"pos\":[0,0]}\n";
+  const char* bad =
+      "{\"t\":0,\"pos\":[0,0,0],\"quat\":[1,0,0,0],\"broken\":[]}\n{\"t\":1,\"pos\":[0,0]}\n";
   e = (vd_error){0};
-  CHECK_STATUS(vd_sim_frames_open(put_file("bad.jsonl", bad, strlen(bad)), &fr, &e), VD_ERR_FORMAT, e);
+  CHECK_STATUS(vd_sim_frames_open(put_file("bad.jsonl", bad, strlen(bad)), &fr, &e), VD_ERR_FORMAT,
+               e);
   CHECK_INT(e.line, 2);
   const char* junk = "{\"t\":0,\"pos\":[0,0,0],\"quat\":[1,0,0,0],\"broken\":[]}\n\nnot json\n";
   e = (vd_error){0};
-  CHECK_STATUS(vd_sim_frames_open(put_file("junk.jsonl", junk, strlen(junk)), &fr, &e), VD_ERR_FORMAT, e);
+  CHECK_STATUS(vd_sim_frames_open(put_file("junk.jsonl", junk, strlen(junk)), &fr, &e),
+               VD_ERR_FORMAT, e);
   CHECK_INT(e.line, 3);
   free(copy);
   vd_free(bytes, len + 1);
@@ -343,11 +362,13 @@ TEST(frames, out_of_memory) {
   FILE* f = fopen(paths[0], "wb");
   REQUIRE(f);
   bin_header(f, r.m);
-  for (int k = 0; k < 3; k++) bin_record(f, r.m, r.s[k]);
+  for (int k = 0; k < 3; k++)
+    bin_record(f, r.m, r.s[k]);
   fclose(f);
   f = fopen(paths[1], "wb");
   REQUIRE(f);
-  for (int k = 0; k < 3; k++) jsonl_record(f, r.m, r.s[k]);
+  for (int k = 0; k < 3; k++)
+    jsonl_record(f, r.m, r.s[k]);
   fclose(f);
   vd_sim_data* d = vd_sim_data_create(r.m);
   REQUIRE(d);
@@ -395,7 +416,8 @@ TEST(frames, cantilever_moment_and_stress) {
   vd_sim_joint_moment(m, d, mo);
   vd_sim_seg_stress(m, d, sg);
   double mx = 0;
-  for (int t = 0; t < m->nseg; t++) mx = fmax(mx, fabs(mo[3 * t]) + fabs(mo[3 * t + 1]) + fabs(mo[3 * t + 2]) + sg[t]);
+  for (int t = 0; t < m->nseg; t++)
+    mx = fmax(mx, fabs(mo[3 * t]) + fabs(mo[3 * t + 1]) + fabs(mo[3 * t + 2]) + sg[t]);
   CHECK(mx < 1e-9);
   // loaded: statics
   REQUIRE(m->main_tip >= 0);
@@ -415,12 +437,12 @@ TEST(frames, cantilever_moment_and_stress) {
     double x = m->node_pos0[m->seg_node[2 * t]].x, want = F * (L - x);
     double bend = sqrt(mo[3 * t] * mo[3 * t] + mo[3 * t + 1] * mo[3 * t + 1]);
     worst = fmax(worst, fabs(bend - want) / (F * L));
-    CHECK(fabs(mo[3 * t + 2]) < 1e-6 * F * L);  // no twist
+    CHECK(fabs(mo[3 * t + 2]) < 1e-6 * F * L); // no twist
     if (fabs(x) < 1e-9) base = t;
     checked++;
   }
   CHECK(checked >= 15);
-  CHECK(worst < 0.01);  // within 1 % of F L at every joint
+  CHECK(worst < 0.01); // within 1 % of F L at every joint
   REQUIRE(base >= 0);
   double sigma = 4 * F * L / (VD_PI * r * r * r);
   CHECK_NEAR(sg[base], sigma, 0.01 * sigma);
@@ -447,8 +469,9 @@ TEST(frames, stress_of_broken_and_unbound) {
   for (int t = 0; t < r.m->nseg; t++)
     if (r.s[2]->seg_broken[t]) CHECK(mo[3 * t] == 0 && mo[3 * t + 1] == 0 && mo[3 * t + 2] == 0);
   vd_sim_plant_stress(r.m, r.s[1], r.plant, ps);
-  for (int j = 0; j < r.plant->nseg; j++) CHECK(isfinite(ps[j]) && ps[j] >= 0);
-  CHECK(ps[1] > 0);  // the bent rod is stressed
+  for (int j = 0; j < r.plant->nseg; j++)
+    CHECK(isfinite(ps[j]) && ps[j] >= 0);
+  CHECK(ps[1] > 0); // the bent rod is stressed
   free(ps);
   free(mo);
   run3_free(&r);

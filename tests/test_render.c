@@ -629,7 +629,8 @@ TEST(render, shapes) {
   if (!r) return;
   vd_error err = {0};
   // a sphere of 10 cm, 2 m in front of the camera: robot label, instance 0, its disc's area
-  vd_render_shape s = {VD_SHAPE_SPHERE, {0.1, 0, 0}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0.5f, 0.6f, 0.7f}};
+  vd_render_shape s = {
+      VD_SHAPE_SPHERE, {0.1, 0, 0}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0.5f, 0.6f, 0.7f}};
   CHECK_STATUS(vd_render_add_shape(r, &s, &err), VD_OK, err);
   vd_camera c = cam_y(vd_v3(0, -2, 0.5), 40);
   vd_frame f;
@@ -641,14 +642,18 @@ TEST(render, shapes) {
   CHECK_INT(f.instance[cv * f.width + cu], 0);
   CHECK_NEAR(f.depth[cv * f.width + cu], 2 - 0.1, 2e-3);
   int area = 0;
-  for (int i = 0; i < f.width * f.height; i++) area += f.label[i] == VD_RENDER_ROBOT_LABEL;
+  for (int i = 0; i < f.width * f.height; i++)
+    area += f.label[i] == VD_RENDER_ROBOT_LABEL;
   // the silhouette of a sphere seen from distance D: radius f r / sqrt(D^2 - r^2) pixels
   double rad = f.K.fy * 0.1 / sqrt(4 - 0.01), disc = VD_PI * rad * rad;
   CHECK(fabs(area - disc) < 0.05 * disc);
   // a capsule along x and a box: both drawn, both in the bounds
   vd_render_clear(r);
-  vd_render_shape cap = {VD_SHAPE_CAPSULE, {0.05, 0.3, 0}, vd_v3(0, 0, 0.5),
-                         vd_quat_axis_angle(vd_v3(0, 1, 0), VD_PI / 2), {1, 0, 0}};
+  vd_render_shape cap = {VD_SHAPE_CAPSULE,
+                         {0.05, 0.3, 0},
+                         vd_v3(0, 0, 0.5),
+                         vd_quat_axis_angle(vd_v3(0, 1, 0), VD_PI / 2),
+                         {1, 0, 0}};
   CHECK_STATUS(vd_render_add_shape(r, &cap, &err), VD_OK, err);
   vd_vec3 lo, hi;
   CHECK(vd_render_bounds(r, &lo, &hi));
@@ -658,14 +663,16 @@ TEST(render, shapes) {
   REQUIRE(vd_camera_project(&f.K, vd_v3(0.3, 0, 0.5), &u, &v, &z));
   CHECK_INT(f.label[(int)lround(v) * f.width + (int)lround(u)], VD_RENDER_ROBOT_LABEL);
   REQUIRE(vd_camera_project(&f.K, vd_v3(0, 0, 0.62), &u, &v, &z));
-  CHECK_INT(f.label[(int)lround(v) * f.width + (int)lround(u)], 0);  // above the capsule
+  CHECK_INT(f.label[(int)lround(v) * f.width + (int)lround(u)], 0); // above the capsule
   vd_render_clear(r);
-  vd_render_shape box = {VD_SHAPE_BOX, {0.1, 0.1, 0.2}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0, 1, 0}};
+  vd_render_shape box = {
+      VD_SHAPE_BOX, {0.1, 0.1, 0.2}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0, 1, 0}};
   CHECK_STATUS(vd_render_add_shape(r, &box, &err), VD_OK, err);
   CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_LABEL | VD_LAYER_DEPTH, &f, &err), VD_OK, err);
   // the box's front face (y = -0.1) fills a 0.2 x 0.4 m rectangle 1.9 m away
   area = 0;
-  for (int i = 0; i < f.width * f.height; i++) area += f.label[i] == VD_RENDER_ROBOT_LABEL;
+  for (int i = 0; i < f.width * f.height; i++)
+    area += f.label[i] == VD_RENDER_ROBOT_LABEL;
   double face = (f.K.fx * 0.2 / 1.9) * (f.K.fy * 0.4 / 1.9);
   CHECK(fabs(area - face) < 0.05 * face);
   REQUIRE(vd_camera_project(&f.K, box.pos, &u, &v, &z));
@@ -693,9 +700,12 @@ TEST(render, displacement_from_reference) {
   vd_data* ref = vd_data_create(m);
   REQUIRE(st && ref);
   // the state and the reference both moved 3 cm: no displacement between them; 3 cm from rest
-  for (int i = 0; i < 3 * m->nnode; i += 3) st->node_pos[i] += 0.03, ref->node_pos[i] += 0.03;
-  for (int i = 0; i < 3 * m->nsphere; i += 3) st->sphere_pos[i] += 0.03, ref->sphere_pos[i] += 0.03;
-  for (int i = 0; i < 3 * m->nvert; i += 3) st->vert_pos[i] += 0.03, ref->vert_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nnode; i += 3)
+    st->node_pos[i] += 0.03, ref->node_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nsphere; i += 3)
+    st->sphere_pos[i] += 0.03, ref->sphere_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nvert; i += 3)
+    st->vert_pos[i] += 0.03, ref->vert_pos[i] += 0.03;
   vd_render_style s = vd_render_style_default();
   s.color_by = VD_COLOR_DISPLACEMENT;
   s.ref = ref;
@@ -749,7 +759,8 @@ TEST(render, masks_follow_the_simulated_state) {
   g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
   int s1 = vd_plant_add_segment(sp, &g);
   vd_sphere_spec fr = vd_sphere_spec_default();
-  fr.center = vd_v3(0, 0, 0.32), fr.radius = 0.02, fr.parent = s1, fr.node = c, fr.label = 5, fr.instance = 3;
+  fr.center = vd_v3(0, 0, 0.32), fr.radius = 0.02, fr.parent = s1, fr.node = c, fr.label = 5,
+  fr.instance = 3;
   vd_plant_add_sphere(sp, &fr);
   vd_plant_set_label(sp, 1, "stem");
   vd_plant_set_label(sp, 5, "fruit");
@@ -784,7 +795,7 @@ TEST(render, masks_follow_the_simulated_state) {
     CHECK_INT(f.label[px], 5);
     CHECK_INT(f.instance[px], 3);
     if (k == 0) u0 = u;
-    if (k == 3) CHECK(u - u0 > 20);  // pushed along +x: 20 pixels or more to the right
+    if (k == 3) CHECK(u - u0 > 20); // pushed along +x: 20 pixels or more to the right
     sd->node_force[fruit] = vd_v3(0.07 * (k + 1), 0, 0);
     vd_sim_settle_def sdef = vd_sim_settle_def_default();
     sdef.statics = 1;

@@ -461,10 +461,12 @@ vd_status vd_render_add_shape(vd_renderer* r, const vd_render_shape* s, vd_error
   if ((int)s->kind < VD_SHAPE_SPHERE || s->kind > VD_SHAPE_BOX)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "unknown shape kind %d", (int)s->kind);
   for (int k = 0; k < nsize; k++)
-    if (!isfinite(s->size[k]) || !(s->size[k] > 0 || (s->kind == VD_SHAPE_CAPSULE && k == 1 && s->size[k] >= 0)))
-      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "shape size %d is %g: must be finite and > 0", k,
-                          s->size[k]);
-  if (!isfinite(s->pos.x + s->pos.y + s->pos.z) || !isfinite(s->quat.w + s->quat.x + s->quat.y + s->quat.z))
+    if (!isfinite(s->size[k]) ||
+        !(s->size[k] > 0 || (s->kind == VD_SHAPE_CAPSULE && k == 1 && s->size[k] >= 0)))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
+                          "shape size %d is %g: must be finite and > 0", k, s->size[k]);
+  if (!isfinite(s->pos.x + s->pos.y + s->pos.z) ||
+      !isfinite(s->quat.w + s->quat.x + s->quat.y + s->quat.z))
     return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "shape pose is not finite");
   vd_quat q = vd_quat_normalize(s->quat);
   vd_status st = gl_current(&r->gl, err);
@@ -489,7 +491,8 @@ vd_status vd_render_add_shape(vd_renderer* r, const vd_render_shape* s, vd_error
   gl_tris tris = {n, pos, nrm, NULL};
   it->list = gl_list(&r->gl, &tris);
   vd_free(pos, sizeof(float) * 18 * cap);
-  if (!it->list) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the shape");
+  if (!it->list)
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the shape");
   return VD_OK;
 }
 

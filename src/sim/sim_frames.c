@@ -12,20 +12,20 @@
 #define HEADER_BYTES 24
 
 struct vd_sim_frames {
-  char path[4096];   // file name, for errors
-  int jsonl;         // 1: JSON Lines, 0: binary
-  int nframe;        // frames
-  int nnode, nseg;   // sizes of every frame
-  double* time;      // time of each frame (s) (nframe)
+  char path[4096]; // file name, for errors
+  int jsonl;       // 1: JSON Lines, 0: binary
+  int nframe;      // frames
+  int nnode, nseg; // sizes of every frame
+  double* time;    // time of each frame (s) (nframe)
   // binary
-  FILE* fp;          // open file
-  size_t record;     // bytes of one record
-  unsigned char* buf;// one record
+  FILE* fp;           // open file
+  size_t record;      // bytes of one record
+  unsigned char* buf; // one record
   // JSON Lines
-  char* text;        // whole file (len + 1 bytes)
+  char* text; // whole file (len + 1 bytes)
   size_t len;
-  size_t* line_at;   // offset of each frame's line (nframe)
-  int* line_no;      // its line number (nframe)
+  size_t* line_at; // offset of each frame's line (nframe)
+  int* line_no;    // its line number (nframe)
 };
 
 static uint32_t get_u32(const unsigned char* b) {
@@ -34,7 +34,8 @@ static uint32_t get_u32(const unsigned char* b) {
 
 static double get_f64(const unsigned char* b) {
   uint64_t u = 0;
-  for (int k = 7; k >= 0; k--) u = u << 8 | b[k];
+  for (int k = 7; k >= 0; k--)
+    u = u << 8 | b[k];
   double d;
   memcpy(&d, &u, 8);
   return d;
@@ -55,32 +56,38 @@ static vd_status check_time(vd_sim_frames* f, int k, int line, long long offset,
   double t = f->time[k];
   if (isfinite(t) && (!k || t >= f->time[k - 1])) return VD_OK;
   const char* what = isfinite(t) ? "before the previous frame's" : "not finite";
-  if (line) return vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0, "frame %d: time %g is %s", k, t, what);
-  return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "frame %d at byte %lld: time %g is %s", k, offset,
-                      t, what);
+  if (line)
+    return vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0, "frame %d: time %g is %s", k, t,
+                        what);
+  return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "frame %d at byte %lld: time %g is %s", k,
+                      offset, t, what);
 }
 
 static vd_status open_bin(vd_sim_frames* f, vd_error* err) {
   f->fp = fopen(f->path, "rb");
-  if (!f->fp) return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot open: %s", strerror(errno));
+  if (!f->fp)
+    return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot open: %s", strerror(errno));
   unsigned char h[HEADER_BYTES];
   if (fread(h, 1, sizeof h, f->fp) != sizeof h)
     return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "shorter than the 24-byte header");
   if (memcmp(h, "VDSIMFRM", 8))
-    return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "not a verdant frames file (no VDSIMFRM)");
+    return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0,
+                        "not a verdant frames file (no VDSIMFRM)");
   uint32_t ver = get_u32(h + 8), nn = get_u32(h + 12), ns = get_u32(h + 16);
   if (ver != VD_SIM_FRAMES_VERSION)
-    return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "frames version %u (this verdant reads %d)",
-                        (unsigned)ver, VD_SIM_FRAMES_VERSION);
+    return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0,
+                        "frames version %u (this verdant reads %d)", (unsigned)ver,
+                        VD_SIM_FRAMES_VERSION);
   if (nn > 100000000u || ns > 100000000u)
-    return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "header: %u nodes, %u segments: too many",
-                        (unsigned)nn, (unsigned)ns);
+    return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0,
+                        "header: %u nodes, %u segments: too many", (unsigned)nn, (unsigned)ns);
   f->nnode = (int)nn, f->nseg = (int)ns;
   f->record = 8 + 12 * (size_t)nn + 17 * (size_t)ns;
   if (fseek(f->fp, 0, SEEK_END) != 0)
     return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot seek: %s", strerror(errno));
   long size = ftell(f->fp);
-  if (size < HEADER_BYTES) return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot tell its size");
+  if (size < HEADER_BYTES)
+    return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot tell its size");
   size_t body = (size_t)size - HEADER_BYTES;
   if (body % f->record)
     return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0,
@@ -98,7 +105,8 @@ static vd_status open_bin(vd_sim_frames* f, vd_error* err) {
     long long at = HEADER_BYTES + (long long)k * (long long)f->record;
     unsigned char b[8];
     if (fseek(f->fp, (long)at, SEEK_SET) != 0 || fread(b, 1, 8, f->fp) != 8)
-      return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot read frame %d at byte %lld", k, at);
+      return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot read frame %d at byte %lld", k,
+                          at);
     f->time[k] = get_f64(b);
     vd_status st = check_time(f, k, 0, at, err);
     if (st) return st;
@@ -141,16 +149,18 @@ static vd_status parse_line(vd_sim_frames* f, int k, cJSON** out, vd_error* err)
   if (f->nnode < 0) {
     if (np % 3 || nq % 4) {
       cJSON_Delete(o);
-      return vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0,
-                          "\"pos\" has %d numbers and \"quat\" %d: not 3 per node and 4 per segment", np, nq);
+      return vd_error_set(
+          err, VD_ERR_FORMAT, f->path, line, 0,
+          "\"pos\" has %d numbers and \"quat\" %d: not 3 per node and 4 per segment", np, nq);
     }
     f->nnode = np / 3, f->nseg = nq / 4;
   }
   if (np != 3 * f->nnode || nq != 4 * f->nseg) {
     cJSON_Delete(o);
-    return vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0,
-                        "%d node and %d segment values where the first frame has %d nodes and %d segments",
-                        np / 3, nq / 4, f->nnode, f->nseg);
+    return vd_error_set(
+        err, VD_ERR_FORMAT, f->path, line, 0,
+        "%d node and %d segment values where the first frame has %d nodes and %d segments", np / 3,
+        nq / 4, f->nnode, f->nseg);
   }
   f->time[k] = t->valuedouble;
   *out = o;
@@ -166,7 +176,8 @@ static vd_status open_jsonl(vd_sim_frames* f, vd_error* err) {
     const char* e = memchr(f->text + i, '\n', f->len - i);
     size_t end = e ? (size_t)(e - f->text) : f->len;
     size_t j = i;
-    while (j < end && (f->text[j] == ' ' || f->text[j] == '\t' || f->text[j] == '\r')) j++;
+    while (j < end && (f->text[j] == ' ' || f->text[j] == '\t' || f->text[j] == '\r'))
+      j++;
     n += j < end;
     i = end + 1;
   }
@@ -184,7 +195,8 @@ static vd_status open_jsonl(vd_sim_frames* f, vd_error* err) {
     const char* e = memchr(f->text + i, '\n', f->len - i);
     size_t end = e ? (size_t)(e - f->text) : f->len;
     size_t j = i;
-    while (j < end && (f->text[j] == ' ' || f->text[j] == '\t' || f->text[j] == '\r')) j++;
+    while (j < end && (f->text[j] == ' ' || f->text[j] == '\t' || f->text[j] == '\r'))
+      j++;
     if (j < end) f->line_at[n] = i, f->line_no[n++] = line;
     i = end + 1;
   }
@@ -227,7 +239,9 @@ void vd_sim_frames_close(vd_sim_frames* f) {
   vd_free(f, sizeof *f);
 }
 
-int vd_sim_frames_count(const vd_sim_frames* f) { return f->nframe; }
+int vd_sim_frames_count(const vd_sim_frames* f) {
+  return f->nframe;
+}
 
 void vd_sim_frames_size(const vd_sim_frames* f, int* nnode_all, int* nseg) {
   *nnode_all = f->nnode;
@@ -292,18 +306,21 @@ vd_status vd_sim_frames_load(vd_sim_frames* f, int k, const vd_sim_model* m, vd_
     const cJSON* v = pos->child;
     for (int i = 0; i < m->nnode_all; i++) {
       double x[3];
-      for (int c = 0; c < 3; c++, v = v->next) x[c] = cJSON_IsNumber(v) ? v->valuedouble : NAN;
+      for (int c = 0; c < 3; c++, v = v->next)
+        x[c] = cJSON_IsNumber(v) ? v->valuedouble : NAN;
       d->node_pos[i] = vd_v3(x[0], x[1], x[2]);
     }
     v = quat->child;
     for (int t = 0; t < m->nseg; t++) {
       double q[4];
-      for (int c = 0; c < 4; c++, v = v->next) q[c] = cJSON_IsNumber(v) ? v->valuedouble : NAN;
+      for (int c = 0; c < 4; c++, v = v->next)
+        q[c] = cJSON_IsNumber(v) ? v->valuedouble : NAN;
       d->seg_quat[t] = (vd_quat){q[0], q[1], q[2], q[3]};
     }
   } else {
     if (fseek(f->fp, (long)at, SEEK_SET) != 0 || fread(f->buf, 1, f->record, f->fp) != f->record)
-      return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot read frame %d at byte %lld", k, at);
+      return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "cannot read frame %d at byte %lld", k,
+                          at);
     const unsigned char* b = f->buf + 8;
     for (int i = 0; i < m->nnode_all; i++, b += 12)
       d->node_pos[i] = vd_v3(get_f32(b), get_f32(b + 4), get_f32(b + 8));
@@ -315,7 +332,8 @@ vd_status vd_sim_frames_load(vd_sim_frames* f, int k, const vd_sim_model* m, vd_
   for (int i = 0; i < m->nnode_all && !st; i++) {
     vd_vec3 p = d->node_pos[i];
     if (!isfinite(p.x + p.y + p.z))
-      st = vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0, "frame %d: node %d is not finite", k, i);
+      st = vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0, "frame %d: node %d is not finite", k,
+                        i);
   }
   for (int t = 0; t < m->nseg && !st; t++) {
     vd_quat q = d->seg_quat[t];
@@ -334,8 +352,8 @@ vd_status vd_sim_frames_load(vd_sim_frames* f, int k, const vd_sim_model* m, vd_
     } else {
       unsigned char flag = f->buf[8 + 12 * (size_t)m->nnode_all + 16 * (size_t)m->nseg + (size_t)t];
       if (flag > 1) {
-        st = vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "frame %d: segment %d has flag %u (0 or 1)",
-                          k, t, (unsigned)flag);
+        st = vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0,
+                          "frame %d: segment %d has flag %u (0 or 1)", k, t, (unsigned)flag);
         break;
       }
       broken = flag;

@@ -30,7 +30,8 @@ void vd_sim_joint_moment(const vd_sim_model* m, const vd_sim_data* d, double* ou
 }
 
 void vd_sim_seg_stress(const vd_sim_model* m, const vd_sim_data* d, double* out) {
-  for (int t = 0; t < m->nseg; t++) out[t] = 0;
+  for (int t = 0; t < m->nseg; t++)
+    out[t] = 0;
   // each joint loads the segment on either side of it, each with its own section
   for (int t = 0; t < m->nseg; t++) {
     int p = m->seg_parent[t];
@@ -44,7 +45,8 @@ void vd_sim_seg_stress(const vd_sim_model* m, const vd_sim_data* d, double* out)
 void vd_sim_plant_stress(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant,
                          double* out) {
   VD_ASSERT(plant->nseg == m->nbind_seg);
-  for (int j = 0; j < plant->nseg; j++) out[j] = NAN;
+  for (int j = 0; j < plant->nseg; j++)
+    out[j] = NAN;
   // rod segments that resample a plant segment start at 0 (a segment without load)
   for (int t = 0; t < m->nseg; t++)
     if (m->seg_plant[t] >= 0) out[m->seg_plant[t]] = 0;
