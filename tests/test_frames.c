@@ -344,11 +344,40 @@ TEST(frames, bad_files) {
   CHECK_STATUS(vd_sim_frames_open(put_file("bad.jsonl", bad, strlen(bad)), &fr, &e), VD_ERR_FORMAT,
                e);
   CHECK_INT(e.line, 2);
+  // a time going backwards in JSON Lines (fuzz finding: the parsed line leaked)
+  const char* back = "{\"t\":1,\"pos\":[0,0,0],\"quat\":[1,0,0,0],\"broken\":[]}\n"
+                     "{\"t\":0,\"pos\":[0,0,0],\"quat\":[1,0,0,0],\"broken\":[]}\n";
+  e = (vd_error){0};
+  CHECK_STATUS(vd_sim_frames_open(put_file("back.jsonl", back, strlen(back)), &fr, &e),
+               VD_ERR_FORMAT, e);
+  CHECK_INT(e.line, 2);
   const char* junk = "{\"t\":0,\"pos\":[0,0,0],\"quat\":[1,0,0,0],\"broken\":[]}\n\nnot json\n";
   e = (vd_error){0};
   CHECK_STATUS(vd_sim_frames_open(put_file("junk.jsonl", junk, strlen(junk)), &fr, &e),
                VD_ERR_FORMAT, e);
   CHECK_INT(e.line, 3);
+  // a broken segment id out of every range (fuzz finding: 1e999 cast to int)
+  const char* huge = tmp_path("huge.jsonl");
+  f = fopen(huge, "wb");
+  REQUIRE(f);
+  jsonl_record(f, r.m, r.s[0]);
+  fclose(f);
+  char* text;
+  size_t tl;
+  REQUIRE(!vd_file_read(huge, &text, &tl, &e));
+  char* br = strstr(text, "\"broken\":[]");
+  REQUIRE(br);
+  char* edited = malloc(tl + 16);
+  REQUIRE(edited);
+  snprintf(edited, tl + 16, "%.*s\"broken\":[1e999]}\n", (int)(br - text), text);
+  vd_free(text, tl + 1);
+  e = (vd_error){0};
+  CHECK_STATUS(vd_sim_frames_open(put_file("huge.jsonl", edited, strlen(edited)), &fr, &e), VD_OK,
+               e);
+  REQUIRE(fr);
+  CHECK_STATUS(vd_sim_frames_load(fr, 0, r.m, d, &e), VD_ERR_FORMAT, e);
+  vd_sim_frames_close(fr);
+  free(edited);
   free(copy);
   vd_free(bytes, len + 1);
   vd_sim_data_destroy(d);

@@ -163,8 +163,13 @@ static vd_status parse_line(vd_sim_frames* f, int k, cJSON** out, vd_error* err)
         nq / 4, f->nnode, f->nseg);
   }
   f->time[k] = t->valuedouble;
+  vd_status st = check_time(f, k, line, 0, err);
+  if (st) {
+    cJSON_Delete(o);
+    return st;
+  }
   *out = o;
-  return check_time(f, k, line, 0, err);
+  return VD_OK;
 }
 
 static vd_status open_jsonl(vd_sim_frames* f, vd_error* err) {
@@ -363,8 +368,9 @@ vd_status vd_sim_frames_load(vd_sim_frames* f, int k, const vd_sim_model* m, vd_
   if (f->jsonl && !st) {
     const cJSON* b;
     cJSON_ArrayForEach(b, cJSON_GetObjectItemCaseSensitive(o, "broken")) {
-      if (!cJSON_IsNumber(b) || b->valuedouble != (int)b->valuedouble || b->valuedouble < 0 ||
-          b->valuedouble >= m->nseg) {
+      // range first: casting an out-of-range double to int is undefined (fuzz finding: inf)
+      if (!cJSON_IsNumber(b) || !(b->valuedouble >= 0 && b->valuedouble < m->nseg) ||
+          b->valuedouble != floor(b->valuedouble)) {
         st = vd_error_set(err, VD_ERR_FORMAT, f->path, line, 0,
                           "frame %d: \"broken\" holds %g, not a segment id (0..%d)", k,
                           cJSON_IsNumber(b) ? b->valuedouble : NAN, m->nseg - 1);
