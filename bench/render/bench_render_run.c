@@ -153,8 +153,8 @@ int main(int argc, char** argv) {
   printf("%-34s %7s %7s %7s %7s %7s %8s %6s %8s %7s %6s\n", "case", "load", "plant", "stress",
          "scene", "draw", "total", "fps", "best", "peer", "x peer");
   const bench_case cases[] = {
-      {"colour, supersample 2 (CLI default)", 2, VD_LAYER_COLOR, VD_COLOR_LABEL},
-      {"colour by stress, supersample 2", 2, VD_LAYER_COLOR, VD_COLOR_STRESS},
+      {"colour; supersample 2 (CLI default)", 2, VD_LAYER_COLOR, VD_COLOR_LABEL},
+      {"colour by stress; supersample 2", 2, VD_LAYER_COLOR, VD_COLOR_STRESS},
       {"colour + depth + masks", 1, VD_LAYER_ALL, VD_COLOR_LABEL},
   };
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
