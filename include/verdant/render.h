@@ -37,7 +37,7 @@ extern "C" {
 #endif
 
 #define VD_RENDER_FORMAT_VERSION 1  // version of the image sidecar JSON (docs/formats.md)
-#define VD_RENDER_ROBOT_LABEL 65535 // label id of robot and solid (collider) pixels in the label mask
+#define VD_RENDER_ROBOT_LABEL 65535 // label id of robot and collider pixels in masks
 
 // ---------------------------------------------------------------------------------------------
 // cameras
