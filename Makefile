@@ -28,6 +28,7 @@ test: all
 bench: all
 	./$(BUILD)/verdant_bench $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_render $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_render_run $(BENCH_ARGS)
 	bash bench/cloud_bench.sh ./$(BUILD)/verdant $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_sim $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_collide --csv bench/results/collide-2core.csv

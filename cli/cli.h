@@ -107,6 +107,65 @@ int cli_label_counts(const vd_cloud* c, int64_t* count);
 // The --stats JSON of a result (caller deletes it), NULL when out of memory.
 struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total);
 
+// Simulation runs on disk (cli_run.c): the rod build settings of rod.json, the colliders of
+// colliders.jsonl, and a run read back frame by frame.
+struct cJSON* cli_sim_def_json(const vd_sim_def* def);
+// Read the build settings written by cli_sim_def_json (errors name path and the field).
+vd_status cli_sim_def_parse(const struct cJSON* o, const char* path, vd_sim_def* def, vd_error* err);
+// Write one line of colliders.jsonl: the state's time and colliders.
+void cli_colliders_write(FILE* fp, const vd_sim_data* d);
+
+// A run folder opened for reading.
+typedef struct cli_run {
+  char dir[4096];          // the folder
+  vd_plant_spec* spec;     // the initial plant (plant_initial.json)
+  vd_model* plant;         // compiled
+  vd_sim_model* sim;       // rod model rebuilt with the run's build settings
+  vd_sim_data* state;      // rod state of the loaded frame
+  vd_data* pstate;         // plant state of the loaded frame
+  vd_sim_frames* frames;   // frames.bin or frames.jsonl
+  int nframe;              // frames (>= 1)
+  int* col_start;          // colliders of frame k: col[col_start[k] .. col_start[k + 1]) (nframe + 1)
+  vd_sim_collider* col;    // every frame's colliders (ncol); NULL without colliders.jsonl
+  int ncol, cap_col;
+} cli_run;
+
+// Open a run folder: rod.json, plant_initial.json, frames, colliders.jsonl when there.
+vd_status cli_run_open(const char* dir, cli_run* run, vd_error* err);
+// Load frame k into run->state and run->pstate.
+vd_status cli_run_load(cli_run* run, int k, vd_error* err);
+// Colliders of frame k (count returned; *out points into the run).
+int cli_run_colliders(const cli_run* run, int k, const vd_sim_collider** out);
+// Release everything the run holds.
+void cli_run_close(cli_run* run);
+
+// Options of `verdant render` (cli_render.c), shared with the run renderer (cli_render_run.c).
+typedef struct cli_render_opts {
+  cli_plant_opts po;        // the input (po.path) and the plant options
+  const char* out;          // -o: OUT.png, or a folder for every frame of a run
+  const char* mp4;          // --mp4 (runs)
+  vd_render_def def;        // --size, --supersample, --robot, --no-floor ...
+  vd_render_style style;    // --color-by, --range
+  vd_camera_kind kind;      // --camera
+  double az, el;            // --camera orbit angles (degrees)
+  int has_eye;              // --eye/--lookat given
+  vd_vec3 eye, lookat, up;  // explicit pose (m), --up
+  double fov;               // --fov (degrees)
+  int depth, masks, info;   // --depth, --masks, --info
+  double point_size;        // --point-size (m), 0 automatic
+  int has_time;             // --time given
+  double time;              // --time (s)
+  double fps;               // --fps of the MP4 (0: the run's frame rate)
+} cli_render_opts;
+
+// The camera of the options: the explicit pose, or the preset fitted to the box lo..hi.
+vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi);
+// Write a frame: OUT.png, and with depth or masks OUT.depth.png, OUT.label.png, OUT.instance.png
+// and the sidecar OUT.json naming them (every file atomic).
+vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err);
+// Render a simulation run folder (cli_render_run.c); returns the exit code.
+int cli_render_run(const cli_render_opts* o);
+
 // Subcommands.
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);

@@ -3,7 +3,9 @@
 // (master seed, i) so any item can be remade alone. Items run in parallel (--jobs) and split
 // across machines (--shard i/N); a run skips complete items, so an interrupted dataset resumes.
 // Every file is written under a temporary name and renamed when complete; an item is complete
-// when its record (written after its cloud) names a cloud file of the recorded size.
+// when its record (written after its cloud and images) names a cloud file of the recorded size
+// and the images it lists exist. With --images N each item also gets N rendered views of the
+// same plant (colour, depth, label and instance masks, camera sidecar).
 #define _POSIX_C_SOURCE 200809L
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -43,6 +45,10 @@ static const char* dataset_usage =
     "                        Slurm job array or of mpirun ranks (examples/dataset_*.sh)\n"
     "      --vary NAME=A:B   set the .lpy global NAME to a value drawn uniformly in [A, B] for\n"
     "                        each item (repeatable); the value is in the item's record\n"
+    "      --images N        also N pictures of each plant from around it (colour, depth and label\n"
+    "                        and instance masks, camera JSON: item_000000_view0.png, ...), seeded\n"
+    "                        by the item; needs an OpenGL context (EGL, software without a GPU)\n"
+    "      --image-size WxH  size of those pictures in pixels (default 640x480)\n"
     "      --force           remake complete items too\n"
     "      --stats           print a JSON summary on stdout (made, skipped, seconds, items/s)\n";
 
@@ -61,7 +67,19 @@ typedef struct dataset {
   int instance_labels; // --labels instance: every item has its own label table
   char params[17];     // hex FNV-1a of the arguments that shape the output
   cJSON* arguments;    // those arguments
+  int images;          // --images: views per item
+  int img_w, img_h;    // --image-size (pixels)
 } dataset;
+
+// Renderers shared by the worker threads, one thread at a time (an OpenGL context is current on
+// one thread; vd_render_release hands it over).
+#define POOL_MAX 1024
+typedef struct render_pool {
+  vd_renderer* r[POOL_MAX]; // renderers (n), NULL until first needed
+  int geoms[POOL_MAX];      // their max_geoms
+  int busy[POOL_MAX];       // 1 while a thread holds it
+  int n;
+} render_pool;
 
 // ---------------------------------------------------------------------------------------------
 // small helpers
@@ -159,13 +177,130 @@ static cJSON* complete_record(const dataset* ds, int i, int* mismatch) {
     cJSON_Delete(rec);
     return NULL;
   }
+  // the pictures: as many views as asked, every file there
+  if (ds->images) {
+    const cJSON* views = cJSON_GetObjectItemCaseSensitive(rec, "images");
+    int ok = cJSON_IsArray(views) && cJSON_GetArraySize(views) == ds->images;
+    static const char* roles[5] = {"color", "depth", "label", "instance", "camera"};
+    const cJSON* v;
+    cJSON_ArrayForEach(v, views) {
+      for (int k = 0; k < 5 && ok; k++) {
+        const cJSON* f = cJSON_GetObjectItemCaseSensitive(v, roles[k]);
+        ok = cJSON_IsString(f) && !strchr(f->valuestring, '/');
+        if (ok) {
+          snprintf(cpath, sizeof cpath, "%s/%s", ds->dir, f->valuestring);
+          ok = access(cpath, F_OK) == 0;
+        }
+      }
+    }
+    if (!ok) {
+      cJSON_Delete(rec);
+      return NULL;
+    }
+  }
   return rec;
+}
+
+// ---------------------------------------------------------------------------------------------
+// pictures of an item
+
+// a renderer of the pool for this thread (made on first use, remade when too small)
+static vd_status pool_take(render_pool* p, const dataset* ds, int geoms, int* slot, vd_error* err) {
+  int s = -1;
+#pragma omp critical(dataset_pool)
+  {
+    for (int k = 0; k < p->n && s < 0; k++)
+      if (!p->busy[k]) s = k;
+    if (s < 0 && p->n < POOL_MAX) s = p->n++;
+    if (s >= 0) p->busy[s] = 1;
+  }
+  if (s < 0) return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0, "more than %d renderers", POOL_MAX);
+  *slot = s;
+  if (p->r[s] && p->geoms[s] >= geoms) return VD_OK;
+  vd_render_destroy(p->r[s]);
+  p->r[s] = NULL;
+  vd_render_def def = vd_render_def_default();
+  def.width = ds->img_w, def.height = ds->img_h;
+  def.legend = 0;  // training images: nothing drawn over the scene
+  if (geoms > def.max_geoms) def.max_geoms = geoms;
+  p->geoms[s] = def.max_geoms;
+  vd_status st = vd_render_create(&def, &p->r[s], err);
+  if (st) p->busy[s] = 0;
+  return st;
+}
+
+// give the renderer back, its context free for the next thread
+static void pool_put(render_pool* p, int slot) {
+  vd_render_release(p->r[slot]);
+#pragma omp critical(dataset_pool)
+  p->busy[slot] = 0;
+}
+
+static void pool_free(render_pool* p) {
+  for (int k = 0; k < p->n; k++)
+    vd_render_destroy(p->r[k]);
+  p->n = 0;
+}
+
+// ds->images views of item i's plant (loaded with the item's options): the camera orbits the
+// plant at azimuths evenly spaced from an offset, at elevations in [10, 40] degrees, all drawn
+// from the stream (item seed, VIEW_STREAM); the files and the cameras go into the record
+#define VIEW_STREAM 0x76696577u  // "view"
+static vd_status make_images(const dataset* ds, render_pool* pool, const cli_plant_opts* po, int i, uint64_t seed,
+                             cJSON* rec, vd_error* err) {
+  vd_plant_spec* spec = NULL;
+  vd_model* m = NULL;
+  cli_grow_info info;
+  memset(&info, 0, sizeof info);
+  vd_status st = cli_load_plant(po, &spec, &info, err);
+  if (!st) st = vd_plant_compile(spec, &m, err);
+  cli_grow_info_free(&info);
+  vd_plant_spec_destroy(spec);
+  int slot = -1;
+  if (!st) st = pool_take(pool, ds, m->ninstance + 16, &slot, err);
+  vd_renderer* r = slot >= 0 ? pool->r[slot] : NULL;
+  if (!st) {
+    vd_render_clear(r);
+    st = vd_render_add_plant(r, m, NULL, NULL, err);
+  }
+  cJSON* views = cJSON_AddArrayToObject(rec, "images");
+  if (!st && !views) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_rng g;
+  vd_rng_stream(&g, seed, VIEW_STREAM);
+  double az0 = vd_rng_uniform(&g, -180, 180);
+  for (int v = 0; !st && v < ds->images; v++) {
+    double az = fmod(az0 + 360.0 * v / ds->images + 180, 360) - 180, el = vd_rng_uniform(&g, 10, 40);
+    vd_vec3 lo, hi;
+    vd_render_bounds(r, &lo, &hi);
+    vd_camera cam = vd_camera_preset(VD_CAMERA_ORBIT, az * VD_PI / 180, el * VD_PI / 180, lo, hi, ds->img_w, ds->img_h);
+    vd_frame f;
+    char base[64], path[4200];
+    snprintf(base, sizeof base, "item_%0*d_view%d", ds->width, i, v);
+    snprintf(path, sizeof path, "%s/%s.png", ds->dir, base);
+    st = vd_render_draw(r, &cam, VD_LAYER_ALL, &f, err);
+    if (!st) st = cli_frame_write(&f, path, 1, 1, err);
+    if (st) break;
+    cJSON* e = cJSON_CreateObject();
+    cJSON_AddNumberToObject(e, "view", v);
+    cJSON_AddNumberToObject(e, "azimuth", az);
+    cJSON_AddNumberToObject(e, "elevation", el);
+    static const char* roles[5][2] = {{"color", "png"}, {"depth", "depth.png"}, {"label", "label.png"},
+                                      {"instance", "instance.png"}, {"camera", "json"}};
+    for (int k = 0; k < 5; k++) {
+      snprintf(path, sizeof path, "%s.%s", base, roles[k][1]);
+      cJSON_AddStringToObject(e, roles[k][0], path);
+    }
+    cJSON_AddItemToArray(views, e);
+  }
+  if (slot >= 0) pool_put(pool, slot);
+  vd_model_destroy(m);
+  return st;
 }
 
 // ---------------------------------------------------------------------------------------------
 // one item
 
-static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const cli_cloud_opts* co,
+static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant_opts* po0, const cli_cloud_opts* co,
                            int i, int64_t* points, vd_error* err) {
   double values[MAX_VARY];
   uint64_t seed = item_seed(ds, i, values);
@@ -230,7 +365,9 @@ static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const c
   cJSON_AddStringToObject(rec, "parameters", ds->params);
   *points = res.cloud.n;
   vd_cloud_free(&res.cloud);
-  st = write_json(rpath, rec, 0, err);
+  // the pictures, then the record that makes the item complete
+  if (ds->images) st = make_images(ds, pool, &po, i, seed, rec, err);
+  if (!st) st = write_json(rpath, rec, 0, err);
   cJSON_Delete(rec);
   return st;
 }
@@ -319,6 +456,20 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
   cJSON_AddStringToObject(root, "regenerate",
                           "verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
                           "<parameters.arguments> -o item.<cloud_format>");
+  if (ds->images) {
+    cJSON* im = cJSON_AddObjectToObject(root, "images");
+    cJSON_AddNumberToObject(im, "per_item", ds->images);
+    cJSON_AddNumberToObject(im, "width", ds->img_w);
+    cJSON_AddNumberToObject(im, "height", ds->img_h);
+    cJSON_AddStringToObject(im, "depth", "16-bit grey PNG, millimetres along the optical axis, 0 = nothing");
+    cJSON_AddStringToObject(im, "masks", "16-bit grey PNG ids: label (the labels table), instance; 0 = background");
+    char regen[256];
+    snprintf(regen, sizeof regen,
+             "verdant render PLANT --seed <item seed> [--set NAME=<item vary value>]... --camera "
+             "orbit:<azimuth>:<elevation> --size %dx%d --no-legend --depth --masks -o view.png",
+             ds->img_w, ds->img_h);
+    cJSON_AddStringToObject(im, "regenerate", regen);
+  }
   if (ds->instance_labels)
     cJSON_Delete(labels);  // in the items
   else
@@ -369,6 +520,8 @@ int cli_dataset(int argc, char** argv) {
   dataset ds;
   memset(&ds, 0, sizeof ds);
   ds.jobs = 1, ds.nshard = 1, ds.ext = "ply", ds.count = -1;
+  ds.img_w = 640, ds.img_h = 480;
+  int image_size_given = 0;
   ds.progress = po.progress;
   int stats = 0;
   for (int i = 1; i < argc; i++) {
@@ -413,6 +566,16 @@ int cli_dataset(int argc, char** argv) {
       if (!val || !parse_vary(val, &ds.vary[ds.nvary]))
         return cli_usage_error("dataset", "--vary expects NAME=A:B with A <= B, got '%s'", val ? val : "");
       ds.nvary++, i++;
+    } else if (!strcmp(a, "--images")) {
+      long v = val ? (errno = 0, strtol(val, &end, 10)) : 0;
+      if (!val || errno || *end || v < 1 || v > 1000) return cli_usage_error("dataset", "--images expects an integer in 1..1000");
+      ds.images = (int)v, i++;
+    } else if (!strcmp(a, "--image-size")) {
+      int w, h;
+      char tail;
+      if (!val || sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+        return cli_usage_error("dataset", "--image-size expects WxH with 1..8192 pixels each, got '%s'", val ? val : "");
+      ds.img_w = w, ds.img_h = h, image_size_given = 1, i++;
     } else if (!strcmp(a, "--force")) {
       ds.force = 1;
     } else if (!strcmp(a, "--stats")) {
@@ -430,6 +593,7 @@ int cli_dataset(int argc, char** argv) {
   if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
+  if (image_size_given && !ds.images) return cli_usage_error("dataset", "--image-size goes with --images N");
   ds.master = po.seed;
   ds.instance_labels = co.labels_instance;
   ds.progress = po.progress;
@@ -486,6 +650,21 @@ int cli_dataset(int argc, char** argv) {
   int64_t points = 0;
   vd_error first = {0};
   vd_status first_st = VD_OK;
+  // pictures need an OpenGL context: make the first renderer now, so that its absence is one
+  // clear failure before any item
+  render_pool pool;
+  memset(&pool, 0, sizeof pool);
+  if (ds.images && ntodo) {
+    int slot;
+    vd_status st = pool_take(&pool, &ds, 16, &slot, &first);
+    if (st) {
+      vd_free(todo, (size_t)ds.count * sizeof(int));
+      cJSON_Delete(ds.arguments);
+      cli_report("dataset", &first, st);
+      return EXIT_FAIL;
+    }
+    pool_put(&pool, slot);
+  }
   progress(&ds, 0, ntodo, t0);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ds.jobs)
   for (int k = 0; k < ntodo; k++) {
@@ -495,7 +674,7 @@ int cli_dataset(int argc, char** argv) {
     if (stop >= 0) continue;
     vd_error err = {0};
     int64_t n = 0;
-    vd_status st = make_item(&ds, &po, &co, todo[k], &n, &err);
+    vd_status st = make_item(&ds, &pool, &po, &co, todo[k], &n, &err);
 #pragma omp critical(dataset_progress)
     {
       if (st && (failed_item < 0 || todo[k] < failed_item)) {
@@ -511,6 +690,7 @@ int cli_dataset(int argc, char** argv) {
     }
   }
   vd_free(todo, (size_t)ds.count * sizeof(int));
+  pool_free(&pool);
   if (failed_item >= 0) {
     cJSON_Delete(ds.arguments);
     if (ds.progress) fputc('\n', stderr);

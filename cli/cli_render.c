@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// verdant render: a plant (.lpy or plant file) or a point cloud (.ply .pcd .xyz .csv .las) → PNG colour image, with
-// depth (16-bit, mm) and label/instance masks (16-bit ids) and a JSON sidecar on request.
+// verdant render: a plant (.lpy or plant file), a point cloud (.ply .pcd .xyz .csv .las) or a
+// simulation run folder → PNG colour image, with depth (16-bit, mm) and label/instance masks
+// (16-bit ids) and a JSON sidecar on request; every frame of a run into a folder or an MP4.
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -12,9 +13,11 @@
 
 static const char* render_help =
     "usage: verdant render PLANT|CLOUD -o OUT.png [options]\n"
+    "       verdant render RUN/ -o OUT.png [--time T] | -o DIR/ | --mp4 OUT.mp4 [options]\n"
     "\n"
-    "Draw a plant (an .lpy file, derived on the fly, or a plant .json) or a point cloud (.ply,\n"
-    ".pcd, .xyz, .csv or .las, with optional label and instance) headless with MuJoCo's renderer (EGL; software rendering\n"
+    "Draw a plant (an .lpy file, derived on the fly, or a plant .json), a point cloud (.ply,\n"
+    ".pcd, .xyz, .csv or .las, with optional label and instance) or a simulation run (a folder\n"
+    "written by 'verdant sim -o RUN/') headless with MuJoCo's renderer (EGL; software rendering\n"
     "when there is no GPU) and write a colour PNG with a legend.\n"
     "\n"
     "options:\n"
@@ -28,7 +31,9 @@ static const char* render_help =
     "      --fov DEG         vertical field of view (degrees, default 45)\n"
     "      --size WxH        image size in pixels (default 640x480)\n"
     "      --color-by WHAT   label | instance | stress | displacement (default label); stress\n"
-    "                        needs a simulation state, a plant at rest has zero displacement\n"
+    "                        needs a simulation run, a plant at rest has zero displacement\n"
+    "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the data's\n"
+    "                        (for a run: 0 to the largest value of the whole run)\n"
     "      --depth           also write OUT.depth.png (16-bit grey, millimetres along the optical\n"
     "                        axis, 0 = nothing) and OUT.json (intrinsics, pose)\n"
     "      --masks           also write OUT.label.png and OUT.instance.png (16-bit ids, 0 =\n"
@@ -37,7 +42,19 @@ static const char* render_help =
     "      --point-size M    splat half-size of cloud points (m, default 0.4% of the cloud)\n"
     "      --robot FILE.xml  draw a robot from its MJCF (with its own world) beside the plant\n"
     "      --no-floor, --no-shadows, --no-legend, --no-sky   leave those out\n"
-    "      --info            print the OpenGL context used on stderr\n";
+    "      --info            print the OpenGL context used on stderr\n"
+    "simulation runs (RUN/ holds rod.json, plant_initial.json, frames, colliders.jsonl):\n"
+    "  -o OUT.png            one frame: the one nearest --time T (s), default the last\n"
+    "  -o DIR/               every frame: DIR/frame_00000.png ... (and their depth, masks and\n"
+    "                        sidecars), DIR/frames.json (index: frame times and files)\n"
+    "      --time T          simulated time of the frame to draw (s), nearest frame\n"
+    "      --mp4 OUT.mp4     every frame as an H.264 video (needs Debian's ffmpeg; skipped\n"
+    "                        with a message when it is not installed)\n"
+    "      --fps N           frame rate of the video (default: the run's, from its frame times)\n"
+    "  Displacement is measured from the first frame; stress is the largest bending stress of\n"
+    "  each segment, 4 |M| / (pi r^3), from its curvature (grey where there is none: leaf\n"
+    "  blades, fruits). The camera and the colour scale stay fixed over the whole run, and\n"
+    "  probes and other colliders are drawn (label 65535 in the masks, as robots).\n";
 
 // three comma-separated numbers
 static int parse_vec(const char* s, vd_vec3* v) {
@@ -101,54 +118,49 @@ static void sibling(const char* out, const char* what, char* buf, size_t cap) {
   snprintf(buf, cap, "%.*s.%s", (int)n, out, what);
 }
 
-int cli_render(int argc, char** argv) {
-  cli_plant_opts po;
-  cli_plant_opts_init(&po);
-  const char* out = NULL;
-  const char* robot = NULL;
+// the file name of a path
+static const char* base_name(const char* path) {
+  const char* slash = strrchr(path, '/');
+  return slash ? slash + 1 : path;
+}
+
+// the whole command line, checked before any work
+static int parse_args(int argc, char** argv, cli_render_opts* o) {
   const char* camera_text = "orbit";
-  vd_vec3 eye, lookat, up = vd_v3(0, 0, 1);
-  int has_eye = 0, has_lookat = 0, depth = 0, masks = 0, info = 0;
-  double fov = 45, point_size = 0;
-  vd_render_def def = vd_render_def_default();
-  vd_render_style style = vd_render_style_default();
+  int has_lookat = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
-    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-      fputs(render_help, stdout);
-      fputs(cli_plant_help, stdout);
-      return EXIT_OK;
-    }
-    int r = cli_plant_opt(&po, "render", argc, argv, &i);
+    int r = cli_plant_opt(&o->po, "render", argc, argv, &i);
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     // options with a value
     const char* val = NULL;
     static const char* with_value[] = {"-o",         "--output",      "--camera",     "--eye",
                                        "--lookat",   "--up",          "--fov",        "--size",
-                                       "--color-by", "--supersample", "--point-size", "--robot"};
+                                       "--color-by", "--supersample", "--point-size", "--robot",
+                                       "--time",     "--mp4",         "--fps",        "--range"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
       if (!strcmp(a, with_value[k])) {
         if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
         val = argv[++i];
       }
     if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-      out = val;
+      o->out = val;
     } else if (!strcmp(a, "--camera")) {
       camera_text = val;
     } else if (!strcmp(a, "--eye")) {
-      if (!parse_vec(val, &eye))
+      if (!parse_vec(val, &o->eye))
         return cli_usage_error("render", "--eye expects X,Y,Z in metres, got '%s'", val);
-      has_eye = 1;
+      o->has_eye = 1;
     } else if (!strcmp(a, "--lookat")) {
-      if (!parse_vec(val, &lookat))
+      if (!parse_vec(val, &o->lookat))
         return cli_usage_error("render", "--lookat expects X,Y,Z in metres, got '%s'", val);
       has_lookat = 1;
     } else if (!strcmp(a, "--up")) {
-      if (!parse_vec(val, &up))
+      if (!parse_vec(val, &o->up))
         return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
     } else if (!strcmp(a, "--fov")) {
-      if (!parse_num(val, &fov) || fov <= 0 || fov >= 180)
+      if (!parse_num(val, &o->fov) || o->fov <= 0 || o->fov >= 180)
         return cli_usage_error("render", "--fov expects degrees in (0, 180), got '%s'", val);
     } else if (!strcmp(a, "--size")) {
       int w, h;
@@ -156,82 +168,175 @@ int cli_render(int argc, char** argv) {
       if (sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
         return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'",
                                val);
-      def.width = w, def.height = h;
+      o->def.width = w, o->def.height = h;
     } else if (!strcmp(a, "--color-by")) {
       if (!strcmp(val, "label"))
-        style.color_by = VD_COLOR_LABEL;
+        o->style.color_by = VD_COLOR_LABEL;
       else if (!strcmp(val, "instance"))
-        style.color_by = VD_COLOR_INSTANCE;
+        o->style.color_by = VD_COLOR_INSTANCE;
       else if (!strcmp(val, "stress"))
-        style.color_by = VD_COLOR_STRESS;
+        o->style.color_by = VD_COLOR_STRESS;
       else if (!strcmp(val, "displacement"))
-        style.color_by = VD_COLOR_DISPLACEMENT;
+        o->style.color_by = VD_COLOR_DISPLACEMENT;
       else
         return cli_usage_error(
             "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
+    } else if (!strcmp(a, "--range")) {
+      char* end;
+      errno = 0;
+      double lo = strtod(val, &end), hi = 0;
+      int ok = end != val && *end == ',' && !errno && isfinite(lo);
+      if (ok) ok = parse_num(end + 1, &hi) && hi > lo;
+      if (!ok)
+        return cli_usage_error("render",
+                               "--range expects MIN,MAX with MIN < MAX (Pa or m), got '%s'", val);
+      o->style.range_min = lo, o->style.range_max = hi;
     } else if (!strcmp(a, "--supersample")) {
       double k;
       if (!parse_num(val, &k) || k != floor(k) || k < 1 || k > 4)
         return cli_usage_error("render", "--supersample expects 1, 2, 3 or 4, got '%s'", val);
-      def.supersample = (int)k;
+      o->def.supersample = (int)k;
     } else if (!strcmp(a, "--point-size")) {
-      if (!parse_num(val, &point_size) || point_size <= 0)
+      if (!parse_num(val, &o->point_size) || o->point_size <= 0)
         return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'",
                                val);
     } else if (!strcmp(a, "--robot")) {
-      robot = val;
+      o->def.robot_mjcf = val;
+    } else if (!strcmp(a, "--time")) {
+      if (!parse_num(val, &o->time))
+        return cli_usage_error("render", "--time expects a time in seconds, got '%s'", val);
+      o->has_time = 1;
+    } else if (!strcmp(a, "--mp4")) {
+      if (!cli_has_ext(val, ".mp4"))
+        return cli_usage_error("render", "--mp4 '%s' must end in .mp4", val);
+      o->mp4 = val;
+    } else if (!strcmp(a, "--fps")) {
+      if (!parse_num(val, &o->fps) || o->fps <= 0 || o->fps > 1000)
+        return cli_usage_error("render", "--fps expects a frame rate in (0, 1000] (1/s), got '%s'",
+                               val);
     } else if (!strcmp(a, "--depth")) {
-      depth = 1;
+      o->depth = 1;
     } else if (!strcmp(a, "--masks")) {
-      masks = 1;
+      o->masks = 1;
     } else if (!strcmp(a, "--no-floor")) {
-      def.floor = 0;
+      o->def.floor = 0;
     } else if (!strcmp(a, "--no-shadows")) {
-      def.shadows = 0;
+      o->def.shadows = 0;
     } else if (!strcmp(a, "--no-legend")) {
-      def.legend = 0;
+      o->def.legend = 0;
     } else if (!strcmp(a, "--no-sky")) {
-      def.sky = 0;
+      o->def.sky = 0;
     } else if (!strcmp(a, "--info")) {
-      info = 1;
+      o->info = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error("render", "unknown option '%s'", a);
-    } else if (!po.path) {
-      po.path = a;
+    } else if (!o->po.path) {
+      o->po.path = a;
     } else {
       return cli_usage_error("render", "unexpected argument '%s'", a);
     }
   }
-  // check the whole command line before doing any work
-  if (!po.path)
-    return cli_usage_error("render", "missing PLANT or CLOUD (.lpy, plant .json, or a .ply/.pcd/.xyz/.csv/.las cloud)");
-  if (!out) return cli_usage_error("render", "missing -o OUT.png");
-  if (!cli_has_ext(out, ".png"))
-    return cli_usage_error("render", "output '%s' must end in .png", out);
-  vd_camera_kind kind = VD_CAMERA_FRONT;
-  double az = 0, el = 0;
-  if (!parse_camera(camera_text, &kind, &az, &el))
+  if (!parse_camera(camera_text, &o->kind, &o->az, &o->el))
     return cli_usage_error(
         "render", "--camera expects front, side, top or orbit[:AZ[:EL]] (degrees), got '%s'",
         camera_text);
-  if (has_eye != has_lookat) return cli_usage_error("render", "--eye and --lookat go together");
+  if (o->has_eye != has_lookat) return cli_usage_error("render", "--eye and --lookat go together");
+  return EXIT_OK;
+}
+
+vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi) {
+  vd_camera cam;
+  if (o->has_eye) {
+    cam.eye = o->eye, cam.lookat = o->lookat, cam.up = o->up;
+    cam.fovy = o->fov * VD_PI / 180;
+    double dist = vd_norm(vd_sub(o->lookat, o->eye));
+    cam.znear = fmax(1e-3, 0.01 * dist);
+    cam.zfar = 100 * dist + 60;
+    return cam;
+  }
+  cam = vd_camera_preset(o->kind, o->az * VD_PI / 180, o->el * VD_PI / 180, lo, hi, o->def.width,
+                         o->def.height);
+  if (o->fov != 45) {
+    // keep the fitted view, narrow or widen the lens: move along the axis to keep the framing
+    double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2),
+           f1 = tan(o->fov * VD_PI / 360);
+    vd_vec3 dir = vd_normalize(vd_sub(cam.eye, cam.lookat));
+    cam.eye = vd_madd(cam.lookat, dir, d * f0 / f1);
+    cam.fovy = o->fov * VD_PI / 180;
+    cam.zfar += d * f0 / f1;
+  }
+  return cam;
+}
+
+vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err) {
+  char p_depth[4200], p_label[4200], p_inst[4200], p_json[4200];
+  sibling(out, "depth.png", p_depth, sizeof p_depth);
+  sibling(out, "label.png", p_label, sizeof p_label);
+  sibling(out, "instance.png", p_inst, sizeof p_inst);
+  sibling(out, "json", p_json, sizeof p_json);
+  // colour, then depth and masks, then the sidecar naming them
+  vd_status st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
+  if (!st && depth) st = vd_render_write_png(f, VD_LAYER_DEPTH, p_depth, err);
+  if (!st && masks) st = vd_render_write_png(f, VD_LAYER_LABEL, p_label, err);
+  if (!st && masks) st = vd_render_write_png(f, VD_LAYER_INSTANCE, p_inst, err);
+  if (!st && (depth || masks)) {
+    // the sidecar names its siblings by file name, so the folder can move
+    const char* files[12];
+    int nf = 0;
+    files[nf++] = "color", files[nf++] = base_name(out);
+    if (depth) files[nf++] = "depth", files[nf++] = base_name(p_depth);
+    if (masks)
+      files[nf++] = "label", files[nf++] = base_name(p_label), files[nf++] = "instance",
+      files[nf++] = base_name(p_inst);
+    files[nf] = NULL;
+    st = vd_render_write_json(f, files, p_json, err);
+  }
+  return st;
+}
+
+int cli_render(int argc, char** argv) {
+  for (int i = 1; i < argc; i++)
+    if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+      fputs(render_help, stdout);
+      fputs(cli_plant_help, stdout);
+      return EXIT_OK;
+    }
+  cli_render_opts o;
+  memset(&o, 0, sizeof o);
+  cli_plant_opts_init(&o.po);
+  o.def = vd_render_def_default();
+  o.style = vd_render_style_default();
+  o.up = vd_v3(0, 0, 1);
+  o.fov = 45;
+  int rc = parse_args(argc, argv, &o);
+  if (rc) return rc;
+  if (!o.po.path)
+    return cli_usage_error(
+        "render", "missing PLANT, CLOUD or RUN/ (.lpy, plant .json, a .ply/.pcd/.xyz/.csv/.las "
+                  "cloud, or a folder of 'verdant sim -o')");
+  // a simulation run
   struct stat sb;
-  if (stat(po.path, &sb) == 0 && S_ISDIR(sb.st_mode))
+  if (stat(o.po.path, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_render_run(&o);
+  if (!o.out) return cli_usage_error("render", "missing -o OUT.png");
+  if (!cli_has_ext(o.out, ".png"))
+    return cli_usage_error("render", "output '%s' must end in .png", o.out);
+  if (o.has_time || o.mp4 || o.fps > 0)
     return cli_usage_error(
         "render",
-        "'%s' is a folder: rendering simulation runs waits for the run format of "
-        "'verdant sim' (not yet available)",
-        po.path);
+        "--time, --mp4 and --fps apply to simulation runs (a folder of 'verdant sim -o')");
   // point clouds in any format the cloud module reads; everything else is a plant
-  int is_cloud = cli_has_ext(po.path, ".ply") || cli_has_ext(po.path, ".pcd") || cli_has_ext(po.path, ".xyz") ||
-                 cli_has_ext(po.path, ".csv") || cli_has_ext(po.path, ".las");
+  int is_cloud = cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") ||
+                 cli_has_ext(o.po.path, ".xyz") || cli_has_ext(o.po.path, ".csv") ||
+                 cli_has_ext(o.po.path, ".las");
+  vd_render_style style = o.style;
   if (is_cloud && style.color_by != VD_COLOR_LABEL && style.color_by != VD_COLOR_INSTANCE)
     return cli_usage_error("render", "a point cloud is coloured by label or instance");
   if (!is_cloud && style.color_by == VD_COLOR_STRESS)
-    return cli_usage_error("render",
-                           "--color-by stress needs a simulation state (a run of 'verdant sim'); "
-                           "a plant at rest carries no stress");
-  def.robot_mjcf = robot;
+    return cli_usage_error(
+        "render",
+        "--color-by stress needs a simulation state (a run folder of 'verdant sim -o RUN/'); "
+        "a plant at rest carries no stress");
+  vd_render_def def = o.def;
   // load what is drawn
   vd_error err = {0};
   vd_status st;
@@ -244,10 +349,11 @@ int cli_render(int argc, char** argv) {
   vd_renderer* r = NULL;
   int code = EXIT_OK;
   if (is_cloud) {
-    st = vd_cloud_read(po.path, &cl, &err);
-    if (!st && cl.n > INT32_MAX) st = vd_error_set(&err, VD_ERR_LIMIT, po.path, 0, 0, "more than 2^31 points");
+    st = vd_cloud_read(o.po.path, &cl, &err);
+    if (!st && cl.n > INT32_MAX)
+      st = vd_error_set(&err, VD_ERR_LIMIT, o.po.path, 0, 0, "more than 2^31 points");
   } else {
-    st = cli_load_plant(&po, &plant, &ginfo, &err);
+    st = cli_load_plant(&o.po, &plant, &ginfo, &err);
     if (!st) st = vd_plant_compile(plant, &model, &err);
   }
   if (st) {
@@ -266,9 +372,9 @@ int cli_render(int argc, char** argv) {
     if (st == VD_ERR_UNSUPPORTED || st == VD_ERR_NOMEM) code = EXIT_FAIL;
     goto done;
   }
-  if (info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
+  if (o.info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
   if (is_cloud) {
-    vd_points pts = {(int)cl.n, cl.pos, cl.label, cl.instance, point_size, cl.labels, cl.nlabel};
+    vd_points pts = {(int)cl.n, cl.pos, cl.label, cl.instance, o.point_size, cl.labels, cl.nlabel};
     st = vd_render_add_points(r, &pts, &style, &err);
   } else {
     st = vd_render_add_plant(r, model, NULL, &style, &err);
@@ -277,56 +383,19 @@ int cli_render(int argc, char** argv) {
     code = cli_report("render", &err, st);
     goto done;
   }
-  // the camera
-  vd_camera cam;
-  if (has_eye) {
-    cam.eye = eye, cam.lookat = lookat, cam.up = up;
-    cam.fovy = fov * VD_PI / 180;
-    double dist = vd_norm(vd_sub(lookat, eye));
-    cam.znear = fmax(1e-3, 0.01 * dist);
-    cam.zfar = 100 * dist + 60;
-  } else {
-    vd_vec3 lo, hi;
-    vd_render_bounds(r, &lo, &hi);
-    cam = vd_camera_preset(kind, az * VD_PI / 180, el * VD_PI / 180, lo, hi, def.width, def.height);
-    if (fov != 45) {
-      // keep the fitted view, narrow or widen the lens: move along the axis to keep the framing
-      double d = vd_norm(vd_sub(cam.lookat, cam.eye)), f0 = tan(cam.fovy / 2),
-             f1 = tan(fov * VD_PI / 360);
-      vd_vec3 dir = vd_normalize(vd_sub(cam.eye, cam.lookat));
-      cam.eye = vd_madd(cam.lookat, dir, d * f0 / f1);
-      cam.fovy = fov * VD_PI / 180;
-      cam.zfar += d * f0 / f1;
-    }
-  }
-  unsigned layers = VD_LAYER_COLOR | (depth ? VD_LAYER_DEPTH : 0) |
-                    (masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
+  // the camera, the frame, the files
+  vd_vec3 lo, hi;
+  vd_render_bounds(r, &lo, &hi);
+  vd_camera cam = cli_render_camera(&o, lo, hi);
+  unsigned layers = VD_LAYER_COLOR | (o.depth ? VD_LAYER_DEPTH : 0) |
+                    (o.masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
   vd_frame f;
   st = vd_render_draw(r, &cam, layers, &f, &err);
   if (st) {
     code = cli_report("render", &err, st);
     goto done;
   }
-  // the files: colour, then depth and masks, then the sidecar naming them
-  char p_depth[4200], p_label[4200], p_inst[4200], p_json[4200];
-  sibling(out, "depth.png", p_depth, sizeof p_depth);
-  sibling(out, "label.png", p_label, sizeof p_label);
-  sibling(out, "instance.png", p_inst, sizeof p_inst);
-  sibling(out, "json", p_json, sizeof p_json);
-  st = vd_render_write_png(&f, VD_LAYER_COLOR, out, &err);
-  if (!st && depth) st = vd_render_write_png(&f, VD_LAYER_DEPTH, p_depth, &err);
-  if (!st && masks) st = vd_render_write_png(&f, VD_LAYER_LABEL, p_label, &err);
-  if (!st && masks) st = vd_render_write_png(&f, VD_LAYER_INSTANCE, p_inst, &err);
-  if (!st && (depth || masks)) {
-    const char* files[12];
-    int nf = 0;
-    files[nf++] = "color", files[nf++] = out;
-    if (depth) files[nf++] = "depth", files[nf++] = p_depth;
-    if (masks)
-      files[nf++] = "label", files[nf++] = p_label, files[nf++] = "instance", files[nf++] = p_inst;
-    files[nf] = NULL;
-    st = vd_render_write_json(&f, files, p_json, &err);
-  }
+  st = cli_frame_write(&f, o.out, o.depth, o.masks, &err);
   if (st)
     code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL)
                            : cli_report("render", &err, st);

@@ -19,8 +19,9 @@ static const char* sim_help =
     "write frames, fracture events and the final plant to DIR; --stats prints a JSON summary.\n"
     "\n"
     "run:\n"
-    "  -o, --output DIR        write DIR/frames.bin (or .jsonl), DIR/rod.json, DIR/events.csv,\n"
-    "                          DIR/plant.json (the final plant)\n"
+    "  -o, --output DIR        write DIR/frames.bin (or .jsonl), DIR/colliders.jsonl,\n"
+    "                          DIR/rod.json, DIR/plant_initial.json, DIR/events.csv,\n"
+    "                          DIR/plant.json (the final plant); 'verdant render DIR' draws it\n"
     "      --duration T        simulated time (s); default 1, or 0 after --settle/--statics\n"
     "      --dt H              time step (s), default 0.001\n"
     "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 1\n"
@@ -258,8 +259,8 @@ static vd_status read_wind(const char* path, double** rows, int* n, vd_error* er
 // outputs
 
 typedef struct outputs {
-  vd_outfile frames;
-  int frames_open, jsonl;
+  vd_outfile frames, colliders;
+  int frames_open, colliders_open, jsonl;
   float* fbuf;
   size_t fbuf_n;
   unsigned char* bbuf;
@@ -288,6 +289,10 @@ static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir
   if (st) return st;
   o->frames_open = 1;
   o->jsonl = jsonl;
+  // the colliders' poses at the same instants (for pictures of the run)
+  snprintf(path, sizeof path, "%s/colliders.jsonl", dir);
+  if ((st = vd_outfile_open(&o->colliders, path, err))) return st;
+  o->colliders_open = 1;
   if (!jsonl) {
     // header: magic, version, node count, segment count, reserved (little-endian)
     unsigned char h[24];
@@ -306,6 +311,7 @@ static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir
 
 static void frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d) {
   FILE* f = o->frames.fp;
+  cli_colliders_write(o->colliders.fp, d);
   if (o->jsonl) {
     fprintf(f, "{\"t\":%.9g,\"pos\":[", d->time);
     for (int i = 0; i < m->nnode_all; i++)
@@ -335,7 +341,8 @@ static void frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d
 }
 
 // the rod topology that frames refer to
-static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, const char* dir, vd_error* err) {
+static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, const vd_sim_def* def, const char* dir,
+                                vd_error* err) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   cJSON_AddStringToObject(root, "format", "verdant-rod");
@@ -362,6 +369,9 @@ static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, co
     snprintf(id, sizeof id, "%d", plant->labels[k].id);
     cJSON_AddStringToObject(labels, id, plant->labels[k].name);
   }
+  // what rebuilds this rod model: the initial plant and the build settings
+  cJSON_AddStringToObject(root, "initial_plant", "plant_initial.json");
+  cJSON_AddItemToObject(root, "build", cli_sim_def_json(def));
   char* text = cJSON_PrintUnformatted(root);
   cJSON_Delete(root);
   if (!text) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
@@ -678,7 +688,12 @@ int cli_sim(int argc, char** argv) {
   if (o.out) {
     if (mkdir(o.out, 0777) && errno != EEXIST)
       st = vd_error_set(&err, VD_ERR_IO, o.out, 0, 0, "cannot create the output folder: %s", strerror(errno));
-    if (!st) st = write_rod_json(m, plant, o.out, &err);
+    if (!st) st = write_rod_json(m, plant, &o.def, o.out, &err);
+    if (!st) {
+      char path[4096];
+      snprintf(path, sizeof path, "%s/plant_initial.json", o.out);
+      st = vd_plant_write_json(spec, path, &err);
+    }
     if (!st && strcmp(o.frames, "none")) st = frames_begin(&out, m, o.out, !strcmp(o.frames, "jsonl"), &err);
     if (st) {
       cli_report("sim", &err, st);
@@ -739,6 +754,11 @@ int cli_sim(int argc, char** argv) {
       st = vd_outfile_commit(&out.frames, &err);
       out.frames_open = 0;
     }
+    if (out.colliders_open) {
+      vd_status s2 = vd_outfile_commit(&out.colliders, st ? NULL : &err);
+      st = st ? st : s2;
+      out.colliders_open = 0;
+    }
     if (!st && o.out) st = write_events(d, plant, o.out, &err);
     if (!st && (o.out || o.final)) {
       vd_sim_to_spec(m, d, spec);
@@ -758,6 +778,7 @@ int cli_sim(int argc, char** argv) {
   }
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);
+  if (out.colliders_open) vd_outfile_abort(&out.colliders);
   vd_free(out.bbuf, out.fbuf_n);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);

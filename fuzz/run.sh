@@ -10,7 +10,7 @@ set -u
 cd "$(dirname "$0")/.."
 SECONDS_PER=${1:-30}
 shift || true
-TARGETS=${*:-"fuzz_lsys fuzz_plant_json fuzz_expr fuzz_cloud fuzz_curves"}
+TARGETS=${*:-"fuzz_lsys fuzz_plant_json fuzz_expr fuzz_cloud fuzz_curves fuzz_frames"}
 CC=${FUZZ_CC:-clang}
 OUT=build-fuzz
 SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
@@ -21,7 +21,7 @@ LIBS="$(pkg-config --libs libcjson) -lm"
 mkdir -p "$OUT/obj"
 newest_h=$(ls -t include/verdant/*.h src/*/*.h fuzz/*.h | head -1)
 objs=()
-for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/cloud/*.c; do
+for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/cloud/*.c src/sim/*.c; do
   obj="$OUT/obj/$(basename "${src%.c}").o"
   objs+=("$obj")
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$newest_h" -nt "$obj" ]; then
@@ -38,7 +38,9 @@ for t in $TARGETS; do
   log="$OUT/$t.log"
   touch "$OUT/$t.stamp"
   # the first crash, leak or timeout stops the run; its input is saved in findings/<target>/
-  dict=lsys.dict; [ "$t" = fuzz_plant_json ] && dict=plant_json.dict; [ "$t" = fuzz_cloud ] && dict=cloud.dict; [ "$t" = fuzz_curves ] && dict=curves.dict
+  dict=lsys.dict; [ "$t" = fuzz_plant_json ] && dict=plant_json.dict; [ "$t" = fuzz_cloud ] && dict=cloud.dict
+  [ "$t" = fuzz_curves ] && dict=curves.dict
+  [ "$t" = fuzz_frames ] && dict=frames.dict
   "$bin" -max_len=4096 -timeout=5 -rss_limit_mb=2048 -max_total_time="$SECONDS_PER" \
     -dict="fuzz/$dict" -print_final_stats=1 -artifact_prefix="$OUT/findings/$t/" \
     "$OUT/corpus/$t" "fuzz/corpus/$t" >"$log" 2>&1

@@ -51,8 +51,17 @@ print(f"   settling: {s['segments']} rod segments, {s['total_mass']:.3f} kg, sti
 print(f"   probe: pushed the plant up to {100 * p['max_displacement']:.1f} cm, {p['nevents']} fractures, "
       f"penetration {p['max_penetration']:.1e} m, {p['steps_per_second']:.0f} steps/s")
 PY
+echo "== pictures of the run: the push at t = 1 s, coloured by displacement (docs/img/tomato-probe.png)"
+"$V" render out/tomato-run -o out/tomato-probe.png --time 1.0 --camera front --color-by displacement
+if command -v ffmpeg >/dev/null 2>&1; then
+  "$V" render out/tomato-run --mp4 out/tomato-probe.mp4 --camera front --color-by displacement --no-progress
+  echo "   out/tomato-probe.png, out/tomato-probe.mp4 (every frame)"
+else
+  echo "   out/tomato-probe.png (install Debian's ffmpeg for a video: verdant render out/tomato-run --mp4 x.mp4)"
+fi
 echo "== results in out/: tomato.obj (+ .mtl, one group and material per label), tomato.ply,"
 echo "   tomato.json (plant file), *-stats.json, pictures; open the OBJ in any mesh viewer;"
 echo "   tomato-cloud.ply (labelled points: label, instance), tomato-scan.ply (8 scans, view and"
 echo "   range per point): open them in CloudCompare, Open3D or MeshLab;"
-echo "   tomato-run/ (frames, events, final plant) and tomato-pushed.obj from the simulation"
+echo "   tomato-run/ (frames, events, final plant) and tomato-pushed.obj from the simulation,"
+echo "   tomato-probe.png (a frame of it)"

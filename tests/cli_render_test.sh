@@ -36,7 +36,8 @@ expect "render stress without a run" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T
 expect_err "stress message" "simulation"
 expect "render eye without lookat" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --eye 0,-2,1
 expect "render bad eye" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --eye 0,-2 --lookat 0,0,1
-expect "render run folder (not yet)" 2 "$V" render "$T" -o "$T/x.png"
+expect "render a folder that is not a run" 2 "$V" render "$T" -o "$T/x.png"
+expect_err "not a run: rod.json named" "rod.json"
 expect "render missing plant" 2 "$V" render "$T/missing.lpy" -o "$T/x.png"
 expect_err "missing plant named" "missing.lpy"
 printf 'Axiom: A\nproduction:\nA --> B(1 +)\n' >"$T/bad.lpy"

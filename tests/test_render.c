@@ -392,7 +392,13 @@ TEST(render, colour_modes_and_legend) {
   CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
   CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
   CHECK_NEAR(f.range_max, 1e5 * (m->nseg - 1), 1e-6);
+  // NaN is "no value" (grey, left out of the range); infinity is refused
   stress[3] = NAN;
+  vd_render_clear(r);
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK_NEAR(f.range_max, 1e5 * (m->nseg - 1), 1e-6);
+  stress[3] = INFINITY;
   vd_render_clear(r);
   CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_ERR_VALUE, err);
   free(stress);
@@ -611,4 +617,193 @@ TEST(render, out_of_memory) {
   CHECK(done);
   vd_render_destroy(r);
   vd_model_destroy(m);
+}
+
+// ---------------------------------------------------------------------------------------------
+// solids, displacement from a reference state, a simulation state
+
+TEST(render, shapes) {
+  vd_render_def d = small_def(200, 150);
+  d.floor = 0;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_error err = {0};
+  // a sphere of 10 cm, 2 m in front of the camera: robot label, instance 0, its disc's area
+  vd_render_shape s = {
+      VD_RENDER_SPHERE, {0.1, 0, 0}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0.5f, 0.6f, 0.7f}};
+  CHECK_STATUS(vd_render_add_shape(r, &s, &err), VD_OK, err);
+  vd_camera c = cam_y(vd_v3(0, -2, 0.5), 40);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_ALL, &f, &err), VD_OK, err);
+  double u, v, z;
+  REQUIRE(vd_camera_project(&f.K, s.pos, &u, &v, &z));
+  int cu = (int)lround(u), cv = (int)lround(v);
+  CHECK_INT(f.label[cv * f.width + cu], VD_RENDER_ROBOT_LABEL);
+  CHECK_INT(f.instance[cv * f.width + cu], 0);
+  CHECK_NEAR(f.depth[cv * f.width + cu], 2 - 0.1, 2e-3);
+  int area = 0;
+  for (int i = 0; i < f.width * f.height; i++)
+    area += f.label[i] == VD_RENDER_ROBOT_LABEL;
+  // the silhouette of a sphere seen from distance D: radius f r / sqrt(D^2 - r^2) pixels
+  double rad = f.K.fy * 0.1 / sqrt(4 - 0.01), disc = VD_PI * rad * rad;
+  CHECK(fabs(area - disc) < 0.05 * disc);
+  // a capsule along x and a box: both drawn, both in the bounds
+  vd_render_clear(r);
+  vd_render_shape cap = {VD_RENDER_CAPSULE,
+                         {0.05, 0.3, 0},
+                         vd_v3(0, 0, 0.5),
+                         vd_quat_axis_angle(vd_v3(0, 1, 0), VD_PI / 2),
+                         {1, 0, 0}};
+  CHECK_STATUS(vd_render_add_shape(r, &cap, &err), VD_OK, err);
+  vd_vec3 lo, hi;
+  CHECK(vd_render_bounds(r, &lo, &hi));
+  CHECK_NEAR(hi.x, 0.35, 1e-3);
+  CHECK_NEAR(lo.x, -0.35, 1e-3);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_LABEL, &f, &err), VD_OK, err);
+  REQUIRE(vd_camera_project(&f.K, vd_v3(0.3, 0, 0.5), &u, &v, &z));
+  CHECK_INT(f.label[(int)lround(v) * f.width + (int)lround(u)], VD_RENDER_ROBOT_LABEL);
+  REQUIRE(vd_camera_project(&f.K, vd_v3(0, 0, 0.62), &u, &v, &z));
+  CHECK_INT(f.label[(int)lround(v) * f.width + (int)lround(u)], 0); // above the capsule
+  vd_render_clear(r);
+  vd_render_shape box = {
+      VD_RENDER_BOX, {0.1, 0.1, 0.2}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0, 1, 0}};
+  CHECK_STATUS(vd_render_add_shape(r, &box, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_LABEL | VD_LAYER_DEPTH, &f, &err), VD_OK, err);
+  // the box's front face (y = -0.1) fills a 0.2 x 0.4 m rectangle 1.9 m away
+  area = 0;
+  for (int i = 0; i < f.width * f.height; i++)
+    area += f.label[i] == VD_RENDER_ROBOT_LABEL;
+  double face = (f.K.fx * 0.2 / 1.9) * (f.K.fy * 0.4 / 1.9);
+  CHECK(fabs(area - face) < 0.05 * face);
+  REQUIRE(vd_camera_project(&f.K, box.pos, &u, &v, &z));
+  CHECK_NEAR(f.depth[(int)lround(v) * f.width + (int)lround(u)], 1.9, 2e-3);
+  // bad sizes and poses
+  vd_render_shape bad = s;
+  bad.size[0] = 0;
+  CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_VALUE, err);
+  bad = s, bad.pos.x = NAN;
+  CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_VALUE, err);
+  bad = cap, bad.size[1] = -1;
+  CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_VALUE, err);
+  bad = s, bad.kind = (vd_render_shape_kind)9;
+  CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_ARG, err);
+  vd_render_destroy(r);
+}
+
+TEST(render, displacement_from_reference) {
+  vd_render_def d = small_def(120, 90);
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_model* m = tomato(1);
+  REQUIRE(m);
+  vd_data* st = vd_data_create(m);
+  vd_data* ref = vd_data_create(m);
+  REQUIRE(st && ref);
+  // the state and the reference both moved 3 cm: no displacement between them; 3 cm from rest
+  for (int i = 0; i < 3 * m->nnode; i += 3)
+    st->node_pos[i] += 0.03, ref->node_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nsphere; i += 3)
+    st->sphere_pos[i] += 0.03, ref->sphere_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nvert; i += 3)
+    st->vert_pos[i] += 0.03, ref->vert_pos[i] += 0.03;
+  vd_render_style s = vd_render_style_default();
+  s.color_by = VD_COLOR_DISPLACEMENT;
+  s.ref = ref;
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
+  vd_vec3 lo, hi;
+  vd_render_bounds(r, &lo, &hi);
+  vd_camera c = vd_camera_preset(VD_CAMERA_FRONT, 0, 0, lo, hi, 120, 90);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK_NEAR(f.range_max, 0, 1e-12);
+  // against the rest shape: 3 cm; the plant drawn at rest against the reference: 3 cm too
+  vd_render_clear(r);
+  s.ref = NULL;
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK_NEAR(f.range_max, 0.03, 1e-9);
+  vd_render_clear(r);
+  s.ref = ref;
+  CHECK_STATUS(vd_render_add_plant(r, m, NULL, &s, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK_NEAR(f.range_min, 0.03, 1e-9);
+  // a reference of another model is refused
+  vd_model* q = quad_plant((vd_vec3[4]){{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}, 2, 1);
+  vd_data* qd = q ? vd_data_create(q) : NULL;
+  REQUIRE(qd);
+  s.ref = qd;
+  CHECK_STATUS(vd_render_add_plant(r, m, st, &s, &err), VD_ERR_ARG, err);
+  vd_data_destroy(qd);
+  vd_model_destroy(q);
+  vd_data_destroy(st);
+  vd_data_destroy(ref);
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}
+
+TEST(render, masks_follow_the_simulated_state) {
+  // a stem with a fruit pushed sideways by a growing force (statics): in every state drawn, the
+  // pixel of the fruit's centre carries the fruit's label and instance, and the fruit moves
+  vd_render_def d = small_def(240, 180);
+  d.floor = 0;
+  vd_renderer* r = renderer(&d);
+  if (!r) return;
+  vd_plant_spec* sp = vd_plant_spec_create();
+  REQUIRE(sp);
+  int a = vd_plant_add_node(sp, vd_v3(0, 0, -0.01)), b = vd_plant_add_node(sp, vd_v3(0, 0, 0));
+  int c = vd_plant_add_node(sp, vd_v3(0, 0, 0.3));
+  vd_segment_spec g = vd_segment_spec_default();
+  g.node0 = a, g.node1 = b, g.r0 = g.r1 = 0.002, g.label = 1, g.instance = 1;
+  int s0 = vd_plant_add_segment(sp, &g);
+  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
+  int s1 = vd_plant_add_segment(sp, &g);
+  vd_sphere_spec fr = vd_sphere_spec_default();
+  fr.center = vd_v3(0, 0, 0.32), fr.radius = 0.02, fr.parent = s1, fr.node = c, fr.label = 5,
+  fr.instance = 3;
+  vd_plant_add_sphere(sp, &fr);
+  vd_plant_set_label(sp, 1, "stem");
+  vd_plant_set_label(sp, 5, "fruit");
+  vd_model* pm = NULL;
+  vd_error err = {0};
+  CHECK_STATUS(vd_plant_compile(sp, &pm, &err), VD_OK, err);
+  vd_plant_spec_destroy(sp);
+  REQUIRE(pm);
+  vd_sim_def def = vd_sim_def_default();
+  def.segment_length = 0.03;
+  vd_sim_model* sm = NULL;
+  CHECK_STATUS(vd_sim_build(pm, &def, &sm, &err), VD_OK, err);
+  REQUIRE(sm);
+  sm->opt.gravity = vd_v3(0, 0, 0);
+  vd_sim_data* sd = vd_sim_data_create(sm);
+  vd_data* pd = vd_data_create(pm);
+  REQUIRE(sd && pd);
+  int fruit = vd_sim_find_organ(sm, pm, "fruit", 0);
+  REQUIRE(fruit >= 0);
+  vd_camera cam = cam_y(vd_v3(0, -1.2, 0.2), 40);
+  double u0 = 0;
+  for (int k = 0; k < 4; k++) {
+    vd_sim_to_plant(sm, sd, pm, pd);
+    vd_render_clear(r);
+    CHECK_STATUS(vd_render_add_plant(r, pm, pd, NULL, &err), VD_OK, err);
+    vd_frame f;
+    CHECK_STATUS(vd_render_draw(r, &cam, VD_LAYER_LABEL | VD_LAYER_INSTANCE, &f, &err), VD_OK, err);
+    double u, v, z;
+    vd_vec3 p = vd_v3(pd->sphere_pos[0], pd->sphere_pos[1], pd->sphere_pos[2]);
+    REQUIRE(vd_camera_project(&f.K, p, &u, &v, &z));
+    int px = (int)lround(v) * f.width + (int)lround(u);
+    CHECK_INT(f.label[px], 5);
+    CHECK_INT(f.instance[px], 3);
+    if (k == 0) u0 = u;
+    if (k == 3) CHECK(u - u0 > 20); // pushed along +x: 20 pixels or more to the right
+    sd->node_force[fruit] = vd_v3(0.07 * (k + 1), 0, 0);
+    vd_sim_settle_def sdef = vd_sim_settle_def_default();
+    sdef.statics = 1;
+    vd_sim_settle(sm, sd, &sdef, NULL, NULL);
+  }
+  vd_data_destroy(pd);
+  vd_sim_data_destroy(sd);
+  vd_sim_model_destroy(sm);
+  vd_model_destroy(pm);
+  vd_render_destroy(r);
 }

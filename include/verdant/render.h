@@ -11,8 +11,8 @@
 // and, when asked, a second exact pass without lighting or anti-aliasing that gives per pixel the
 // depth (m, along the optical axis) and the label and instance of the front surface. Images are
 // owned by the renderer and stay valid until its next draw. No global state except the MuJoCo
-// error hook (installed once; errors come back as a status on the calling thread). One renderer
-// per thread.
+// error hook (installed once; errors come back as a status on the calling thread). A renderer is
+// used by one thread at a time: vd_render_release hands it from one thread to the next.
 //
 // Pixels: row 0 is the top row; camera intrinsics follow OpenCV (u right, v down, pixel centres
 // at integers): u = fx X/Z + cx, v = fy Y/Z + cy in the camera frame (X right, Y down, Z forward).
@@ -37,7 +37,7 @@ extern "C" {
 #endif
 
 #define VD_RENDER_FORMAT_VERSION 1  // version of the image sidecar JSON (docs/formats.md)
-#define VD_RENDER_ROBOT_LABEL 65535 // label id of robot pixels in the label mask
+#define VD_RENDER_ROBOT_LABEL 65535 // label id of robot and collider pixels in masks
 
 // ---------------------------------------------------------------------------------------------
 // cameras
@@ -119,6 +119,9 @@ typedef struct vd_renderer vd_renderer;
 vd_status vd_render_create(const vd_render_def* def, vd_renderer** out, vd_error* err);
 // Release the renderer, its context and images (NULL is fine).
 void vd_render_destroy(vd_renderer* r);
+// Let go of the renderer's OpenGL context on this thread, so that another thread may use the
+// renderer next (a pool of renderers shared by worker threads, one thread at a time).
+void vd_render_release(vd_renderer* r);
 // Text describing the OpenGL context ("EGL 1.5 surfaceless, Mesa llvmpipe ..."), for logs.
 const char* vd_render_info(const vd_renderer* r);
 // Set the robot's joint positions (MuJoCo qpos, nq values) for the next frames.
@@ -138,13 +141,17 @@ typedef enum vd_color_by {
 // Look of one plant or cloud.
 typedef struct vd_render_style {
   vd_color_by color_by;     // default VD_COLOR_LABEL
-  const double* seg_stress; // Nullable: stress per segment (Pa) (nseg), needed by VD_COLOR_STRESS
+  const double* seg_stress; // Nullable: stress per segment (Pa) (nseg), needed by VD_COLOR_STRESS;
+                            // NaN: no value (drawn grey), infinite: refused
   double range_min;         // colour scale minimum (Pa or m); with range_max <= range_min the
   double range_max;         // scale spans the data; default 0, 0
   int slices;               // tessellation sides (>= 3), or 0 for each primitive's own; default 0
+  const vd_data* ref;       // Nullable: state displacement is measured from (a run's first
+                            // frame); NULL: the model's rest shape; default NULL
 } vd_render_style;
 
-// Defaults: colour by label, no stress, automatic range, slices 0.
+// Defaults: colour by label, no stress, automatic range, slices 0, displacement from the rest
+// shape (ref NULL).
 vd_render_style vd_render_style_default(void);
 
 // Remove every plant and cloud added since the last clear.
@@ -167,6 +174,25 @@ typedef struct vd_points {
 // Add a point cloud coloured by label or instance (style Nullable: by label).
 vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_render_style* s,
                                vd_error* err);
+// Shapes of solids drawn beside plants and clouds (the colliders of a simulation run).
+typedef enum vd_render_shape_kind {
+  VD_RENDER_SPHERE = 0, // sphere of radius size[0]
+  VD_RENDER_CAPSULE,    // capsule of radius size[0] and half-length size[1] along its z axis
+  VD_RENDER_BOX,        // box of half-extents size[0..2] along its axes
+} vd_render_shape_kind;
+
+// A solid: a probe, a tool, an obstacle.
+typedef struct vd_render_shape {
+  vd_render_shape_kind kind; // shape
+  double size[3];     // sizes (m), see vd_render_shape_kind
+  vd_vec3 pos;        // centre (m)
+  vd_quat quat;       // orientation (normalised here)
+  float rgb[3];       // colour in [0, 1]
+} vd_render_shape;
+
+// Add a solid; its pixels carry label VD_RENDER_ROBOT_LABEL and instance 0 in the masks, like a
+// robot's. VD_ERR_VALUE for sizes that are not finite and > 0 (a capsule's half-length >= 0).
+vd_status vd_render_add_shape(vd_renderer* r, const vd_render_shape* s, vd_error* err);
 // Bounds of everything added and of the robot's geoms (m); with the floor on, of what is above
 // it (z >= 0) when anything is. Returns 0 when there is nothing.
 int vd_render_bounds(const vd_renderer* r, vd_vec3* lo, vd_vec3* hi);

@@ -321,6 +321,46 @@ void vd_sim_to_plant(const vd_sim_model* m, const vd_sim_data* d, const vd_model
 void vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec);
 
 // ---------------------------------------------------------------------------------------------
+// stress from a state (geometry only: works on any state, frames read back included)
+
+// Elastic moment of each segment's joint with its parent from the change of curvature and twist,
+// M = C_b / (compliance l-bar) (N m), in the parent's material frame: bending about d1 and d2,
+// twisting about d3 (nseg x 3); 0 for broken joints and segments without a parent.
+void vd_sim_joint_moment(const vd_sim_model* m, const vd_sim_data* d, double* out);
+// Largest bending stress of each rod segment (Pa): 4 |M_bend| / (pi r^3) of the joints at its
+// two ends, with its parent and with its children (nseg).
+void vd_sim_seg_stress(const vd_sim_model* m, const vd_sim_data* d, double* out);
+// The same per plant segment: the largest over the rod segments that resample it, NaN where no
+// rod segment does; plant must be the model m was built from (plant->nseg).
+void vd_sim_plant_stress(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant,
+                         double* out);
+
+// ---------------------------------------------------------------------------------------------
+// reading the frames `verdant sim -o DIR` writes (frames.bin, frames.jsonl; docs/formats.md)
+
+// An open frames file.
+typedef struct vd_sim_frames vd_sim_frames;
+
+// Open a frames file and index it: sizes checked against the file, times finite and never
+// decreasing; errors name the file and the byte offset (binary) or the line (JSON Lines).
+vd_status vd_sim_frames_open(const char* path, vd_sim_frames** out, vd_error* err);
+// Close a frames file (NULL is fine).
+void vd_sim_frames_close(vd_sim_frames* f);
+// Number of frames.
+int vd_sim_frames_count(const vd_sim_frames* f);
+// Node count (spares included) and segment count of every frame.
+void vd_sim_frames_size(const vd_sim_frames* f, int* nnode_all, int* nseg);
+// Time of frame k (s).
+double vd_sim_frames_time(const vd_sim_frames* f, int k);
+// Frame nearest to time t (s), the earlier one on a tie; -1 when there are no frames.
+int vd_sim_frames_nearest(const vd_sim_frames* f, double t);
+// Put frame k into state d of rod model m: time, node positions, segment frames and broken
+// joints (whose spare nodes take their share of mass, as in a fracture); velocities, multipliers
+// and events cleared. VD_ERR_FORMAT when the frame does not fit m or holds non-finite numbers.
+vd_status vd_sim_frames_load(vd_sim_frames* f, int k, const vd_sim_model* m, vd_sim_data* d,
+                             vd_error* err);
+
+// ---------------------------------------------------------------------------------------------
 // validation against analytic references (docs/validation.md)
 
 // One checked quantity.

@@ -214,6 +214,10 @@ vd_status vd_render_create(const vd_render_def* def, vd_renderer** out, vd_error
   return VD_OK;
 }
 
+void vd_render_release(vd_renderer* r) {
+  if (r && r->have_gl && r->gl.ctx) gl_release(&r->gl);
+}
+
 void vd_render_destroy(vd_renderer* r) {
   if (!r) return;
   vd_error ignore;

@@ -155,7 +155,7 @@ static void draw_legend(vd_renderer* r, int w, int h, int k) {
   } else if (r->color_by == VD_COLOR_INSTANCE) {
     int n = 0;
     for (int i = 0; i < r->nitem; i++)
-      n += r->items[i].kind >= ITEM_PLANT;
+      n += r->items[i].kind == ITEM_PLANT || r->items[i].kind == ITEM_POINTS;
     snprintf(title, sizeof title, "colour: organ instance (%d)", n);
     rows = 1;
     width = text_width(con, title);

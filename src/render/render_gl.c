@@ -224,6 +224,10 @@ vd_status gl_current(gl_ctx* g, vd_error* err) {
   return VD_OK;
 }
 
+void gl_release(gl_ctx* g) {
+  if (g->api && g->dpy) g->api->MakeCurrent(g->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+}
+
 void gl_destroy(gl_ctx* g) {
   gl_api* a = g->api;
   if (a && g->dpy) {

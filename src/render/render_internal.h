@@ -26,6 +26,8 @@ typedef struct gl_ctx {
 vd_status gl_create(gl_ctx* g, vd_error* err);
 // Make the context current on this thread.
 vd_status gl_current(gl_ctx* g, vd_error* err);
+// Make no context current on this thread (another thread may take this one next).
+void gl_release(gl_ctx* g);
 // Release the context and the library.
 void gl_destroy(gl_ctx* g);
 
@@ -58,9 +60,9 @@ const char* mjguard_message(void);
 // the renderer
 
 // item kinds
-enum { ITEM_BACKGROUND = 0, ITEM_ROBOT = 1, ITEM_PLANT = 2, ITEM_POINTS = 3 };
+enum { ITEM_BACKGROUND = 0, ITEM_ROBOT = 1, ITEM_PLANT = 2, ITEM_POINTS = 3, ITEM_SHAPE = 4 };
 
-// One scene geom we add: a (label, instance) group of a plant or cloud.
+// One scene geom we add: a (label, instance) group of a plant or cloud, or a solid.
 typedef struct item {
   int kind;            // ITEM_*
   int label, instance; // ids written to the masks

@@ -185,23 +185,28 @@ static double moved(const double* now, const double* rest) {
   return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-// value of each primitive for colour by stress or displacement (NaN: no value)
+// value of each primitive for colour by stress or displacement (NaN: no value); displacement is
+// from the style's reference state, or from the rest shape
 static void prim_values(const vd_model* m, const vd_data* d, const vd_render_style* s, double* seg,
                         double* sph, double* msh) {
+  const vd_data* ref = s->ref;
+  const double* node0 = ref ? ref->node_pos : m->node_pos0;
+  const double* sph0 = ref ? ref->sphere_pos : m->sphere_pos0;
+  const double* vert0 = ref ? ref->vert_pos : m->vert_pos0;
+  // without a state the plant is drawn at rest: displacement 0 unless a reference says otherwise
+  const double* node = d ? d->node_pos : m->node_pos0;
+  const double* sphp = d ? d->sphere_pos : m->sphere_pos0;
+  const double* vert = d ? d->vert_pos : m->vert_pos0;
   for (int i = 0; i < m->nseg; i++) {
     if (s->color_by == VD_COLOR_STRESS) {
       seg[i] = s->seg_stress[i];
     } else {
       int a = m->seg_node[2 * i], b = m->seg_node[2 * i + 1];
-      seg[i] = d ? 0.5 * (moved(d->node_pos + 3 * a, m->node_pos0 + 3 * a) +
-                          moved(d->node_pos + 3 * b, m->node_pos0 + 3 * b))
-                 : 0;
+      seg[i] = 0.5 * (moved(node + 3 * a, node0 + 3 * a) + moved(node + 3 * b, node0 + 3 * b));
     }
   }
   for (int i = 0; i < m->nsphere; i++)
-    sph[i] = s->color_by == VD_COLOR_STRESS ? NAN
-             : d                            ? moved(d->sphere_pos + 3 * i, m->sphere_pos0 + 3 * i)
-                                            : 0;
+    sph[i] = s->color_by == VD_COLOR_STRESS ? NAN : moved(sphp + 3 * i, sph0 + 3 * i);
   for (int i = 0; i < m->nmesh; i++) {
     if (s->color_by == VD_COLOR_STRESS) {
       msh[i] = NAN;
@@ -209,8 +214,8 @@ static void prim_values(const vd_model* m, const vd_data* d, const vd_render_sty
     }
     double sum = 0;
     int v0 = m->mesh_vert[2 * i], nv = m->mesh_vert[2 * i + 1];
-    for (int v = v0; d && v < v0 + nv; v++)
-      sum += moved(d->vert_pos + 3 * v, m->vert_pos0 + 3 * v);
+    for (int v = v0; v < v0 + nv; v++)
+      sum += moved(vert + 3 * v, vert0 + 3 * v);
     msh[i] = nv ? sum / nv : 0;
   }
 }
@@ -244,10 +249,14 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
             d->nvert != m->nvert))
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
                         "the state does not belong to this model (sizes differ)");
+  if (s.ref && (s.ref->nnode != m->nnode || s.ref->nseg != m->nseg ||
+                s.ref->nsphere != m->nsphere || s.ref->nvert != m->nvert))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "the reference state does not belong to this model (sizes differ)");
   if (s.color_by == VD_COLOR_STRESS)
     for (int i = 0; i < m->nseg; i++)
-      if (!isfinite(s.seg_stress[i]))
-        return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "stress of segment %d is not finite", i);
+      if (isinf(s.seg_stress[i]))
+        return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "stress of segment %d is infinite", i);
   if ((st = gl_current(&r->gl, err))) return st;
   // the plant as labelled triangles
   vd_mesh mesh;
@@ -363,6 +372,128 @@ done:
   vd_free(buf, nt ? sizeof(float) * 2 * nt * 27 : 1);
   vd_mesh_free(&mesh);
   return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// solids (probes, colliders)
+
+// resolution of shapes: sides around, rings from pole to pole (even: capsules split at the
+// equator)
+#define SHAPE_SIDES 32
+#define SHAPE_RINGS 16
+
+// unit-sphere point at ring i (0 north pole .. SHAPE_RINGS south) and side j
+static vd_vec3 sphere_dir(int i, int j) {
+  double th = VD_PI * i / SHAPE_RINGS, ph = 2 * VD_PI * j / SHAPE_SIDES;
+  return vd_v3(sin(th) * cos(ph), sin(th) * sin(ph), cos(th));
+}
+
+// append triangle (a, b, c) with normals (na, nb, nc) in the local frame, placed by (pos, q)
+static void shape_tri(float* pos, float* nrm, int* k, vd_vec3 p, vd_quat q, const vd_vec3 v[3],
+                      const vd_vec3 n[3]) {
+  for (int c = 0; c < 3; c++) {
+    vd_vec3 w = vd_add(p, vd_quat_rotate(q, v[c])), wn = vd_quat_rotate(q, n[c]);
+    float* o = pos + 9 * *k + 3 * c;
+    float* on = nrm + 9 * *k + 3 * c;
+    o[0] = (float)w.x, o[1] = (float)w.y, o[2] = (float)w.z;
+    on[0] = (float)wn.x, on[1] = (float)wn.y, on[2] = (float)wn.z;
+  }
+  (*k)++;
+}
+
+// triangles of a shape (at most 2 x SHAPE_RINGS x SHAPE_SIDES + 2 x SHAPE_SIDES + 12)
+static int shape_tris(const vd_render_shape* s, vd_quat q, float* pos, float* nrm) {
+  int k = 0;
+  if (s->kind == VD_RENDER_BOX) {
+    // six faces, two triangles each, counter-clockwise seen from outside
+    for (int axis = 0; axis < 3; axis++)
+      for (int sign = -1; sign <= 1; sign += 2) {
+        double e[3] = {0, 0, 0};
+        e[axis] = sign;
+        vd_vec3 n = vd_v3(e[0], e[1], e[2]);
+        int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+        vd_vec3 c[4];
+        static const double uv[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int i = 0; i < 4; i++) {
+          double x[3];
+          x[axis] = sign * s->size[axis];
+          x[a1] = uv[i][0] * s->size[a1];
+          x[a2] = uv[i][1] * s->size[a2] * sign;
+          c[i] = vd_v3(x[0], x[1], x[2]);
+        }
+        vd_vec3 n3[3] = {n, n, n}, t0[3] = {c[0], c[1], c[2]}, t1[3] = {c[0], c[2], c[3]};
+        shape_tri(pos, nrm, &k, s->pos, q, t0, n3);
+        shape_tri(pos, nrm, &k, s->pos, q, t1, n3);
+      }
+    return k;
+  }
+  // sphere or capsule: a UV sphere whose northern half (equator included) moves up by the
+  // half-length and southern half down; ring e of RINGS + 2 is latitude ring lat[e]
+  double r = s->size[0], hl = s->kind == VD_RENDER_CAPSULE ? s->size[1] : 0;
+  for (int e = 0; e <= SHAPE_RINGS; e++) {
+    int a = e <= SHAPE_RINGS / 2 ? e : e - 1, b = e + 1 <= SHAPE_RINGS / 2 ? e + 1 : e;
+    double za = e <= SHAPE_RINGS / 2 ? hl : -hl, zb = e + 1 <= SHAPE_RINGS / 2 ? hl : -hl;
+    if (a == b && hl <= 0) continue; // a sphere has no cylinder band
+    for (int j = 0; j < SHAPE_SIDES; j++) {
+      vd_vec3 d00 = sphere_dir(a, j), d01 = sphere_dir(a, j + 1);
+      vd_vec3 d10 = sphere_dir(b, j), d11 = sphere_dir(b, j + 1);
+      vd_vec3 p00 = vd_v3(r * d00.x, r * d00.y, r * d00.z + za);
+      vd_vec3 p01 = vd_v3(r * d01.x, r * d01.y, r * d01.z + za);
+      vd_vec3 p10 = vd_v3(r * d10.x, r * d10.y, r * d10.z + zb);
+      vd_vec3 p11 = vd_v3(r * d11.x, r * d11.y, r * d11.z + zb);
+      // the quad (00, 10, 11, 01) runs counter-clockwise seen from outside; at a pole it is one
+      // triangle
+      if (b < SHAPE_RINGS) {
+        vd_vec3 v[3] = {p00, p10, p11}, n[3] = {d00, d10, d11};
+        shape_tri(pos, nrm, &k, s->pos, q, v, n);
+      }
+      if (a > 0) {
+        vd_vec3 v[3] = {p00, p11, p01}, n[3] = {d00, d11, d01};
+        shape_tri(pos, nrm, &k, s->pos, q, v, n);
+      }
+    }
+  }
+  return k;
+}
+
+vd_status vd_render_add_shape(vd_renderer* r, const vd_render_shape* s, vd_error* err) {
+  int nsize = s->kind == VD_RENDER_SPHERE ? 1 : s->kind == VD_RENDER_CAPSULE ? 2 : 3;
+  if ((int)s->kind < VD_RENDER_SPHERE || s->kind > VD_RENDER_BOX)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "unknown shape kind %d", (int)s->kind);
+  for (int k = 0; k < nsize; k++)
+    if (!isfinite(s->size[k]) ||
+        !(s->size[k] > 0 || (s->kind == VD_RENDER_CAPSULE && k == 1 && s->size[k] >= 0)))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
+                          "shape size %d is %g: must be finite and > 0", k, s->size[k]);
+  if (!isfinite(s->pos.x + s->pos.y + s->pos.z) ||
+      !isfinite(s->quat.w + s->quat.x + s->quat.y + s->quat.z))
+    return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "shape pose is not finite");
+  vd_quat q = vd_quat_normalize(s->quat);
+  vd_status st = gl_current(&r->gl, err);
+  if (st) return st;
+  size_t cap = 2 * SHAPE_RINGS * SHAPE_SIDES + 2 * SHAPE_SIDES + 12;
+  float* pos = vd_malloc(sizeof(float) * 18 * cap);
+  if (!pos) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  float* nrm = pos + 9 * cap;
+  int n = shape_tris(s, q, pos, nrm);
+  item* it = new_item(r);
+  if (!it) {
+    vd_free(pos, sizeof(float) * 18 * cap);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  it->kind = ITEM_SHAPE;
+  it->label = VD_RENDER_ROBOT_LABEL;
+  it->instance = 0;
+  for (int c = 0; c < 3; c++)
+    it->rgba[c] = s->rgb[c] < 0 ? 0 : s->rgb[c] > 1 ? 1 : s->rgb[c];
+  for (int v = 0; v < 3 * n; v++)
+    bounds_add(r, vd_v3(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]));
+  gl_tris tris = {n, pos, nrm, NULL};
+  it->list = gl_list(&r->gl, &tris);
+  vd_free(pos, sizeof(float) * 18 * cap);
+  if (!it->list)
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the shape");
+  return VD_OK;
 }
 
 // ---------------------------------------------------------------------------------------------

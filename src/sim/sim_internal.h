@@ -124,6 +124,9 @@ typedef struct sim_joint {
 void sim_joint_eval(const vd_sim_model* m, const vd_sim_data* d, int t, sim_joint* j);
 // Constraint values only (for damping and fracture checks).
 void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double c[6]);
+// Detach segment t from its parent (a fracture): its start moves to its spare node, which takes
+// half the segment's mass; the joint is marked broken (sim_step.c).
+void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t);
 
 // ---------------------------------------------------------------------------------------------
 // solver scratch kept in vd_sim_data::work

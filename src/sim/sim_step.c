@@ -17,9 +17,7 @@ static int finite_state(const vd_sim_model* m, const vd_sim_data* d) {
   return 1;
 }
 
-// detach segment t from its parent: its start moves to its spare node
-static void break_joint(const vd_sim_model* m, vd_sim_data* d, int t, double force, double moment,
-                        double cs, double cb, int cause) {
+void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t) {
   int a = d->seg_start[t], k = m->seg_spare[t];
   double share = 0.5 * m->seg_mass[t];
   if (share < 1e-6) share = 1e-6;
@@ -30,6 +28,13 @@ static void break_joint(const vd_sim_model* m, vd_sim_data* d, int t, double for
   d->node_force[k] = vd_v3(0, 0, 0);
   d->seg_start[t] = k;
   d->seg_broken[t] = 1;
+}
+
+// detach segment t from its parent and record the event
+static void break_joint(const vd_sim_model* m, vd_sim_data* d, int t, double force, double moment,
+                        double cs, double cb, int cause) {
+  int a = d->seg_start[t];
+  sim_detach(m, d, t);
   double* lam = d->seg_lambda + 6 * t;
   lam[3] = lam[4] = lam[5] = 0;
   vd_sim_event* e = &d->event[d->nevent++];

@@ -1,0 +1,338 @@
+// SPDX-License-Identifier: MIT
+// Simulation runs on disk (`verdant sim -o DIR`): the rod build settings kept in rod.json, the
+// collider poses of colliders.jsonl, and reading a run back: the initial plant is compiled, the
+// rod model rebuilt with the run's settings (and checked against rod.json), and each frame
+// loaded into a rod state and a plant state. The writers and the readers sit together here so
+// that the two cannot drift apart.
+#define _POSIX_C_SOURCE 200809L
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+// ---------------------------------------------------------------------------------------------
+// build settings (rod.json "build")
+
+// a number, or null for an infinite threshold
+static cJSON* num_or_inf(double v) {
+  return isinf(v) && v > 0 ? cJSON_CreateNull() : cJSON_CreateNumber(v);
+}
+
+cJSON* cli_sim_def_json(const vd_sim_def* def) {
+  cJSON* o = cJSON_CreateObject();
+  if (!o) return NULL;
+  cJSON_AddNumberToObject(o, "segment_length", def->segment_length);
+  cJSON_AddNumberToObject(o, "clamp_length", def->clamp_length);
+  cJSON_AddNumberToObject(o, "clamp_roots", def->clamp_roots);
+  cJSON_AddNumberToObject(o, "leaf_areal_density", def->leaf_areal_density);
+  cJSON_AddNumberToObject(o, "leaf_vein_ratio", def->leaf_vein_ratio);
+  cJSON_AddNumberToObject(o, "leaf_plate_cd", def->leaf_plate_cd);
+  cJSON_AddNumberToObject(o, "leaf_graphs", def->leaf_graphs);
+  cJSON_AddNumberToObject(o, "sag_free", def->sag_free);
+  double g[3] = {def->gravity.x, def->gravity.y, def->gravity.z};
+  cJSON_AddItemToObject(o, "gravity", cJSON_CreateDoubleArray(g, 3));
+  cJSON_AddNumberToObject(o, "stake_spacing", def->stake_spacing);
+  cJSON_AddNumberToObject(o, "stake_stiffness", def->stake_stiffness);
+  cJSON* mats = cJSON_AddObjectToObject(o, "materials");
+  for (int c = 0; c < VD_SIM_CLASS_COUNT; c++) {
+    const vd_sim_material* mt = &def->material[c];
+    cJSON* e = cJSON_AddObjectToObject(mats, vd_sim_class_name((vd_sim_class)c));
+    cJSON_AddNumberToObject(e, "young", mt->young);
+    cJSON_AddNumberToObject(e, "poisson", mt->poisson);
+    cJSON_AddNumberToObject(e, "density", mt->density);
+    cJSON_AddItemToObject(e, "break_force", num_or_inf(mt->break_force));
+    cJSON_AddItemToObject(e, "break_moment", num_or_inf(mt->break_moment));
+    cJSON_AddItemToObject(e, "break_cs", num_or_inf(mt->break_cs));
+    cJSON_AddItemToObject(e, "break_cb", num_or_inf(mt->break_cb));
+    cJSON_AddNumberToObject(e, "drag_cd", mt->drag_cd);
+  }
+  return o;
+}
+
+// read number key of o into *v (null: +infinity when inf_ok); an error names the field
+static vd_status get_num(const cJSON* o, const char* key, int inf_ok, double* v, const char* path,
+                         const char* where, vd_error* err) {
+  const cJSON* x = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (inf_ok && cJSON_IsNull(x)) {
+    *v = INFINITY;
+    return VD_OK;
+  }
+  if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble))
+    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "%s.%s: expected a number%s", where, key,
+                        inf_ok ? " or null" : "");
+  *v = x->valuedouble;
+  return VD_OK;
+}
+
+vd_status cli_sim_def_parse(const cJSON* o, const char* path, vd_sim_def* def, vd_error* err) {
+  *def = vd_sim_def_default();
+  if (!cJSON_IsObject(o))
+    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                        "no \"build\" settings (a run of an older 'verdant sim': make it again)");
+  double flags[4];
+  vd_status st = VD_OK;
+  static const char* ints[4] = {"clamp_roots", "leaf_graphs", "sag_free", NULL};
+  st = get_num(o, "segment_length", 0, &def->segment_length, path, "build", err);
+  if (!st) st = get_num(o, "clamp_length", 0, &def->clamp_length, path, "build", err);
+  for (int k = 0; !st && ints[k]; k++)
+    st = get_num(o, ints[k], 0, &flags[k], path, "build", err);
+  if (!st)
+    def->clamp_roots = (int)flags[0], def->leaf_graphs = (int)flags[1],
+    def->sag_free = (int)flags[2];
+  if (!st) st = get_num(o, "leaf_areal_density", 0, &def->leaf_areal_density, path, "build", err);
+  if (!st) st = get_num(o, "leaf_vein_ratio", 0, &def->leaf_vein_ratio, path, "build", err);
+  if (!st) st = get_num(o, "leaf_plate_cd", 0, &def->leaf_plate_cd, path, "build", err);
+  if (!st) st = get_num(o, "stake_spacing", 0, &def->stake_spacing, path, "build", err);
+  if (!st) st = get_num(o, "stake_stiffness", 0, &def->stake_stiffness, path, "build", err);
+  if (st) return st;
+  const cJSON* g = cJSON_GetObjectItemCaseSensitive(o, "gravity");
+  if (!cJSON_IsArray(g) || cJSON_GetArraySize(g) != 3)
+    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                        "build.gravity: expected [x, y, z] (m/s^2)");
+  double gv[3];
+  for (int k = 0; k < 3; k++) {
+    const cJSON* x = cJSON_GetArrayItem(g, k);
+    if (!cJSON_IsNumber(x))
+      return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                          "build.gravity: expected [x, y, z] (m/s^2)");
+    gv[k] = x->valuedouble;
+  }
+  def->gravity = vd_v3(gv[0], gv[1], gv[2]);
+  const cJSON* mats = cJSON_GetObjectItemCaseSensitive(o, "materials");
+  for (int c = 0; c < VD_SIM_CLASS_COUNT && !st; c++) {
+    const char* name = vd_sim_class_name((vd_sim_class)c);
+    const cJSON* e = cJSON_GetObjectItemCaseSensitive(mats, name);
+    char where[64];
+    snprintf(where, sizeof where, "build.materials.%s", name);
+    if (!cJSON_IsObject(e))
+      return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "%s: missing", where);
+    vd_sim_material* mt = &def->material[c];
+    st = get_num(e, "young", 0, &mt->young, path, where, err);
+    if (!st) st = get_num(e, "poisson", 0, &mt->poisson, path, where, err);
+    if (!st) st = get_num(e, "density", 0, &mt->density, path, where, err);
+    if (!st) st = get_num(e, "break_force", 1, &mt->break_force, path, where, err);
+    if (!st) st = get_num(e, "break_moment", 1, &mt->break_moment, path, where, err);
+    if (!st) st = get_num(e, "break_cs", 1, &mt->break_cs, path, where, err);
+    if (!st) st = get_num(e, "break_cb", 1, &mt->break_cb, path, where, err);
+    if (!st) st = get_num(e, "drag_cd", 0, &mt->drag_cd, path, where, err);
+  }
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// colliders (colliders.jsonl: one line per frame)
+
+static const char* shape_names[4] = {"plane", "sphere", "capsule", "box"};
+
+void cli_colliders_write(FILE* fp, const vd_sim_data* d) {
+  fprintf(fp, "{\"t\":%.9g,\"colliders\":[", d->time);
+  for (int i = 0; i < d->ncollider; i++) {
+    const vd_sim_collider* c = &d->collider[i];
+    fprintf(fp,
+            "%s{\"shape\":\"%s\",\"size\":[%.9g,%.9g,%.9g],\"pos\":[%.9g,%.9g,%.9g],\"quat\":[%.9g,"
+            "%.9g,%.9g,%.9g]}",
+            i ? "," : "", shape_names[c->shape], c->size[0], c->size[1], c->size[2], c->pos.x,
+            c->pos.y, c->pos.z, c->quat.w, c->quat.x, c->quat.y, c->quat.z);
+  }
+  fputs("]}\n", fp);
+}
+
+// n numbers of array key of o into v; 0 when missing, short or not numbers
+static int get_vec(const cJSON* o, const char* key, double* v, int n) {
+  const cJSON* a = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n) return 0;
+  int k = 0;
+  const cJSON* x;
+  cJSON_ArrayForEach(x, a) {
+    if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble)) return 0;
+    v[k++] = x->valuedouble;
+  }
+  return 1;
+}
+
+// read colliders.jsonl: one line per frame (nframe lines), each a list of colliders
+static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
+  char* text;
+  size_t len;
+  vd_status st = vd_file_read(path, &text, &len, err);
+  if (st) return st;
+  run->col_start = vd_calloc((size_t)run->nframe + 1, sizeof(int));
+  if (!run->col_start) st = vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  int frame = 0, line = 0;
+  for (char* p = text; !st && *p;) {
+    line++;
+    char* e = strchr(p, '\n');
+    size_t n = e ? (size_t)(e - p) : strlen(p);
+    char* next = e ? e + 1 : p + n;
+    size_t blank = strspn(p, " \t\r");
+    if (blank >= n) {
+      p = next;
+      continue;
+    }
+    if (frame >= run->nframe) {
+      st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "more lines than the run's %d frames",
+                        run->nframe);
+      break;
+    }
+    cJSON* o = cJSON_ParseWithLength(p, n);
+    const cJSON* list = cJSON_GetObjectItemCaseSensitive(o, "colliders");
+    if (!cJSON_IsArray(list))
+      st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0,
+                        "expected {\"t\": T, \"colliders\": [...]}");
+    const cJSON* c;
+    int idx = 0;
+    cJSON_ArrayForEach(c, list) {
+      if (st) break;
+      vd_sim_collider col;
+      memset(&col, 0, sizeof col);
+      const cJSON* shape = cJSON_GetObjectItemCaseSensitive(c, "shape");
+      int kind = -1;
+      for (int k = 0; k < 4 && cJSON_IsString(shape); k++)
+        if (!strcmp(shape->valuestring, shape_names[k])) kind = k;
+      double q[4], pos[3];
+      if (kind < 0 || !get_vec(c, "size", col.size, 3) || !get_vec(c, "pos", pos, 3) ||
+          !get_vec(c, "quat", q, 4)) {
+        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0,
+                          "collider %d: expected shape (plane, sphere, capsule, box), size [3], "
+                          "pos [3], quat [4]",
+                          idx);
+        break;
+      }
+      col.shape = (vd_sim_shape)kind;
+      col.pos = vd_v3(pos[0], pos[1], pos[2]);
+      col.quat = (vd_quat){q[0], q[1], q[2], q[3]};
+      int cap = run->cap_col;
+      if (!vd_grow((void**)&run->col, &cap, run->ncol + 1, sizeof(vd_sim_collider))) {
+        st = vd_error_set(err, VD_ERR_NOMEM, path, line, 0, "out of memory");
+        break;
+      }
+      run->cap_col = cap;
+      run->col[run->ncol++] = col;
+      idx++;
+    }
+    cJSON_Delete(o);
+    run->col_start[++frame] = run->ncol;
+    p = next;
+  }
+  vd_free(text, len + 1);
+  if (!st && frame != run->nframe)
+    st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0, "%d lines for the run's %d frames", frame,
+                      run->nframe);
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// reading a run
+
+// rod.json's sizes and rest positions against the rebuilt model
+static vd_status check_rod(const cJSON* rod, const vd_sim_model* m, const char* path,
+                           vd_error* err) {
+  const cJSON* nodes = cJSON_GetObjectItemCaseSensitive(rod, "nodes");
+  const cJSON* segs = cJSON_GetObjectItemCaseSensitive(rod, "segments");
+  const cJSON* pos0 = cJSON_GetObjectItemCaseSensitive(rod, "node_pos0");
+  int ok = cJSON_IsNumber(nodes) && cJSON_IsNumber(segs) && nodes->valuedouble == m->nnode_all &&
+           segs->valuedouble == m->nseg && cJSON_IsArray(pos0) &&
+           cJSON_GetArraySize(pos0) == 3 * m->nnode_all;
+  const cJSON* x = ok ? pos0->child : NULL;
+  for (int i = 0; ok && i < m->nnode_all; i++) {
+    double p[3] = {m->node_pos0[i].x, m->node_pos0[i].y, m->node_pos0[i].z};
+    for (int k = 0; k < 3 && ok; k++, x = x->next)
+      ok = cJSON_IsNumber(x) && fabs(x->valuedouble - p[k]) <= 1e-9;
+  }
+  if (!ok)
+    return vd_error_set(
+        err, VD_ERR_FORMAT, path, 0, 0,
+        "the rod model rebuilt from plant_initial.json and the build settings differs from "
+        "this file (%d nodes, %d segments rebuilt): was the run made by another verdant?",
+        m->nnode_all, m->nseg);
+  return VD_OK;
+}
+
+vd_status cli_run_open(const char* dir, cli_run* run, vd_error* err) {
+  memset(run, 0, sizeof *run);
+  snprintf(run->dir, sizeof run->dir, "%s", dir);
+  size_t n = strlen(run->dir);
+  while (n > 1 && run->dir[n - 1] == '/')
+    run->dir[--n] = 0;
+  char path[4200];
+  // rod.json: the build settings
+  snprintf(path, sizeof path, "%s/rod.json", run->dir);
+  char* text;
+  size_t len;
+  vd_status st = vd_file_read(path, &text, &len, err);
+  if (st) return st;
+  cJSON* rod = cJSON_ParseWithLength(text, len);
+  vd_free(text, len + 1);
+  const cJSON* format = cJSON_GetObjectItemCaseSensitive(rod, "format");
+  if (!cJSON_IsString(format) || strcmp(format->valuestring, "verdant-rod")) {
+    cJSON_Delete(rod);
+    return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
+                        "not a verdant rod file (\"format\": \"verdant-rod\")");
+  }
+  vd_sim_def def;
+  st = cli_sim_def_parse(cJSON_GetObjectItemCaseSensitive(rod, "build"), path, &def, err);
+  // the initial plant, compiled; the rod model rebuilt from it
+  char ppath[4200];
+  snprintf(ppath, sizeof ppath, "%s/plant_initial.json", run->dir);
+  if (!st) st = vd_plant_read_json(ppath, &run->spec, err);
+  if (!st) st = vd_plant_compile(run->spec, &run->plant, err);
+  if (!st) st = vd_sim_build(run->plant, &def, &run->sim, err);
+  if (!st) st = check_rod(rod, run->sim, path, err);
+  cJSON_Delete(rod);
+  if (!st) {
+    run->state = vd_sim_data_create(run->sim);
+    run->pstate = vd_data_create(run->plant);
+    if (!run->state || !run->pstate)
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  // the frames: binary or JSON Lines
+  if (!st) {
+    snprintf(path, sizeof path, "%s/frames.bin", run->dir);
+    if (access(path, F_OK) != 0) snprintf(path, sizeof path, "%s/frames.jsonl", run->dir);
+    if (access(path, F_OK) != 0)
+      st = vd_error_set(err, VD_ERR_IO, run->dir, 0, 0,
+                        "no frames.bin or frames.jsonl (made with --frames none?)");
+    else
+      st = vd_sim_frames_open(path, &run->frames, err);
+  }
+  if (!st) {
+    run->nframe = vd_sim_frames_count(run->frames);
+    if (!run->nframe) st = vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "no frames in the file");
+  }
+  // the colliders, when recorded
+  snprintf(path, sizeof path, "%s/colliders.jsonl", run->dir);
+  if (!st && access(path, F_OK) == 0) st = read_colliders(run, path, err);
+  if (st) cli_run_close(run);
+  return st;
+}
+
+vd_status cli_run_load(cli_run* run, int k, vd_error* err) {
+  vd_status st = vd_sim_frames_load(run->frames, k, run->sim, run->state, err);
+  if (!st) vd_sim_to_plant(run->sim, run->state, run->plant, run->pstate);
+  return st;
+}
+
+int cli_run_colliders(const cli_run* run, int k, const vd_sim_collider** out) {
+  if (!run->col_start) {
+    *out = NULL;
+    return 0;
+  }
+  *out = run->col + run->col_start[k];
+  return run->col_start[k + 1] - run->col_start[k];
+}
+
+void cli_run_close(cli_run* run) {
+  vd_sim_frames_close(run->frames);
+  vd_data_destroy(run->pstate);
+  vd_sim_data_destroy(run->state);
+  vd_sim_model_destroy(run->sim);
+  vd_model_destroy(run->plant);
+  vd_plant_spec_destroy(run->spec);
+  vd_free(run->col_start, run->col_start ? ((size_t)run->nframe + 1) * sizeof(int) : 0);
+  vd_free(run->col, (size_t)run->cap_col * sizeof(vd_sim_collider));
+  memset(run, 0, sizeof *run);
+}
