@@ -50,6 +50,9 @@ static const char* sim_help =
     "      --mass-damping C    velocity damping rate (1/s), default 0\n"
     "contacts and probes:\n"
     "      --ground Z          ground plane at height Z (m), default 0; --no-ground for none\n"
+    "      --self-collision    capsules and fruits collide with each other (default; neighbours\n"
+    "                          and parts touching in the modelled shape excluded);\n"
+    "                          --no-self-collision turns it off\n"
     "      --probe R:X0,Y0,Z0:X1,Y1,Z1[:T0:T1]\n"
     "                          kinematic sphere of radius R (m) moving from P0 to P1 (m) between\n"
     "                          T0 and T1 (s, default the whole run); repeatable\n"
@@ -446,6 +449,7 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "segments", m->nseg);
   cJSON_AddNumberToObject(root, "total_mass", m->total_mass);
   cJSON_AddNumberToObject(root, "max_penetration", d->max_penetration);
+  cJSON_AddNumberToObject(root, "contacts", d->ncontact);
   cJSON_AddNumberToObject(root, "sag_free_out_of_reach", m->nsagfree_clamped);
   cJSON_AddNumberToObject(root, "warnings", (double)d->nwarning);
   char* text = cJSON_Print(root);
@@ -563,6 +567,10 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->no_ground = 0;
     } else if (!strcmp(a, "--no-ground")) {
       o->no_ground = 1;
+    } else if (!strcmp(a, "--self-collision")) {
+      o->opt.self_collision = 1;
+    } else if (!strcmp(a, "--no-self-collision")) {
+      o->opt.self_collision = 0;
     } else if (!strcmp(a, "--probe")) {
       VAL();
       if (o->nprobe == 16) return cli_usage_error(cmd, "too many --probe options (16 at most)");
@@ -663,11 +671,11 @@ int cli_sim(int argc, char** argv) {
       st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   if (!st && !o.no_ground) {
-    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o.ground), vd_quat_identity(), vd_v3(0, 0, 0)};
+    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o.ground), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
     vd_sim_add_collider(d, &c);
   }
   for (int k = 0; !st && k < o.nprobe; k++) {
-    vd_sim_collider c = {VD_SIM_SPHERE, {o.probe[k].r, 0, 0}, o.probe[k].p0, vd_quat_identity(), vd_v3(0, 0, 0)};
+    vd_sim_collider c = {VD_SIM_SPHERE, {o.probe[k].r, 0, 0}, o.probe[k].p0, vd_quat_identity(), vd_v3(0, 0, 0), NULL};
     o.probe[k].id = vd_sim_add_collider(d, &c);
   }
   if (st) {

@@ -54,12 +54,12 @@ static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_so
   m->opt.solver = solver;
   m->opt.iterations = iters;
   vd_sim_data* d = vd_sim_data_create(m);
-  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   vd_sim_add_collider(d, &g);
   // the probe crosses the plant at 60 % of its height
   double top = 0;
   for (int i = 0; i < m->nnode; i++) top = fmax(top, m->node_pos0[i].z);
-  vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.5, 0, 0.6 * top), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.5, 0, 0.6 * top), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   int id = vd_sim_add_collider(d, &p);
   int steps = (int)(secs / m->opt.dt + 0.5);
   double w0 = now(), c0 = cpu();

@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: MIT
-// External colliders until the collide module takes over: analytic signed distances of a
-// plane, sphere, capsule and box, contact candidates against node spheres and segment
-// capsules, and their XPBD projection (compliance 0) with Coulomb friction. The interface
-// (sim_contacts_find / _project / _friction in sim_internal.h) is what the collide module's
-// generator (SDF grids, triangle meshes, self-contact with a broad phase) plugs into.
+// External colliders: analytic signed distances of a plane, sphere, capsule and box, closed
+// triangle meshes through the collide module's signed distance grids, contact candidates against node spheres and segment
+// capsules, and their XPBD projection (compliance 0) with Coulomb friction; self-contacts come
+// from vd_collide_self (sim_self.c) and are projected here too.
 #include "sim_internal.h"
 
 double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* normal) {
@@ -52,6 +51,15 @@ double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* norma
         g = vd_v3(e[0], e[1], e[2]);
       }
       *normal = q_rotate(k->quat, g);
+      return dist;
+    }
+    case VD_SIM_MESH: {
+      // the collide module's grid in the mesh frame: interpolated distance and its gradient
+      if (!k->sdf) break;
+      vd_vec3 g;
+      double dist = vd_sdf_eval(k->sdf, q_rotate(q_conj(k->quat), v), &g);
+      double gn = v_norm(g);
+      *normal = gn > 1e-15 ? q_rotate(k->quat, vd_scale(g, 1.0 / gn)) : vd_v3(0, 0, 1);
       return dist;
     }
   }
