@@ -98,13 +98,21 @@ static double closest_t_seg(vd_vec3 a, vd_vec3 b, vd_vec3 c, vd_vec3 dd) {
 }
 
 // best parameter along the segment for a collider: exact for spheres and capsules, the
-// deepest of 9 equidistant samples for boxes (as Gazebo Plants samples capsules)
+// deepest of 9 equidistant samples for boxes (as Gazebo Plants samples capsules), the collide
+// module's search along the axis for meshes
 static double seg_param(const vd_sim_collider* k, vd_vec3 a, vd_vec3 b) {
   switch (k->shape) {
     case VD_SIM_SPHERE: return closest_t(a, b, k->pos);
     case VD_SIM_CAPSULE: {
       vd_vec3 ax = q_rotate(k->quat, vd_v3(0, 0, k->size[1]));
       return closest_t_seg(a, b, vd_sub(k->pos, ax), vd_add(k->pos, ax));
+    }
+    case VD_SIM_MESH: {
+      // the collide module's axis search: samples every half cell, then a golden-section refine
+      if (!k->sdf) return 0;
+      vd_pose pose = {k->pos, k->quat};
+      vd_collider c = vd_collider_sdf(pose, k->sdf);
+      return vd_collide_capsule(&c, a, b, 0, 0).t;
     }
     default: {
       double best = 1e300, bt = 0;
