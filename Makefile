@@ -31,6 +31,8 @@ bench: all
 	./$(BUILD)/verdant_bench_render_run $(BENCH_ARGS)
 	bash bench/cloud_bench.sh ./$(BUILD)/verdant $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_sim $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_collide --csv bench/results/collide-2core.csv
+	./$(BUILD)/verdant_bench_mujoco --csv bench/results/mujoco-chain-2core.csv
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant

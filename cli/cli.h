@@ -29,6 +29,9 @@ typedef struct cli_plant_opts {
   const char* label[64];   // --label ID=NAME
   int nlabel;
   int progress;            // show a progress bar (stderr is a terminal)
+  double curve_step;       // --curve-step (m) for curves files, < 0: the file's or the default
+  double curve_connect;    // --curve-connect (m), < 0: the file's or the default
+  double curve_distance;   // --curve-distance (m), < 0: the file's or the default
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
@@ -39,8 +42,8 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
 // Help text lines for the plant options.
 extern const char* cli_plant_help;
 
-// Load the plant: derive an .lpy (and keep its derived string's module counts in stats) or
-// read a plant file. On success *out is a new spec.
+// Load the plant: derive an .lpy (and keep its derived string's module counts in stats), read
+// a plant file, or build a plant from a curves file. On success *out is a new spec.
 typedef struct cli_grow_info {
   int64_t modules;          // modules of the derived string (0 for plant files)
   int nsym;                 // symbol count of the lsystem

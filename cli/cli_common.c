@@ -58,6 +58,11 @@ const char* cli_plant_help =
     "      --label ID=NAME   name a label id (repeatable; the file's LABELS come first)\n"
     "      --max-modules N   largest L-string allowed (default 50000000)\n"
     "      --max-ops N       interpreter work allowed: loop iterations + calls (default 1e9)\n"
+    "      --curve-step M    curves files: dense sampling step (m; default 0.001)\n"
+    "      --curve-connect M curves files: largest branch gap, sigma_connect (m; default 0.01)\n"
+    "      --curve-distance M\n"
+    "                        curves files: segment length, sigma_distance (m; default 0.02);\n"
+    "                        the file's \"settings\" replace the defaults, these flags the file's\n"
     "      --no-progress     no progress bar (it shows only when stderr is a terminal)\n";
 
 void cli_plant_opts_init(cli_plant_opts* o) {
@@ -66,6 +71,7 @@ void cli_plant_opts_init(cli_plant_opts* o) {
   o->seed = 0;
   o->max_modules = 50000000;
   o->progress = isatty(2);
+  o->curve_step = o->curve_connect = o->curve_distance = -1;
 }
 
 // strict integer parsing: the whole text, within [lo, hi]
@@ -155,6 +161,19 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     }
     return 1;
   }
+  if (!strcmp(a, "--curve-step") || !strcmp(a, "--curve-connect") || !strcmp(a, "--curve-distance")) {
+    TAKE();
+    char* end;
+    errno = 0;
+    double x = strtod(val, &end);
+    int step = a[8] == 's';
+    if (errno || *end || !(x >= (step ? 1e-6 : 0)) || !(x <= 1e3)) {
+      cli_usage_error(cmd, "%s expects a length in metres%s, got '%s'", a, step ? " >= 1e-6" : " >= 0", val);
+      return -1;
+    }
+    *(step ? &o->curve_step : a[8] == 'c' ? &o->curve_connect : &o->curve_distance) = x;
+    return 1;
+  }
   if (!strcmp(a, "--no-progress")) {
     o->progress = 0;
     return 1;
@@ -176,19 +195,55 @@ static int progress_cb(void* user, int step, int steps, int64_t modules) {
   return 0;
 }
 
+// a curves file (format "verdant-curves") built into a new spec with the --curve-* settings
+static vd_status load_curves(const cli_plant_opts* o, const char* text, size_t len, vd_plant_spec** out,
+                             vd_error* err) {
+  vd_curves* c;
+  vd_status st = vd_curves_parse(text, len, o->path, &c, err);
+  if (st) return st;
+  vd_curves_def def = vd_curves_file_def(c);
+  if (o->curve_step >= 0) def.sample_step = o->curve_step;
+  if (o->curve_connect >= 0) def.connect = o->curve_connect;
+  if (o->curve_distance >= 0) def.distance = o->curve_distance;
+  *out = vd_plant_spec_create();
+  st = *out ? vd_curves_build(c, &def, *out, NULL, err)
+            : vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+  vd_curves_destroy(c);
+  if (st) {
+    vd_plant_spec_destroy(*out);
+    *out = NULL;
+  }
+  return st;
+}
+
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
   memset(info, 0, sizeof *info);
   *out = NULL;
   vd_status st;
   if (cli_has_ext(o->path, ".json")) {
     if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
-    st = vd_plant_read_json(o->path, out, err);
+    // a plant file or a curves file, by its "format"
+    char* text;
+    size_t len;
+    st = vd_file_read(o->path, &text, &len, err);
+    if (st) return st;
+    char fmt[32];
+    if (!strcmp(vd_plant_json_format(text, len, fmt, sizeof fmt), "verdant-curves")) {
+      st = load_curves(o, text, len, out, err);
+    } else if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0) {
+      st = vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
+    } else {
+      st = vd_plant_parse_json(text, len, o->path, out, err);
+    }
+    vd_free(text, len + 1);
     for (int i = 0; !st && i < o->nlabel; i++) {
       const char* eq = strchr(o->label[i], '=');
       st = vd_plant_set_label(*out, atoi(o->label[i]), eq + 1);
     }
     return st;
   }
+  if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0)
+    return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
   vd_lsystem* ls;
   st = vd_lsys_load(o->path, &ls, err);
   if (st) return st;

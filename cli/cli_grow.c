@@ -9,8 +9,9 @@
 static const char* grow_help =
     "usage: verdant grow PLANT [-o OUT] [options]\n"
     "\n"
-    "Grow a plant from an L-Py file (.lpy, derived on the fly) or read a plant file (.json),\n"
-    "and write it as plant JSON (.json) or a labelled mesh (.obj with .mtl, .ply).\n"
+    "Grow a plant from an L-Py file (.lpy, derived on the fly), read a plant file (.json) or\n"
+    "build one from hand-drawn branch curves (.json with \"format\": \"verdant-curves\"), and\n"
+    "write it as plant JSON (.json) or a labelled mesh (.obj with .mtl, .ply).\n"
     "\n"
     "options:\n"
     "  -o, --output OUT      output file; the extension picks the format: .json .obj .ply\n"

@@ -254,9 +254,9 @@ static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int n
   for (int c = 0; c < ncol && !st; c++) {
     const vd_sim_collider* k = &col[c];
     if (k->shape == VD_SIM_PLANE) continue;
-    vd_render_shape s = {k->shape == VD_SIM_SPHERE    ? VD_SHAPE_SPHERE
-                         : k->shape == VD_SIM_CAPSULE ? VD_SHAPE_CAPSULE
-                                                      : VD_SHAPE_BOX,
+    vd_render_shape s = {k->shape == VD_SIM_SPHERE    ? VD_RENDER_SPHERE
+                         : k->shape == VD_SIM_CAPSULE ? VD_RENDER_CAPSULE
+                                                      : VD_RENDER_BOX,
                          {k->size[0], k->size[1], k->size[2]},
                          k->pos,
                          k->quat,

@@ -630,7 +630,7 @@ TEST(render, shapes) {
   vd_error err = {0};
   // a sphere of 10 cm, 2 m in front of the camera: robot label, instance 0, its disc's area
   vd_render_shape s = {
-      VD_SHAPE_SPHERE, {0.1, 0, 0}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0.5f, 0.6f, 0.7f}};
+      VD_RENDER_SPHERE, {0.1, 0, 0}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0.5f, 0.6f, 0.7f}};
   CHECK_STATUS(vd_render_add_shape(r, &s, &err), VD_OK, err);
   vd_camera c = cam_y(vd_v3(0, -2, 0.5), 40);
   vd_frame f;
@@ -649,7 +649,7 @@ TEST(render, shapes) {
   CHECK(fabs(area - disc) < 0.05 * disc);
   // a capsule along x and a box: both drawn, both in the bounds
   vd_render_clear(r);
-  vd_render_shape cap = {VD_SHAPE_CAPSULE,
+  vd_render_shape cap = {VD_RENDER_CAPSULE,
                          {0.05, 0.3, 0},
                          vd_v3(0, 0, 0.5),
                          vd_quat_axis_angle(vd_v3(0, 1, 0), VD_PI / 2),
@@ -666,7 +666,7 @@ TEST(render, shapes) {
   CHECK_INT(f.label[(int)lround(v) * f.width + (int)lround(u)], 0); // above the capsule
   vd_render_clear(r);
   vd_render_shape box = {
-      VD_SHAPE_BOX, {0.1, 0.1, 0.2}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0, 1, 0}};
+      VD_RENDER_BOX, {0.1, 0.1, 0.2}, vd_v3(0, 0, 0.5), vd_quat_identity(), {0, 1, 0}};
   CHECK_STATUS(vd_render_add_shape(r, &box, &err), VD_OK, err);
   CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_LABEL | VD_LAYER_DEPTH, &f, &err), VD_OK, err);
   // the box's front face (y = -0.1) fills a 0.2 x 0.4 m rectangle 1.9 m away
@@ -685,7 +685,7 @@ TEST(render, shapes) {
   CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_VALUE, err);
   bad = cap, bad.size[1] = -1;
   CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_VALUE, err);
-  bad = s, bad.kind = (vd_shape_kind)9;
+  bad = s, bad.kind = (vd_render_shape_kind)9;
   CHECK_STATUS(vd_render_add_shape(r, &bad, &err), VD_ERR_ARG, err);
   vd_render_destroy(r);
 }

@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
       double t3 = now();
       vd_render_clear(r);
       vd_render_shape sh = {
-          VD_SHAPE_SPHERE, {0.04, 0, 0}, probe_at[fk], vd_quat_identity(), {0.55f, 0.62f, 0.75f}};
+          VD_RENDER_SPHERE, {0.04, 0, 0}, probe_at[fk], vd_quat_identity(), {0.55f, 0.62f, 0.75f}};
       if (vd_render_add_plant(r, pm, pd, &st, &err) || vd_render_add_shape(r, &sh, &err))
         return fail("scene", &err);
       double t4 = now();

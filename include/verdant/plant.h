@@ -238,6 +238,68 @@ vd_status vd_plant_read_json(const char* path, vd_plant_spec** out, vd_error* er
 // Parse plant JSON from memory (name is used in errors, Nullable).
 vd_status vd_plant_parse_json(const char* text, size_t len, const char* name, vd_plant_spec** out,
                               vd_error* err);
+// The top-level "format" string of a JSON text ("verdant-plant", "verdant-curves") copied into
+// buf, found without parsing the whole text; "" when there is none.
+const char* vd_plant_json_format(const char* text, size_t len, char* buf, size_t cap);
+
+// ---------------------------------------------------------------------------------------------
+// hand-drawn plants: branch polylines (curves JSON, docs/formats.md) to a plant spec, as Gazebo
+// Plants (Deng et al. 2024, sec. 3.5) builds them: dense sampling of every polyline, branch
+// connections within sigma_connect by a search from the root (nearest gap first), simplification
+// to segments of about sigma_distance keeping junctions, tips, curve joins and marked nodes,
+// leaves from templates and fruits as spheres at marked nodes.
+//
+//   vd_curves* c; vd_curves_read("data/curves_tomato.json", &c, &err);
+//   vd_curves_def def = vd_curves_file_def(c);   // defaults with the file's "settings"
+//   def.distance = 0.03;
+//   vd_curves_build(c, &def, spec, NULL, &err); vd_curves_destroy(c);
+
+#define VD_CURVES_FORMAT_VERSION 1  // version of the curves JSON schema (docs/formats.md)
+
+// Settings of the curve import.
+typedef struct vd_curves_def {
+  double sample_step;   // dense sampling step along every polyline (m); default 0.001
+  double connect;       // sigma_connect: largest gap between a branch end and the plant (m);
+                        // default 0.01
+  double distance;      // sigma_distance: segment length after simplification (m); default 0.02
+  double radius;        // radius of curves that give none (m); default 0.002
+  double leaf_length;   // leaf length when a leaf gives none (m); default 0.05
+  double fruit_radius;  // fruit radius when a fruit gives none (m); default 0.01
+  int slices;           // tessellation sides of segments and fruits (>= 3); default 8
+  int64_t max_samples;  // most dense samples over all curves; VD_ERR_LIMIT beyond; default 1e7
+} vd_curves_def;
+
+// Defaults: sample_step 0.001 m, connect 0.01 m, distance 0.02 m, radius 0.002 m, leaf_length
+// 0.05 m, fruit_radius 0.01 m, slices 8, max_samples 10000000.
+vd_curves_def vd_curves_def_default(void);
+
+// A parsed curves file (opaque).
+typedef struct vd_curves vd_curves;
+
+// Counts of a build, for tests and --stats.
+typedef struct vd_curves_stats {
+  int ncurve;     // polylines in the file
+  int64_t nsample;  // dense samples over all curves
+  int nconnect;   // branch connections made (one per curve but the root's)
+  int ngap;       // connections bridged by a segment (the rest joined at a shared point)
+  int nnode;      // nodes kept after simplification
+  int nseg;       // segments made
+  int nleaf, nfruit;  // leaves and fruits placed
+} vd_curves_stats;
+
+// Read a curves file (format "verdant-curves"); errors name the file and the field.
+vd_status vd_curves_read(const char* path, vd_curves** out, vd_error* err);
+// Parse curves JSON from memory (name is used in errors, Nullable).
+vd_status vd_curves_parse(const char* text, size_t len, const char* name, vd_curves** out,
+                          vd_error* err);
+// Free parsed curves (NULL is fine).
+void vd_curves_destroy(vd_curves* c);
+// The defaults with the file's "settings" applied.
+vd_curves_def vd_curves_file_def(const vd_curves* c);
+// Build the plant into spec (appended; def Nullable: vd_curves_file_def; stats Nullable).
+// VD_ERR_VALUE names a curve that does not connect or a marker far from every curve.
+vd_status vd_curves_build(const vd_curves* c, const vd_curves_def* def, vd_plant_spec* spec,
+                          vd_curves_stats* stats, vd_error* err);
 
 #ifdef __cplusplus
 }

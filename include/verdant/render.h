@@ -175,19 +175,19 @@ typedef struct vd_points {
 vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_render_style* s,
                                vd_error* err);
 // Shapes of solids drawn beside plants and clouds (the colliders of a simulation run).
-typedef enum vd_shape_kind {
-  VD_SHAPE_SPHERE = 0, // sphere of radius size[0]
-  VD_SHAPE_CAPSULE,    // capsule of radius size[0] and half-length size[1] along its z axis
-  VD_SHAPE_BOX,        // box of half-extents size[0..2] along its axes
-} vd_shape_kind;
+typedef enum vd_render_shape_kind {
+  VD_RENDER_SPHERE = 0, // sphere of radius size[0]
+  VD_RENDER_CAPSULE,    // capsule of radius size[0] and half-length size[1] along its z axis
+  VD_RENDER_BOX,        // box of half-extents size[0..2] along its axes
+} vd_render_shape_kind;
 
 // A solid: a probe, a tool, an obstacle.
 typedef struct vd_render_shape {
-  vd_shape_kind kind; // shape
-  double size[3];     // sizes (m), see vd_shape_kind
-  vd_vec3 pos;        // centre (m)
-  vd_quat quat;       // orientation (normalised here)
-  float rgb[3];       // colour in [0, 1]
+  vd_render_shape_kind kind; // shape
+  double size[3];            // sizes (m), see vd_render_shape_kind
+  vd_vec3 pos;               // centre (m)
+  vd_quat quat;              // orientation (normalised here)
+  float rgb[3];              // colour in [0, 1]
 } vd_render_shape;
 
 // Add a solid; its pixels carry label VD_RENDER_ROBOT_LABEL and instance 0 in the masks, like a

@@ -20,5 +20,6 @@
 #include "verdant/cloud.h"
 #include "verdant/render.h"
 #include "verdant/sim.h"
+#include "verdant/collide.h"
 
 #endif

@@ -1803,6 +1803,14 @@ done:
   return st;
 }
 
+// append statements (a list linked by next) to the top-level code
+static void append_top(vd_lsystem* ls, stmt* s) {
+  if (ls->top_tail) ls->top_tail->next = s;
+  else ls->top = s;
+  ls->top_tail = s;
+  while (ls->top_tail->next) ls->top_tail = ls->top_tail->next;
+}
+
 static vd_status parse_def(parser* P, int* li) {
   vd_lsystem* ls = P->ls;
   pline* ln = &P->lines[*li];
@@ -1870,9 +1878,7 @@ static vd_status parse_def(parser* P, int* li) {
     s->is_global = 1;
     s->slot = g;
     s->e = e;
-    if (ls->top_tail) ls->top_tail->next = s;
-    else ls->top = s;
-    ls->top_tail = s;
+    append_top(ls, s);
   }
   ls->nfunc++;
   goto done;
@@ -1928,9 +1934,7 @@ static vd_status parse_toplevel_stmt(parser* P, int* li) {
       if (!s) return ls->err->status;
       if (s->op != S_ASSIGN)
         return perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0, "extern() expects NAME = value");
-      if (ls->top_tail) ls->top_tail->next = s;
-      else ls->top = s;
-      ls->top_tail = s;
+      append_top(ls, s);
       (*li)++;
       return VD_OK;
     }
@@ -1938,10 +1942,7 @@ static vd_status parse_toplevel_stmt(parser* P, int* li) {
   sparse S = {P, ls, NULL, 0, 0, 0};
   stmt* s = parse_statement(&S, li, ln->indent);
   if (!s) return ls->err->status ? ls->err->status : VD_ERR_NOMEM;
-  if (ls->top_tail) ls->top_tail->next = s;
-  else ls->top = s;
-  ls->top_tail = s;
-  while (ls->top_tail->next) ls->top_tail = ls->top_tail->next;
+  append_top(ls, s);
   return VD_OK;
 }
 

@@ -404,7 +404,7 @@ static void shape_tri(float* pos, float* nrm, int* k, vd_vec3 p, vd_quat q, cons
 // triangles of a shape (at most 2 x SHAPE_RINGS x SHAPE_SIDES + 2 x SHAPE_SIDES + 12)
 static int shape_tris(const vd_render_shape* s, vd_quat q, float* pos, float* nrm) {
   int k = 0;
-  if (s->kind == VD_SHAPE_BOX) {
+  if (s->kind == VD_RENDER_BOX) {
     // six faces, two triangles each, counter-clockwise seen from outside
     for (int axis = 0; axis < 3; axis++)
       for (int sign = -1; sign <= 1; sign += 2) {
@@ -429,7 +429,7 @@ static int shape_tris(const vd_render_shape* s, vd_quat q, float* pos, float* nr
   }
   // sphere or capsule: a UV sphere whose northern half (equator included) moves up by the
   // half-length and southern half down; ring e of RINGS + 2 is latitude ring lat[e]
-  double r = s->size[0], hl = s->kind == VD_SHAPE_CAPSULE ? s->size[1] : 0;
+  double r = s->size[0], hl = s->kind == VD_RENDER_CAPSULE ? s->size[1] : 0;
   for (int e = 0; e <= SHAPE_RINGS; e++) {
     int a = e <= SHAPE_RINGS / 2 ? e : e - 1, b = e + 1 <= SHAPE_RINGS / 2 ? e + 1 : e;
     double za = e <= SHAPE_RINGS / 2 ? hl : -hl, zb = e + 1 <= SHAPE_RINGS / 2 ? hl : -hl;
@@ -457,12 +457,12 @@ static int shape_tris(const vd_render_shape* s, vd_quat q, float* pos, float* nr
 }
 
 vd_status vd_render_add_shape(vd_renderer* r, const vd_render_shape* s, vd_error* err) {
-  int nsize = s->kind == VD_SHAPE_SPHERE ? 1 : s->kind == VD_SHAPE_CAPSULE ? 2 : 3;
-  if ((int)s->kind < VD_SHAPE_SPHERE || s->kind > VD_SHAPE_BOX)
+  int nsize = s->kind == VD_RENDER_SPHERE ? 1 : s->kind == VD_RENDER_CAPSULE ? 2 : 3;
+  if ((int)s->kind < VD_RENDER_SPHERE || s->kind > VD_RENDER_BOX)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "unknown shape kind %d", (int)s->kind);
   for (int k = 0; k < nsize; k++)
     if (!isfinite(s->size[k]) ||
-        !(s->size[k] > 0 || (s->kind == VD_SHAPE_CAPSULE && k == 1 && s->size[k] >= 0)))
+        !(s->size[k] > 0 || (s->kind == VD_RENDER_CAPSULE && k == 1 && s->size[k] >= 0)))
       return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
                           "shape size %d is %g: must be finite and > 0", k, s->size[k]);
   if (!isfinite(s->pos.x + s->pos.y + s->pos.z) ||

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// MuJoCo error trap (mj_trap.h): hooks that longjmp to the innermost open trap of the thread.
+#include "mj_trap.h"
+
+#include <mujoco/mujoco.h>
+#include <stdio.h>
+#include <string.h>
+
+// open traps of this thread, innermost first (MuJoCo's hooks take no user pointer)
+static _Thread_local vd_mj_trap* open_trap;
+
+static void on_error(const char* msg) {
+  vd_mj_trap* t = open_trap;
+  if (!t) {
+    // a MuJoCo call outside any trap: a programmer error, never a return into MuJoCo
+    vd_assert_fail("MuJoCo error outside a vd_mj_trap", __FILE__, __LINE__);
+    return;
+  }
+  snprintf(t->error, sizeof t->error, "%s", msg ? msg : "unknown MuJoCo error");
+  open_trap = t->outer; // closed: an error in the caller's recovery goes to the outer trap
+  longjmp(t->env, 1);
+}
+
+static void on_warning(const char* msg) {
+  vd_mj_trap* t = open_trap;
+  if (!t) return; // outside a trap a warning is dropped (mjData counts it in d->warning)
+  t->nwarning++;
+  snprintf(t->warning, sizeof t->warning, "%s", msg ? msg : "");
+}
+
+void vd_mj_trap_install(void) {
+  mju_user_error = on_error;
+  mju_user_warning = on_warning;
+}
+
+void vd_mj_trap_begin(vd_mj_trap* t) {
+  t->error[0] = t->warning[0] = 0;
+  t->nwarning = 0;
+  t->outer = open_trap;
+  open_trap = t;
+}
+
+void vd_mj_trap_end(vd_mj_trap* t) {
+  VD_ASSERT(open_trap == t);
+  open_trap = t->outer;
+}
+
+vd_status vd_mj_trap_status(const vd_mj_trap* t, vd_error* err) {
+  return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "MuJoCo: %s", t->error[0] ? t->error : "error");
+}
+
+vd_mj_trap* vd_mj_trap_current(void) {
+  return open_trap;
+}
