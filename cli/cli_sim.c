@@ -51,6 +51,12 @@ static const char* sim_help =
     "      --mass-damping C    velocity damping rate (1/s), default 0\n"
     "contacts and probes:\n"
     "      --ground Z          ground plane at height Z (m), default 0; --no-ground for none\n"
+    "      --collider-mesh FILE[:X,Y,Z]\n"
+    "                          closed triangle mesh (.obj, counter-clockwise from outside) as a\n"
+    "                          fixed collider, its origin placed at X,Y,Z (m); repeatable\n"
+    "      --self-collision    capsules and fruits collide with each other (default; neighbours\n"
+    "                          and parts touching in the modelled shape excluded);\n"
+    "                          --no-self-collision turns it off\n"
     "      --probe R:X0,Y0,Z0:X1,Y1,Z1[:T0:T1]\n"
     "                          kinematic sphere of radius R (m) moving from P0 to P1 (m) between\n"
     "                          T0 and T1 (s, default the whole run); repeatable\n"
@@ -65,6 +71,113 @@ static const char* sim_help =
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
     "                          axis), kinetic_energy (J), events, steps_per_second, ...\n";
+
+// a closed triangle mesh from a Wavefront OBJ file: "v x y z" and "f i j k ..." lines (1-based
+// or negative indices, "i/t/n" forms, polygons split in fans); other lines are skipped
+static vd_status read_obj(const char* path, double** vert, int* nvert, int** tri, int* ntri, vd_error* err) {
+  char* text;
+  size_t len;
+  vd_status st = vd_file_read(path, &text, &len, err);
+  if (st) return st;
+  int capv = 0, nv = 0, capt = 0, nt = 0, line = 0;
+  double* v = NULL;
+  int* t = NULL;
+  char* p = text;
+  while (*p && !st) {
+    line++;
+    char* e = strchr(p, '\n');
+    if (e) *e = 0;
+    char* s = p;
+    while (*s == ' ' || *s == '\t') s++;
+    if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
+      double x[3];
+      char* q = s + 1;
+      for (int k = 0; k < 3 && !st; k++) {
+        char* end;
+        x[k] = strtod(q, &end);
+        if (end == q || !isfinite(x[k]))
+          st = vd_error_set(err, VD_ERR_FORMAT, path, line, (int)(q - p) + 1, "expected a vertex coordinate (m)");
+        q = end;
+      }
+      if (!st && !vd_grow((void**)&v, &capv, nv + 1, 3 * sizeof(double)))
+        st = vd_error_set(err, VD_ERR_NOMEM, path, line, 0, "out of memory");
+      if (!st) memcpy(v + 3 * nv++, x, sizeof x);
+    } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
+      int idx[3], k = 0;
+      char* q = s + 1;
+      for (;;) {
+        while (*q == ' ' || *q == '\t' || *q == '\r') q++;
+        if (!*q) break;
+        char* end;
+        long i = strtol(q, &end, 10);
+        if (end == q || i == 0 || (i > 0 && i > nv) || (i < 0 && -i > nv)) {
+          st = vd_error_set(err, VD_ERR_FORMAT, path, line, (int)(q - p) + 1,
+                            "expected a vertex index in 1..%d or -%d..-1", nv, nv);
+          break;
+        }
+        int vi = i > 0 ? (int)i - 1 : nv + (int)i;
+        while (*end && *end != ' ' && *end != '\t' && *end != '\r') end++;  // skip "/t/n"
+        q = end;
+        if (k < 2) {
+          idx[k++] = vi;
+          continue;
+        }
+        idx[2] = vi;
+        if (!vd_grow((void**)&t, &capt, nt + 1, 3 * sizeof(int))) {
+          st = vd_error_set(err, VD_ERR_NOMEM, path, line, 0, "out of memory");
+          break;
+        }
+        memcpy(t + 3 * nt++, idx, sizeof idx);
+        idx[1] = vi;  // fan
+        k = 3;
+      }
+      if (!st && k < 3) st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "a face needs at least 3 vertices");
+    }
+    p = e ? e + 1 : p + strlen(p);
+  }
+  vd_free(text, len + 1);
+  if (!st && !nt) st = vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "no faces ('f' lines) in the mesh");
+  if (st) {
+    vd_free(v, (size_t)capv * 3 * sizeof(double));
+    vd_free(t, (size_t)capt * 3 * sizeof(int));
+    return st;
+  }
+  *vert = v, *nvert = nv, *tri = t, *ntri = nt;
+  // shrink to the exact sizes so the caller frees nv and nt rows
+  double* v2 = vd_realloc(v, (size_t)capv * 3 * sizeof(double), (size_t)nv * 3 * sizeof(double));
+  if (v2) *vert = v2;
+  int* t2 = vd_realloc(t, (size_t)capt * 3 * sizeof(int), (size_t)nt * 3 * sizeof(int));
+  if (t2) *tri = t2;
+  if (!v2 || !t2) {
+    vd_free(v2 ? v2 : v, v2 ? (size_t)nv * 3 * sizeof(double) : (size_t)capv * 3 * sizeof(double));
+    vd_free(t2 ? t2 : t, t2 ? (size_t)nt * 3 * sizeof(int) : (size_t)capt * 3 * sizeof(int));
+    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  }
+  return VD_OK;
+}
+
+// the distance grid of a mesh file; errors name the file
+static vd_status load_mesh_sdf(const char* path, vd_sdf** out, vd_error* err) {
+  if (!cli_has_ext(path, ".obj"))
+    return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "--collider-mesh reads Wavefront .obj files");
+  double* v = NULL;
+  int* t = NULL;
+  int nv = 0, nt = 0;
+  vd_status st = read_obj(path, &v, &nv, &t, &nt, err);
+  if (st) return st;
+  // grid spacing 2 mm, coarser for meshes over 0.256 m so the grid stays near 128 cells across
+  vd_sdf_def def = vd_sdf_def_default();
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, ext = 0;
+  for (int i = 0; i < nv; i++)
+    for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], v[3 * i + k]), hi[k] = fmax(hi[k], v[3 * i + k]);
+  for (int k = 0; k < 3; k++) ext = fmax(ext, hi[k] - lo[k]);
+  if (ext / 128 > def.cell) def.cell = ext / 128, def.band = 3 * def.cell, def.padding = 5 * def.cell;
+  st = vd_sdf_build(v, nv, t, nt, &def, out, err);
+  if (st && !err->file[0]) snprintf(err->file, sizeof err->file, "%s", path);
+  vd_free(v, (size_t)nv * 3 * sizeof(double));
+  vd_free(t, (size_t)nt * 3 * sizeof(int));
+  return st;
+}
 
 // ---------------------------------------------------------------------------------------------
 // option values
@@ -133,6 +246,9 @@ typedef struct sim_opts {
   double ramp;
   int ramp_set;
   const char* wind_file;
+  char mesh_path[8][512];  // --collider-mesh files
+  vd_vec3 mesh_pos[8];     // ... and their placements (m)
+  int nmesh;
   vd_sim_def def;
   vd_sim_opt opt;
 } sim_opts;
@@ -456,6 +572,7 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "segments", m->nseg);
   cJSON_AddNumberToObject(root, "total_mass", m->total_mass);
   cJSON_AddNumberToObject(root, "max_penetration", d->max_penetration);
+  cJSON_AddNumberToObject(root, "contacts", d->ncontact);
   cJSON_AddNumberToObject(root, "sag_free_out_of_reach", m->nsagfree_clamped);
   cJSON_AddNumberToObject(root, "warnings", (double)d->nwarning);
   char* text = cJSON_Print(root);
@@ -573,6 +690,21 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->no_ground = 0;
     } else if (!strcmp(a, "--no-ground")) {
       o->no_ground = 1;
+    } else if (!strcmp(a, "--collider-mesh")) {
+      VAL();
+      if (o->nmesh == 8) return cli_usage_error(cmd, "too many --collider-mesh options (8 at most)");
+      char* m = o->mesh_path[o->nmesh];
+      if (strlen(val) >= sizeof o->mesh_path[0]) return cli_usage_error(cmd, "--collider-mesh: path too long");
+      strcpy(m, val);
+      vd_vec3 at = vd_v3(0, 0, 0);
+      char* colon = strrchr(m, ':');
+      double x[3];
+      if (colon && parse_list(colon + 1, x, 3)) *colon = 0, at = vd_v3(x[0], x[1], x[2]);
+      o->mesh_pos[o->nmesh++] = at;
+    } else if (!strcmp(a, "--self-collision")) {
+      o->opt.self_collision = 1;
+    } else if (!strcmp(a, "--no-self-collision")) {
+      o->opt.self_collision = 0;
     } else if (!strcmp(a, "--probe")) {
       VAL();
       if (o->nprobe == 16) return cli_usage_error(cmd, "too many --probe options (16 at most)");
@@ -644,6 +776,7 @@ int cli_sim(int argc, char** argv) {
   vd_sim_data* d = NULL;
   double* wind = NULL;
   int nwind = 0;
+  vd_sdf* sdf[8] = {NULL};
   outputs out;
   memset(&out, 0, sizeof out);
   cli_grow_info info;
@@ -673,11 +806,18 @@ int cli_sim(int argc, char** argv) {
       st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   if (!st && !o.no_ground) {
-    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o.ground), vd_quat_identity(), vd_v3(0, 0, 0)};
+    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o.ground), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
     vd_sim_add_collider(d, &c);
   }
+  for (int k = 0; !st && k < o.nmesh; k++) {
+    st = load_mesh_sdf(o.mesh_path[k], &sdf[k], &err);
+    if (!st) {
+      vd_sim_collider c = {VD_SIM_MESH, {0, 0, 0}, o.mesh_pos[k], vd_quat_identity(), vd_v3(0, 0, 0), sdf[k]};
+      vd_sim_add_collider(d, &c);
+    }
+  }
   for (int k = 0; !st && k < o.nprobe; k++) {
-    vd_sim_collider c = {VD_SIM_SPHERE, {o.probe[k].r, 0, 0}, o.probe[k].p0, vd_quat_identity(), vd_v3(0, 0, 0)};
+    vd_sim_collider c = {VD_SIM_SPHERE, {o.probe[k].r, 0, 0}, o.probe[k].p0, vd_quat_identity(), vd_v3(0, 0, 0), NULL};
     o.probe[k].id = vd_sim_add_collider(d, &c);
   }
   if (st) {
@@ -785,5 +925,6 @@ done:
   vd_model_destroy(plant);
   vd_plant_spec_destroy(spec);
   vd_free(wind, (size_t)nwind * 4 * sizeof(double));
+  for (int k = 0; k < 8; k++) vd_sdf_destroy(sdf[k]);
   return code;
 }

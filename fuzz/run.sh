@@ -38,7 +38,8 @@ for t in $TARGETS; do
   log="$OUT/$t.log"
   touch "$OUT/$t.stamp"
   # the first crash, leak or timeout stops the run; its input is saved in findings/<target>/
-  dict=lsys.dict; [ "$t" = fuzz_plant_json ] && dict=plant_json.dict; [ "$t" = fuzz_cloud ] && dict=cloud.dict; [ "$t" = fuzz_curves ] && dict=curves.dict
+  dict=lsys.dict; [ "$t" = fuzz_plant_json ] && dict=plant_json.dict; [ "$t" = fuzz_cloud ] && dict=cloud.dict
+  [ "$t" = fuzz_curves ] && dict=curves.dict
   [ "$t" = fuzz_frames ] && dict=frames.dict
   "$bin" -max_len=4096 -timeout=5 -rss_limit_mb=2048 -max_total_time="$SECONDS_PER" \
     -dict="fuzz/$dict" -print_final_stats=1 -artifact_prefix="$OUT/findings/$t/" \

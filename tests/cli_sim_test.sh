@@ -128,6 +128,37 @@ else
   ok "unwritable output (skipped as root)"
 fi
 
+# mesh colliders and self-collision: a cube mesh on the tomato, no penetration; bad meshes exit 2
+cat >"$T/cube.obj" <<'EOF'
+# cube of half size 0.05 m, faces counter-clockwise from outside
+v -0.05 -0.05 -0.05
+v 0.05 -0.05 -0.05
+v -0.05 0.05 -0.05
+v 0.05 0.05 -0.05
+v -0.05 -0.05 0.05
+v 0.05 -0.05 0.05
+v -0.05 0.05 0.05
+v 0.05 0.05 0.05
+f 1 3 4 2
+f 5 6 8 7
+f 1/1 2/2 6/3 5/4
+f 3 7 8 4
+f -8 -4 -2 -6
+f 2 4 8 6
+EOF
+expect "sim mesh collider" 0 "$V" sim "$SRC/data/tomato.lpy" --duration 0.05 --stats --collider-mesh "$T/cube.obj:0.08,0,0.25"
+json_check "sim mesh collider contacts" "d['contacts'] > 2 and d['max_penetration'] < 1e-4 and d['warnings'] == 0"
+expect "sim no self-collision" 0 "$V" sim "$SRC/data/tomato.lpy" --duration 0.02 --stats --no-self-collision --no-ground
+json_check "sim no self-collision contacts" "d['contacts'] == 0"
+head -9 "$T/cube.obj" >"$T/bad.obj"
+echo "f 1 2 x" >>"$T/bad.obj"
+expect "sim mesh bad index" 2 "$V" sim "$T/p.lpy" --stats --collider-mesh "$T/bad.obj"
+expect_err "sim mesh bad index names line and column" "bad.obj:10:7: expected a vertex index"
+head -14 "$T/cube.obj" >"$T/open.obj"
+expect "sim mesh open" 2 "$V" sim "$T/p.lpy" --stats --collider-mesh "$T/open.obj"
+expect_err "sim mesh open is named" "open.obj: .*not closed"
+expect "sim mesh not obj" 2 "$V" sim "$T/p.lpy" --stats --collider-mesh "$T/cube.ply"
+
 # validate: a subset as JSON, all passing, with the documented fields
 expect "validate json" 0 "$V" validate --json --case cantilever_tip --no-progress
 json_check "validate fields" "len(d) == 2 and all(set(r) >= {'name','measured','reference','error','tolerance','pass'} and r['pass'] for r in d)"

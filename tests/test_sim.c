@@ -178,7 +178,7 @@ TEST(sim, out_of_memory) {
     CHECK(st == VD_OK || st == VD_ERR_NOMEM);
     if (!st) d = vd_sim_data_create(m);
     if (d) {
-      vd_sim_collider c = {VD_SIM_SPHERE, {0.05, 0, 0}, vd_v3(0.1, 0, 0.02), vd_quat_identity(), vd_v3(0, 0, 0)};
+      vd_sim_collider c = {VD_SIM_SPHERE, {0.05, 0, 0}, vd_v3(0.1, 0, 0.02), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
       vd_sim_add_collider(d, &c);
       for (int i = 0; i < 3; i++) vd_sim_step(m, d);
       done = vd_sim_add_tie(d, 2, vd_v3(0, 0, 0), 1e-4) >= 0;
@@ -212,7 +212,7 @@ TEST(sim, determinism) {
   for (int run = 0; run < 2; run++) {
     vd_sim_data* d = vd_sim_data_create(m);
     REQUIRE(d);
-    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+    vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
     vd_sim_add_collider(d, &c);
     for (int i = 0; i < 60; i++) CHECK(vd_sim_step(m, d) == VD_OK);
     h[run] = state_hash(m, d);
@@ -332,11 +332,11 @@ TEST(sim, contacts) {
   REQUIRE(vd_sim_build(pm, &def, &m, &e) == VD_OK);
   vd_sim_data* d = vd_sim_data_create(m);
   REQUIRE(d);
-  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, -0.02), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, -0.02), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   CHECK_INT(vd_sim_add_collider(d, &g), 0);
   // an upright capsule sweeps sideways through the rod (one-way coupling cannot resolve a
   // rod pinched between two colliders, so the sweep keeps clear of the ground)
-  vd_sim_collider p = {VD_SIM_CAPSULE, {0.02, 0.05, 0}, vd_v3(0.25, 0.1, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider p = {VD_SIM_CAPSULE, {0.02, 0.05, 0}, vd_v3(0.25, 0.1, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   int id = vd_sim_add_collider(d, &p);
   double worst = 0;
   int touched = 0;
@@ -457,6 +457,72 @@ TEST(sim, self_contact_projection) {
   for (int k = 0; k < 4; k++) mom1 = vd_madd(mom1, d->node_pos[nodes[k]], d->node_mass[nodes[k]]);
   CHECK(v_norm(vd_sub(mom1, mom0)) < 1e-12);
   vd_sim_data_destroy(d);
+  vd_sim_model_destroy(m);
+  vd_model_destroy(pm);
+}
+
+TEST(sim, self_collision_rest) {
+  // neighbours are excluded: a sagging straight rod, with or without a fruit on its tip, has
+  // no self-contact candidates; turned off, no self-contacts are looked for at all
+  for (int fruit = 0; fruit < 2; fruit++) {
+    vd_model* pm = cantilever(0.4, 0.003, fruit);
+    REQUIRE(pm);
+    vd_sim_def def = cantilever_def(0.02, 5e7, 1000);
+    vd_sim_model* m = NULL;
+    vd_error e = {0};
+    REQUIRE(vd_sim_build(pm, &def, &m, &e) == VD_OK);
+    CHECK_INT(m->opt.self_collision, 1);
+    m->opt.contacts = 1;
+    vd_sim_data* d = vd_sim_data_create(m);
+    REQUIRE(d);
+    const sim_work* w = (const sim_work*)d->work;
+    CHECK(w->self.ncap > 0);
+    CHECK_INT(w->self.nsph, fruit);
+    CHECK(w->self.ex.nexclude > 0);
+    int most = 0;
+    for (int k = 0; k < 200; k++) {
+      CHECK_INT(vd_sim_step(m, d), VD_OK);
+      if (d->ncontact > most) most = d->ncontact;
+    }
+    CHECK_INT(most, 0);
+    CHECK(vd_sim_max_displacement(m, d, NULL) > 1e-3);  // it did move
+    vd_sim_data_destroy(d);
+    vd_sim_model_destroy(m);
+    vd_model_destroy(pm);
+  }
+}
+
+TEST(sim, self_collision_fold) {
+  // a rod folded back over itself by hand: the step's self-contacts push the overlap out
+  vd_model* pm = cantilever(0.4, 0.003, 0);
+  REQUIRE(pm);
+  vd_sim_def def = cantilever_def(0.02, 5e7, 1000);
+  vd_sim_model* m = NULL;
+  vd_error e = {0};
+  REQUIRE(vd_sim_build(pm, &def, &m, &e) == VD_OK);
+  m->opt.gravity = vd_v3(0, 0, 0);
+  m->opt.contacts = 1;
+  for (int on = 0; on < 2; on++) {
+    m->opt.self_collision = on;
+    vd_sim_data* d = vd_sim_data_create(m);
+    REQUIRE(d);
+    int s1 = 3, s2 = 12;
+    int a = m->seg_node[2 * s2], b = m->seg_node[2 * s2 + 1];
+    vd_vec3 p1 = d->node_pos[m->seg_node[2 * s1]], p2 = d->node_pos[m->seg_node[2 * s1 + 1]];
+    d->node_pos[a] = vd_add(p2, vd_v3(0, 0, 0.002));
+    d->node_pos[b] = vd_add(p1, vd_v3(0, 0, 0.002));
+    sim_contact c = {-1, s1, 0.5, m->seg_radius[s1], -1, 0, -1, s2, 0.5, m->seg_radius[s2]};
+    CHECK(sim_contact_gap(m, d, &c) < -0.003);
+    CHECK_INT(vd_sim_step(m, d), VD_OK);
+    if (on) {
+      CHECK(d->ncontact > 0);
+      CHECK(d->max_penetration < 1e-6);
+      CHECK(sim_contact_gap(m, d, &c) > -1e-6);
+    } else {
+      CHECK_INT(d->ncontact, 0);
+    }
+    vd_sim_data_destroy(d);
+  }
   vd_sim_model_destroy(m);
   vd_model_destroy(pm);
 }

@@ -30,7 +30,7 @@ TEST(validate, large_deflection) { run("large_deflection", 12); }
 TEST(validate, frequency) { run("frequency", 5); }
 TEST(validate, buckling) { run("buckling", 4); }
 TEST(validate, fracture) { run("fracture", 2); }
-TEST(validate, contacts) { run("no_penetration", 3); }
+TEST(validate, contacts) { run("no_penetration", 6); }
 TEST(validate, independence) { run("independence", 4); }
 TEST(validate, sag_free) { run("sag_free", 3); }
 TEST(validate, filter_and_empty) {

@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   double* stress = malloc(sizeof(double) * (size_t)pm->nseg);
   if (!sd || !pd || !stress) return 1;
   vd_sim_collider probe = {
-      VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.4, 0, 0.8), vd_quat_identity(), vd_v3(0, 0, 0)};
+      VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.4, 0, 0.8), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   int pid = vd_sim_add_collider(sd, &probe);
   // the run: a frame every 1/30 s, written as frames.bin; the probe's positions kept
   char path[4200];

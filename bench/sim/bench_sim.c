@@ -41,8 +41,9 @@ static vd_model* grow(const char* path) {
   return m;
 }
 
-// a plant run: sag-free plant, ground, a probe sweeping through the crown
-static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_solver solver, int iters, double secs) {
+// a plant run: sag-free plant, ground, a probe sweeping through the crown; self: self-collision
+static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_solver solver, int iters, double secs,
+                      int self) {
   vd_sim_def def = vd_sim_def_default();
   def.sag_free = 1;
   vd_sim_model* m = NULL;
@@ -53,13 +54,14 @@ static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_so
   }
   m->opt.solver = solver;
   m->opt.iterations = iters;
+  m->opt.self_collision = self;
   vd_sim_data* d = vd_sim_data_create(m);
-  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   vd_sim_add_collider(d, &g);
   // the probe crosses the plant at 60 % of its height
   double top = 0;
   for (int i = 0; i < m->nnode; i++) top = fmax(top, m->node_pos0[i].z);
-  vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.5, 0, 0.6 * top), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.5, 0, 0.6 * top), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   int id = vd_sim_add_collider(d, &p);
   int steps = (int)(secs / m->opt.dt + 0.5);
   double w0 = now(), c0 = cpu();
@@ -71,10 +73,10 @@ static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_so
   int dyn = 0;
   for (int t = 0; t < m->nseg; t++) dyn += !(m->seg_flags[t] & VD_SIM_FIXED);
   double sps = steps / ct;
-  printf("%-8s %-6s %4d it  %6d seg  %8.0f steps/s  %6.2fx real time  %6.2f us/seg-step  (wall %.2f s, %lld warnings)\n", name,
-         solver == VD_SIM_GS ? "gs" : "direct", iters, dyn, sps, sps * m->opt.dt, 1e6 * ct / steps / dyn, wall,
-         (long long)d->nwarning);
-  fprintf(csv, "plant,%s,%s,%d,%d,%d,%.6f,%.6f,%.1f,%.3f,%.4f,,\n", name, solver == VD_SIM_GS ? "gs" : "direct", iters,
+  printf("%-8s %-6s %4d it  %6d seg  %8.0f steps/s  %6.2fx real time  %6.2f us/seg-step  (wall %.2f s, %lld warnings)%s\n",
+         name, solver == VD_SIM_GS ? "gs" : "direct", iters, dyn, sps, sps * m->opt.dt, 1e6 * ct / steps / dyn, wall,
+         (long long)d->nwarning, self ? "" : "  no self-collision");
+  fprintf(csv, "plant,%s%s,%s,%d,%d,%d,%.6f,%.6f,%.1f,%.3f,%.4f,,\n", name, self ? "" : "_noself", solver == VD_SIM_GS ? "gs" : "direct", iters,
           dyn, steps, ct, wall, sps, sps * m->opt.dt, 1e6 * ct / steps / dyn);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);
@@ -244,10 +246,12 @@ int main(int argc, char** argv) {
   static const int ns[5] = {5, 10, 20, 40, 80};
   for (int k = 0; k < 5; k++) cantilever_run(csv, ns[k], ref);
   printf("== plants at dt = 1 ms (sag-free, ground, a probe through the crown); CPU time\n");
-  plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 1, quick ? 0.3 : 2.0);
-  plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 2, quick ? 0.3 : 1.0);
-  plant_run(csv, "tomato", tomato, VD_SIM_GS, 10, quick ? 0.2 : 1.0);
-  plant_run(csv, "tree", tree, VD_SIM_DIRECT, 1, quick ? 0.05 : 0.3);
+  plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 1, quick ? 0.3 : 2.0, 1);
+  plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 1, quick ? 0.3 : 2.0, 0);
+  plant_run(csv, "tomato", tomato, VD_SIM_DIRECT, 2, quick ? 0.3 : 1.0, 1);
+  plant_run(csv, "tomato", tomato, VD_SIM_GS, 10, quick ? 0.2 : 1.0, 1);
+  plant_run(csv, "tree", tree, VD_SIM_DIRECT, 1, quick ? 0.05 : 0.3, 1);
+  plant_run(csv, "tree", tree, VD_SIM_DIRECT, 1, quick ? 0.05 : 0.3, 0);
   printf("== solver choice: settled sag of a 1 m cantilever (40 segments) after 3 s of damped dynamics\n");
   static const int gs_it[5] = {5, 20, 50, 200, 1000};
   for (int k = 0; k < 2; k++) {

@@ -184,10 +184,10 @@ typedef enum vd_render_shape_kind {
 // A solid: a probe, a tool, an obstacle.
 typedef struct vd_render_shape {
   vd_render_shape_kind kind; // shape
-  double size[3];            // sizes (m), see vd_render_shape_kind
-  vd_vec3 pos;               // centre (m)
-  vd_quat quat;              // orientation (normalised here)
-  float rgb[3];              // colour in [0, 1]
+  double size[3];     // sizes (m), see vd_render_shape_kind
+  vd_vec3 pos;        // centre (m)
+  vd_quat quat;       // orientation (normalised here)
+  float rgb[3];       // colour in [0, 1]
 } vd_render_shape;
 
 // Add a solid; its pixels carry label VD_RENDER_ROBOT_LABEL and instance 0 in the masks, like a

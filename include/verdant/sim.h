@@ -24,6 +24,7 @@
 #ifndef VERDANT_SIM_H
 #define VERDANT_SIM_H
 
+#include "verdant/collide.h"
 #include "verdant/core.h"
 #include "verdant/plant.h"
 
@@ -121,12 +122,15 @@ typedef struct vd_sim_opt {
   int fracture;               // 1: joints break at their thresholds
   int contacts;               // 1: colliders are projected
   double friction;            // Coulomb friction coefficient of contacts (-)
+  int self_collision;         // 1: the plant's capsules and fruit spheres collide with each other
+                              // (vd_collide_self; topological neighbours and pairs touching in
+                              // the modelled shape excluded)
 } vd_sim_opt;
 
 // Defaults: dt 1e-3 s, iterations 1, solver direct, gravity (0, 0, -9.81) m/s^2,
 // air_density 1.226 kg/m^3, wind 0 m/s, gust_amplitude 0, gust_period 2 s, no wind series,
 // drag 1, stokes_viscosity 0 Pa s, damping 0 s, mass_damping 0 1/s, fracture 1, contacts 1,
-// friction 0.5.
+// friction 0.5, self_collision 1.
 vd_sim_opt vd_sim_opt_default(void);
 
 // rod segment flags
@@ -200,7 +204,9 @@ typedef enum vd_sim_shape {
   VD_SIM_PLANE = 0,  // half-space below the plane through pos with normal +z of quat
   VD_SIM_SPHERE,     // sphere of radius size[0] at pos
   VD_SIM_CAPSULE,    // capsule of radius size[0], half-length size[1] along z of quat
-  VD_SIM_BOX         // box of half-extents size[0..2] in the frame of quat
+  VD_SIM_BOX,        // box of half-extents size[0..2] in the frame of quat
+  VD_SIM_MESH        // closed triangle mesh through its signed distance grid sdf, placed at
+                     // pos / quat (the grid's local frame)
 } vd_sim_shape;
 
 typedef struct vd_sim_collider {
@@ -209,6 +215,7 @@ typedef struct vd_sim_collider {
   vd_vec3 pos;         // position (m)
   vd_quat quat;        // orientation
   vd_vec3 vel;         // velocity (m/s), set by vd_sim_set_collider_pose from pose changes
+  const vd_sdf* sdf;   // VD_SIM_MESH: the mesh's distance grid (not owned; outlives the state)
 } vd_sim_collider;
 
 // One fracture: the joint of segment seg with its parent broke at time t.

@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: MIT
-// External colliders until the collide module takes over: analytic signed distances of a
-// plane, sphere, capsule and box, contact candidates against node spheres and segment
-// capsules, and their XPBD projection (compliance 0) with Coulomb friction. The interface
-// (sim_contacts_find / _project / _friction in sim_internal.h) is what the collide module's
-// generator (SDF grids, triangle meshes, self-contact with a broad phase) plugs into.
+// External colliders: analytic signed distances of a plane, sphere, capsule and box, closed
+// triangle meshes through the collide module's signed distance grids, contact candidates against node spheres and segment
+// capsules, and their XPBD projection (compliance 0) with Coulomb friction; self-contacts come
+// from vd_collide_self (sim_self.c) and are projected here too.
 #include "sim_internal.h"
 
 double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* normal) {
@@ -54,6 +53,15 @@ double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* norma
       *normal = q_rotate(k->quat, g);
       return dist;
     }
+    case VD_SIM_MESH: {
+      // the collide module's grid in the mesh frame: interpolated distance and its gradient
+      if (!k->sdf) break;
+      vd_vec3 g;
+      double dist = vd_sdf_eval(k->sdf, q_rotate(q_conj(k->quat), v), &g);
+      double gn = v_norm(g);
+      *normal = gn > 1e-15 ? q_rotate(k->quat, vd_scale(g, 1.0 / gn)) : vd_v3(0, 0, 1);
+      return dist;
+    }
   }
   *normal = vd_v3(0, 0, 1);
   return 1e300;
@@ -90,13 +98,21 @@ static double closest_t_seg(vd_vec3 a, vd_vec3 b, vd_vec3 c, vd_vec3 dd) {
 }
 
 // best parameter along the segment for a collider: exact for spheres and capsules, the
-// deepest of 9 equidistant samples for boxes (as Gazebo Plants samples capsules)
+// deepest of 9 equidistant samples for boxes (as Gazebo Plants samples capsules), the collide
+// module's search along the axis for meshes
 static double seg_param(const vd_sim_collider* k, vd_vec3 a, vd_vec3 b) {
   switch (k->shape) {
     case VD_SIM_SPHERE: return closest_t(a, b, k->pos);
     case VD_SIM_CAPSULE: {
       vd_vec3 ax = q_rotate(k->quat, vd_v3(0, 0, k->size[1]));
       return closest_t_seg(a, b, vd_sub(k->pos, ax), vd_add(k->pos, ax));
+    }
+    case VD_SIM_MESH: {
+      // the collide module's axis search: samples every half cell, then a golden-section refine
+      if (!k->sdf) return 0;
+      vd_pose pose = {k->pos, k->quat};
+      vd_collider c = vd_collider_sdf(pose, k->sdf);
+      return vd_collide_capsule(&c, a, b, 0, 0).t;
     }
     default: {
       double best = 1e300, bt = 0;

@@ -38,6 +38,13 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
   }
   w->cap_tie_lambda = (int)ntl;
   w->model_ties = m->ntie;
+  // self-collision primitives and their exclusion, from the modelled shape
+  vd_error err;
+  if (sim_self_init(m, &w->self, &err)) {
+    vd_free(w->tie_lambda, ntl * 3 * D);
+    vd_free(blk, top);
+    return NULL;
+  }
   for (int t = 0; t < m->nseg; t++)
     if (m->seg_spare[t] >= 0) w->spare_of[m->seg_spare[t] - m->nnode] = t;
   *bytes = top;
@@ -46,6 +53,7 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
 
 static void work_free(sim_work* w, size_t bytes) {
   if (!w) return;
+  sim_self_free(&w->self);
   vd_free(w->tie_lambda, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
   vd_free(w, bytes);
 }
@@ -96,6 +104,7 @@ void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d) {
   for (int t = 0; t < ns; t++) d->seg_start[t] = m->seg_node[2 * t];
   sim_work* w = (sim_work*)d->work;
   memset(w->tie_lambda, 0, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
+  w->self.have_pairs = 0;
   d->time = 0;
   d->nstep = 0;
   d->nevent = 0;

@@ -129,6 +129,31 @@ void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double
 void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t);
 
 // ---------------------------------------------------------------------------------------------
+// self-collision primitives (sim_self.c): capsule k is segment cap_seg[k], sphere k is the
+// fruit node sph_node[k]; built once per state, refreshed from the positions every step
+
+typedef struct sim_self {
+  int ncap, nsph;            // capsules (segments but fruit stalks) and spheres (fruit nodes)
+  int* cap_seg;              // segment of each capsule (ncap)
+  int* cap_node;             // current end nodes of each capsule (ncap x 2)
+  double* cap_radius;        // radius at both ends (m) (ncap x 2)
+  int* sph_node;             // node of each sphere (nsph)
+  double* sph_pos;           // sphere centres, refreshed each step (m) (nsph x 3)
+  double* sph_radius;        // sphere radii (m) (nsph)
+  vd_collide_exclusion ex;   // neighbours and pairs touching in the modelled shape
+  // candidate pairs reused over steps (a Verlet list): valid while no node has moved more than
+  // (grow - margin) / 2 from pos_built and no joint has broken since
+  vd_arena pair_arena;       // holds pairs
+  vd_pair_list pairs;        // broad-phase pairs of the last build
+  vd_vec3* pos_built;        // node positions at that build (m) (nnode_all)
+  double grow;               // box growth used at that build (m)
+  int have_pairs;            // 0: build at the next step
+  int nevent_built;          // fracture events at that build
+  void* block;               // the arrays above but ex and pairs (one allocation)
+  size_t nbytes;             // its size
+} sim_self;
+
+// ---------------------------------------------------------------------------------------------
 // solver scratch kept in vd_sim_data::work
 
 typedef struct sim_work {
@@ -152,6 +177,7 @@ typedef struct sim_work {
   int cap_tie_lambda;   // capacity of tie_lambda (rows)
   int model_ties;       // stake ties of the model (the first rows)
   int gravity_only;     // scratch flag
+  sim_self self;        // self-collision primitives and exclusion
 } sim_work;
 
 // Allocate the work block for a model; NULL when out of memory. *bytes gets its size.
@@ -203,6 +229,14 @@ typedef struct sim_contact {
 // Find contact candidates at the current (predicted) state, within margin (m); results go to
 // the arena. Returns the count (0 when none or the arena fails; failures counted as warnings).
 int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_contact** out);
+// Build the self-collision primitives and exclusion of a model (zeroed on failure).
+vd_status sim_self_init(const vd_sim_model* m, sim_self* s, vd_error* err);
+// Free them (a zeroed one is fine).
+void sim_self_free(sim_self* s);
+// Append the self-contacts within margin (m) at the current state to the nprev contacts in prev;
+// *out gets the joined list (in the arena). Returns the new count.
+int sim_self_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_contact* prev, int nprev,
+                  sim_contact** out);
 // Project contacts: push penetrating rod elements out of the colliders (compliance 0).
 void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n);
 // Coulomb friction on the step's tangential motion at each active contact.

@@ -154,14 +154,16 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
   // contact candidates near the predicted state
   c.contacts = NULL;
   c.ncontact = 0;
-  if (m->opt.contacts && d->ncollider) {
+  if (m->opt.contacts && (d->ncollider || m->opt.self_collision)) {
     double vmax = 0;
     for (int i = 0; i < na; i++)
       if (sim_node_w(m, d, i) > 0) {
         double s = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
         if (s > vmax) vmax = s;
       }
-    c.ncontact = sim_contacts_find(m, d, 2 * vmax + 0.005, &c.contacts);
+    if (d->ncollider) c.ncontact = sim_contacts_find(m, d, 2 * vmax + 0.005, &c.contacts);
+    // self-contacts: both elements move, so twice the margin
+    if (m->opt.self_collision) c.ncontact = sim_self_find(m, d, 4 * vmax + 0.002, c.contacts, c.ncontact, &c.contacts);
   }
   // constraints
   // statics needs the primal residual that only the direct solver keeps

@@ -920,8 +920,30 @@ static void case_contacts(vctx* v) {
   const char* nm = "no_penetration";
   if (!want(v, nm)) return;
   progress(v, nm);
-  static const char* what[3] = {"ground plane", "moving sphere probe", "moving box"};
-  for (int k = 0; k < 3; k++) {
+  static const char* what[4] = {"ground plane", "moving sphere probe", "moving box",
+                                 "moving closed cube mesh through its signed distance grid"};
+  // the mesh: a cube of half size 0.04 m as 12 triangles, wound counter-clockwise from outside
+  double cv[24];
+  int ct[36];
+  for (int i = 0; i < 8; i++)
+    cv[3 * i] = i & 1 ? 0.04 : -0.04, cv[3 * i + 1] = i & 2 ? 0.04 : -0.04, cv[3 * i + 2] = i & 4 ? 0.04 : -0.04;
+  static const int quad[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+  for (int f = 0; f < 6; f++)
+    for (int h = 0; h < 2; h++) {
+      int* t = ct + 6 * f + 3 * h;
+      t[0] = quad[f][0], t[1] = quad[f][1 + h], t[2] = quad[f][2 + h];
+      // outward: the normal points away from the centre
+      vd_vec3 a = vd_v3(cv[3 * t[0]], cv[3 * t[0] + 1], cv[3 * t[0] + 2]);
+      vd_vec3 b = vd_v3(cv[3 * t[1]], cv[3 * t[1] + 1], cv[3 * t[1] + 2]);
+      vd_vec3 c = vd_v3(cv[3 * t[2]], cv[3 * t[2] + 1], cv[3 * t[2] + 2]);
+      if (vd_dot(vd_cross(vd_sub(b, a), vd_sub(c, a)), vd_add(vd_add(a, b), c)) < 0) {
+        int x = t[1];
+        t[1] = t[2], t[2] = x;
+      }
+    }
+  vd_sdf* sdf = NULL;
+  if ((v->st = vd_sdf_build(cv, 8, ct, 12, NULL, &sdf, v->err))) return;
+  for (int k = 0; k < 4 && !v->st; k++) {
     rod rd = {20, 0.5, 0.003, k ? 1e8 : 2e6, 0.3, 1000, {1, 0, 0}, 0};
     built b;
     if ((v->st = build_rod(&rd, &b, v->err))) return;
@@ -943,6 +965,12 @@ static void case_contacts(vctx* v) {
       c.size[0] = c.size[1] = 0.04, c.size[2] = 0.02;
       c.quat = vd_quat_axis_angle(vd_v3(0, 1, 0), 0.3);
       p0 = vd_v3(0.4, 0, 0.1), p1 = vd_v3(0.3, 0, -0.3);
+      if (k == 3) {
+        c.shape = VD_SIM_MESH;
+        c.sdf = sdf;
+        c.quat = vd_quat_axis_angle(vd_v3(1, 1, 0.3), 0.5);
+        p0 = vd_v3(0.4, 0, 0.12);
+      }
     }
     if (k) c.pos = p0;
     int id = vd_sim_add_collider(b.d, &c);
@@ -958,11 +986,128 @@ static void case_contacts(vctx* v) {
       touched |= b.d->ncontact > 0;
     }
     char name[64];
-    snprintf(name, sizeof name, "no_penetration_%s", k == 0 ? "ground" : k == 1 ? "sphere" : "box");
+    snprintf(name, sizeof name, "no_penetration_%s", k == 0 ? "ground" : k == 1 ? "sphere" : k == 2 ? "box" : "mesh");
     check(v, name, "continuum", "deepest penetration (m)", maxpen, 0, 1e-4, 1,
           "cantilever of capsules against a %s (signed distance), 1 s, h = 1 ms%s", what[k], touched ? "" : " [no contact]");
     built_free(&b);
   }
+  vd_sdf_destroy(sdf);
+}
+
+// closest distance between the segments a-b and c-d (Ericson 2004, 5.1.9)
+static double seg_seg_dist(vd_vec3 a, vd_vec3 b, vd_vec3 c, vd_vec3 dd) {
+  vd_vec3 d1 = vd_sub(b, a), d2 = vd_sub(dd, c), r = vd_sub(a, c);
+  double aa = vd_dot(d1, d1), e = vd_dot(d2, d2), f = vd_dot(d2, r), s = 0, t = 0;
+  if (aa <= 1e-30 && e <= 1e-30) return v_norm(r);
+  if (aa <= 1e-30) {
+    t = f / e;
+  } else {
+    double cc = vd_dot(d1, r);
+    if (e <= 1e-30) {
+      s = -cc / aa;
+    } else {
+      double bb = vd_dot(d1, d2), den = aa * e - bb * bb;
+      s = den > 1e-30 ? (bb * f - cc * e) / den : 0;
+      s = s < 0 ? 0 : s > 1 ? 1 : s;
+      t = (bb * s + f) / e;
+      if (t < 0) t = 0, s = -cc / aa;
+      else if (t > 1) t = 1, s = (bb - cc) / aa;
+    }
+  }
+  s = s < 0 ? 0 : s > 1 ? 1 : s;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  return v_norm(vd_sub(vd_madd(a, d1, s), vd_madd(c, d2, t)));
+}
+
+// two crossing cantilevers, the upper one pushed down through the lower one; the deepest
+// overlap of their capsules (exact segment-segment distances over all pairs of the two rods)
+static double crossing_rods(vctx* v, int self, int* ncontact_max) {
+  vd_plant_spec* s = vd_plant_spec_create();
+  if (!s) {
+    v->st = vd_error_set(v->err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
+    return NAN;
+  }
+  const double r = 0.004, z = 0.02, l = 0.3;
+  vd_segment_spec g = vd_segment_spec_default();
+  g.r0 = g.r1 = r, g.label = 1, g.up = vd_v3(0, 0, 1);
+  // rod A along +x at height 0, rod B along +y at height z crossing A's middle
+  int a0 = vd_plant_add_node(s, vd_v3(-0.01, 0, 0)), a1 = vd_plant_add_node(s, vd_v3(0, 0, 0));
+  int a2 = vd_plant_add_node(s, vd_v3(l, 0, 0));
+  int b0 = vd_plant_add_node(s, vd_v3(l / 2, -l / 2 - 0.01, z)), b1 = vd_plant_add_node(s, vd_v3(l / 2, -l / 2, z));
+  int b2 = vd_plant_add_node(s, vd_v3(l / 2, l / 2, z));
+  g.node0 = a0, g.node1 = a1, g.instance = 1;
+  int sa = vd_plant_add_segment(s, &g);
+  g.node0 = a1, g.node1 = a2, g.parent = sa, g.instance = 2;
+  vd_plant_add_segment(s, &g);
+  g.node0 = b0, g.node1 = b1, g.parent = -1, g.instance = 3, g.up = vd_v3(1, 0, 0);
+  int sb = vd_plant_add_segment(s, &g);
+  g.node0 = b1, g.node1 = b2, g.parent = sb, g.instance = 4;
+  vd_plant_add_segment(s, &g);
+  built b;
+  memset(&b, 0, sizeof b);
+  vd_status st = vd_plant_set_label(s, 1, "stem");
+  if (!st) st = vd_plant_compile(s, &b.pm, v->err);
+  vd_plant_spec_destroy(s);
+  vd_sim_def def = vd_sim_def_default();
+  def.segment_length = 0.02, def.clamp_length = 0.01;
+  for (int k = 0; k < VD_SIM_CLASS_COUNT; k++) {
+    def.material[k].young = 1e8, def.material[k].density = 1000;
+    def.material[k].break_force = def.material[k].break_moment = INFINITY;
+  }
+  if (!st) st = vd_sim_build(b.pm, &def, &b.m, v->err);
+  if (!st && !(b.d = vd_sim_data_create(b.m))) st = vd_error_set(v->err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
+  if (st) {
+    v->st = st;
+    built_free(&b);
+    return NAN;
+  }
+  vd_sim_model* m = b.m;
+  m->opt.drag = 0, m->opt.gravity = vd_v3(0, 0, 0), m->opt.contacts = 1, m->opt.self_collision = self;
+  m->opt.mass_damping = 5;
+  // the node of rod B nearest the crossing, pushed down by a force ramped over 0.5 s
+  int push = -1;
+  double best = 1e300;
+  for (int i = 0; i < m->nnode; i++) {
+    double e = v_norm(vd_sub(m->node_pos0[i], vd_v3(l / 2, 0, z)));
+    if (e < best) best = e, push = i;
+  }
+  double deepest = 0;
+  *ncontact_max = 0;
+  while (b.d->time < 1.0 - 1e-12) {
+    double ramp = b.d->time < 0.5 ? b.d->time / 0.5 : 1.0;
+    b.d->node_force[push] = vd_v3(0, 0, -1.0 * ramp);
+    vd_sim_step(m, b.d);
+    if (b.d->ncontact > *ncontact_max) *ncontact_max = b.d->ncontact;
+    for (int i = 0; i < m->nseg; i++) {
+      if (m->seg_instance[i] > 2) continue;
+      for (int j = 0; j < m->nseg; j++) {
+        if (m->seg_instance[j] <= 2) continue;
+        double dist = seg_seg_dist(b.d->node_pos[b.d->seg_start[i]], b.d->node_pos[m->seg_node[2 * i + 1]],
+                                   b.d->node_pos[b.d->seg_start[j]], b.d->node_pos[m->seg_node[2 * j + 1]]);
+        double pen = m->seg_radius[i] + m->seg_radius[j] - dist;
+        if (pen > deepest) deepest = pen;
+      }
+    }
+  }
+  built_free(&b);
+  return deepest;
+}
+
+static void case_self_contacts(vctx* v) {
+  const char* nm = "no_penetration_self";
+  if (!want(v, nm)) return;
+  progress(v, nm);
+  int nc_on = 0, nc_off = 0;
+  double on = crossing_rods(v, 1, &nc_on);
+  if (v->st) return;
+  double off = crossing_rods(v, 0, &nc_off);
+  if (v->st) return;
+  check(v, nm, "continuum", "deepest penetration (m)", on, 0, 1e-4, 1,
+        "two crossing cantilevers (r 4 mm, E 1e8 Pa) pushed together by 1 N, 1 s, h = 1 ms; "
+        "%.4g m without self-collision", off);
+  // the case means something only if the rods do pass through each other without it
+  check(v, "no_penetration_self_off", "continuum", "penetration without self-collision (m)", off > 2e-3 ? 0 : off, 0,
+        0, 1, "the same run with self-collision off must overlap by more than 2 mm: %.4g m", off);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1224,7 +1369,8 @@ vd_status vd_sim_validate(const vd_validate_def* def, vd_validate_result** out, 
   *n = 0;
   void (*cases[])(vctx*) = {case_tip_load,    case_self_weight, case_end_moment, case_timoshenko,
                             case_torsion,     case_large_deflection, case_frequency, case_buckling,
-                            case_greenhill,   case_fracture,    case_contacts,   case_independence,
+                            case_greenhill,   case_fracture,    case_contacts,   case_self_contacts,
+                            case_independence,
                             case_seed_figures, case_sagfree};
   for (size_t k = 0; k < sizeof cases / sizeof cases[0] && !v.st; k++) cases[k](&v);
   if (v.st) {
