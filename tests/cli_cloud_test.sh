@@ -4,22 +4,7 @@
 # read (PCL's converters and Open3D when installed), determinism across thread counts, dataset
 # manifests, checksums, shards, resuming and regenerating one item alone.
 # Usage: cli_cloud_test.sh VERDANT_BINARY SOURCE_DIR
-set -u
-V="$1"
-SRC="$2"
-T=$(mktemp -d /tmp/verdant_cloud_cli.XXXXXX)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); echo "ok   $1"; }
-bad() { fail=$((fail + 1)); echo "FAIL $1"; }
-expect() {
-  local name="$1" code="$2"
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local rc=$?
-  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
-}
+source "$(dirname "$0")/cli_lib.sh" cloud_cli "$@"
 check() {  # check NAME CMD...: the command succeeds
   local name="$1"
   shift

@@ -2,25 +2,7 @@
 # SPDX-License-Identifier: MIT
 # End-to-end tests of curves files in `verdant grow`: the bundled tomato, the --curve-* options,
 # errors that name the file and field (exit 2, no output). Usage: cli_curves_test.sh VERDANT SRC
-set -u
-V="$1"
-SRC="$2"
-T=$(mktemp -d /tmp/verdant_cli_curves.XXXXXX)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); echo "ok   $1"; }
-bad() { fail=$((fail + 1)); echo "FAIL $1"; }
-expect() {
-  local name="$1" code="$2"
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local rc=$?
-  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
-}
-expect_err() {
-  if grep -Eq "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
-}
+source "$(dirname "$0")/cli_lib.sh" cli_curves "$@"
 # json_field FILE EXPR: evaluate a Python expression over the JSON in FILE (d)
 json_check() {
   python3 -c "import json,sys; d=json.load(open('$1')); sys.exit(0 if ($2) else 1)"

@@ -6,25 +6,7 @@
 # the run's own files; bad runs are clear errors; `verdant dataset --images N` records its views
 # in the manifest and one view made again by `verdant render` has the same bytes.
 # Usage: cli_render_run_test.sh VERDANT_BINARY SOURCE_DIR
-set -u
-V="$1"
-SRC="$2"
-T=$(mktemp -d /tmp/verdant_cli_render_run.XXXXXX)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); echo "ok   $1"; }
-bad() { fail=$((fail + 1)); echo "FAIL $1"; }
-expect() {
-  local name="$1" code="$2"
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local rc=$?
-  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
-}
-expect_err() {
-  if grep -Eq -e "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
-}
+source "$(dirname "$0")/cli_lib.sh" cli_render_run "$@"
 check() {  # check NAME PYTHON-FILE ARGS...: the script exits 0
   local name="$1"
   shift

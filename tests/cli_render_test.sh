@@ -3,25 +3,7 @@
 # End-to-end tests of `verdant render`: exit codes, files written (colour, depth, masks, sidecar),
 # masks read back, point clouds, no context → a clear error and exit 1, no partial output.
 # Usage: cli_render_test.sh VERDANT_BINARY SOURCE_DIR
-set -u
-V="$1"
-SRC="$2"
-T=$(mktemp -d /tmp/verdant_cli_render.XXXXXX)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); echo "ok   $1"; }
-bad() { fail=$((fail + 1)); echo "FAIL $1"; }
-expect() {
-  local name="$1" code="$2"
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local rc=$?
-  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
-}
-expect_err() {
-  if grep -Eq "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
-}
+source "$(dirname "$0")/cli_lib.sh" cli_render "$@"
 
 # usage errors, checked before any work
 expect "render help" 0 "$V" render --help

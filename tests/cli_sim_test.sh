@@ -3,26 +3,7 @@
 # End-to-end tests of `verdant sim` and `verdant validate`: exit codes, errors that name what
 # is wrong, the outputs (frames, rod topology, events, final plant, stats) and no partial
 # output on failure. Usage: cli_sim_test.sh VERDANT_BINARY SOURCE_DIR
-set -u
-V="$1"
-SRC="$2"
-T=$(mktemp -d /tmp/verdant_cli_sim.XXXXXX)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); echo "ok   $1"; }
-bad() { fail=$((fail + 1)); echo "FAIL $1"; }
-
-expect() {
-  local name="$1" code="$2"
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local rc=$?
-  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
-}
-expect_err() {
-  if grep -Eq -e "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
-}
+source "$(dirname "$0")/cli_lib.sh" cli_sim "$@"
 # json_check NAME PYTHON-EXPRESSION-ON-d: the last run's stdout is JSON satisfying the expression
 json_check() {
   if python3 -c "import json,sys; d=json.load(open('$T/out')); sys.exit(0 if ($2) else 1)" 2>/dev/null; then

@@ -2,28 +2,7 @@
 # SPDX-License-Identifier: MIT
 # End-to-end tests of the verdant command: exit codes, error locations, no partial output,
 # outputs that other tools read. Usage: cli_test.sh VERDANT_BINARY SOURCE_DIR
-set -u
-V="$1"
-SRC="$2"
-T=$(mktemp -d /tmp/verdant_cli.XXXXXX)
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); echo "ok   $1"; }
-bad() { fail=$((fail + 1)); echo "FAIL $1"; }
-
-# expect NAME CODE CMD...: run, check the exit code
-expect() {
-  local name="$1" code="$2"
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local rc=$?
-  if [ "$rc" -eq "$code" ]; then ok "$name"; else bad "$name (exit $rc, expected $code: $(head -c 300 "$T/err"))"; fi
-}
-# expect_err NAME PATTERN: the last run's stderr matches
-expect_err() {
-  if grep -Eq "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
-}
+source "$(dirname "$0")/cli_lib.sh" cli "$@"
 
 expect "help" 0 "$V" --help
 expect "version" 0 "$V" --version
