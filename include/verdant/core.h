@@ -64,6 +64,8 @@ typedef struct vd_error {
 } vd_error;
 
 // Fill err (Nullable: err) with status, location and a printf-style message; returns status.
+// The first failure wins: a record that already holds one is left as it is, so a root cause is
+// never overwritten by its consequences. Zero a record (vd_error e = {0}) before reusing it.
 vd_status vd_error_set(vd_error* err, vd_status status, const char* file, int line, int col,
                        const char* fmt, ...)
 #if defined(__GNUC__)
