@@ -55,6 +55,21 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
 // Free what cli_load_plant put in info.
 void cli_grow_info_free(cli_grow_info* info);
 
+// Parse a whole decimal integer within [lo, hi]; 1 on success.
+int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out);
+// Parse a whole finite number; 1 on success.
+int cli_parse_num(const char* s, double* out);
+// Inside an option parser with locals a (the option), val, i, argc, argv and cmd: take the
+// option's value into val, or report that it is missing and return -1.
+#define CLI_TAKE()                                                                                 \
+  do {                                                                                             \
+    if (*i + 1 >= argc) {                                                                          \
+      cli_usage_error(cmd, "%s needs a value", a);                                                 \
+      return -1;                                                                                   \
+    }                                                                                              \
+    val = argv[++*i];                                                                              \
+  } while (0)
+
 // Monotonic seconds.
 double cli_now(void);
 // Does path end with ext (case-insensitive, ext with the dot)?

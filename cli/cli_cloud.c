@@ -84,15 +84,6 @@ static int parse_list(const char* s, double* out, int n, int n2) {
   return k == n || (n2 > 0 && k == n2) ? k : 0;
 }
 
-static int parse_int(const char* s, int64_t lo, int64_t hi, int64_t* out) {
-  if (!s || !*s) return 0;
-  char* end;
-  errno = 0;
-  long long v = strtoll(s, &end, 10);
-  if (errno || *end || v < lo || v > hi) return 0;
-  *out = v;
-  return 1;
-}
 
 // table:D1:G1,D2:G2,...
 static int parse_table(const char* s, vd_cloud_def* def) {
@@ -124,14 +115,6 @@ static int parse_table(const char* s, vd_cloud_def* def) {
 int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int* i) {
   const char* a = argv[*i];
   const char* val = NULL;
-#define TAKE()                                                                                     \
-  do {                                                                                             \
-    if (*i + 1 >= argc) {                                                                          \
-      cli_usage_error(cmd, "%s needs a value", a);                                                 \
-      return -1;                                                                                   \
-    }                                                                                              \
-    val = argv[++*i];                                                                              \
-  } while (0)
 #define FAIL(...)                                                                                  \
   do {                                                                                             \
     cli_usage_error(cmd, __VA_ARGS__);                                                             \
@@ -140,18 +123,18 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
   int64_t v;
   double x[6];
   if (!strcmp(a, "-N") || !strcmp(a, "--points")) {
-    TAKE();
-    if (!parse_int(val, 1, 2000000000, &v)) FAIL("%s expects an integer in 1..2000000000, got '%s'", a, val);
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 1, 2000000000, &v)) FAIL("%s expects an integer in 1..2000000000, got '%s'", a, val);
     o->def.points = v;
     o->points_given = 1;
   } else if (!strcmp(a, "--sensor")) {
-    TAKE();
+    CLI_TAKE();
     if (!strcmp(val, "uniform")) o->def.sensor = VD_SENSOR_UNIFORM;
     else if (!strcmp(val, "distance")) o->def.sensor = VD_SENSOR_DISTANCE;
     else if (!strcmp(val, "scan")) o->def.sensor = VD_SENSOR_SCAN;
     else FAIL("--sensor expects uniform, distance or scan, got '%s'", val);
   } else if (!strcmp(a, "--scanner")) {
-    TAKE();
+    CLI_TAKE();
     int k = parse_list(val, x, 3, 6);
     if (!k) FAIL("--scanner expects X,Y,Z or X,Y,Z,TX,TY,TZ in metres, got '%s'", val);
     if (o->nscanner == CLI_MAX_SCANNERS) FAIL("too many --scanner options (%d at most)", CLI_MAX_SCANNERS);
@@ -160,10 +143,10 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
     o->scanner_has_target[o->nscanner] = k == 6;
     o->nscanner++;
   } else if (!strcmp(a, "--scanners")) {
-    TAKE();
+    CLI_TAKE();
     o->scanners_file = val;
   } else if (!strcmp(a, "--density-law")) {
-    TAKE();
+    CLI_TAKE();
     o->density_given = 1;
     if (!strcmp(val, "inverse-square")) o->def.density = VD_DENSITY_INVERSE_SQUARE;
     else if (!strcmp(val, "linear")) o->def.density = VD_DENSITY_LINEAR;
@@ -176,7 +159,7 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
       FAIL("--density-law expects inverse-square, linear, constant or table:D1:G1,..., got '%s'", val);
     }
   } else if (!strcmp(a, "--noise")) {
-    TAKE();
+    CLI_TAKE();
     int k = parse_list(val, x, 1, 2);
     if (!k || x[0] < 0 || (k == 2 && x[1] < 0)) FAIL("--noise expects S or S,K with S, K >= 0, got '%s'", val);
     o->def.noise_sigma = x[0];
@@ -186,41 +169,41 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
   } else if (!strcmp(a, "--no-interior")) {
     o->def.interior = 0;
   } else if (!strcmp(a, "--pattern")) {
-    TAKE();
+    CLI_TAKE();
     o->scan_opts = 1;
     if (!strcmp(val, "angular")) o->pattern = VD_SCAN_ANGULAR;
     else if (!strcmp(val, "pinhole")) o->pattern = VD_SCAN_PINHOLE;
     else FAIL("--pattern expects angular or pinhole, got '%s'", val);
   } else if (!strcmp(a, "--fov")) {
-    TAKE();
+    CLI_TAKE();
     o->scan_opts = 1;
     if (!parse_list(val, x, 2, 0) || !(x[0] > 0 && x[0] <= 360 && x[1] > 0 && x[1] <= 180))
       FAIL("--fov expects H,V in degrees, 0 < H <= 360, 0 < V <= 180, got '%s'", val);
     o->fov_h = x[0] * VD_PI / 180, o->fov_v = x[1] * VD_PI / 180;
   } else if (!strcmp(a, "--res")) {
-    TAKE();
+    CLI_TAKE();
     o->scan_opts = 1;
     if (!parse_list(val, x, 2, 0) || x[0] != floor(x[0]) || x[1] != floor(x[1]) || x[0] < 1 ||
         x[1] < 1 || x[0] > 100000 || x[1] > 100000)
       FAIL("--res expects W,H integers in 1..100000, got '%s'", val);
     o->res_h = (int)x[0], o->res_v = (int)x[1];
   } else if (!strcmp(a, "--labels")) {
-    TAKE();
+    CLI_TAKE();
     if (!strcmp(val, "semantic")) o->labels_instance = 0;
     else if (!strcmp(val, "instance")) o->labels_instance = 1;
     else FAIL("--labels expects semantic or instance, got '%s'", val);
   } else if (!strcmp(a, "--slices")) {
-    TAKE();
-    if (!parse_int(val, 3, 1024, &v)) FAIL("--slices expects an integer in 3..1024, got '%s'", val);
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 3, 1024, &v)) FAIL("--slices expects an integer in 3..1024, got '%s'", val);
     o->def.mesh.slices = (int)v;
   } else if (!strcmp(a, "--cloud-seed")) {
-    TAKE();
-    if (!parse_int(val, 0, INT64_MAX, &v)) FAIL("--cloud-seed expects an integer >= 0, got '%s'", val);
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 0, INT64_MAX, &v)) FAIL("--cloud-seed expects an integer >= 0, got '%s'", val);
     o->cloud_seed = (uint64_t)v;
     o->has_cloud_seed = 1;
   } else if (!strcmp(a, "--threads")) {
-    TAKE();
-    if (!parse_int(val, 1, 1024, &v)) FAIL("--threads expects an integer in 1..1024, got '%s'", val);
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 1, 1024, &v)) FAIL("--threads expects an integer in 1..1024, got '%s'", val);
     o->def.threads = (int)v;
   } else if (!strcmp(a, "--ascii")) {
     o->wdef.ascii = 1;
@@ -229,7 +212,6 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
   } else {
     return 0;
   }
-#undef TAKE
 #undef FAIL
   return 1;
 }

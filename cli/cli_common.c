@@ -3,6 +3,7 @@
 // plant from an .lpy file or a plant file, the progress bar.
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
+#include <math.h>
 #include <errno.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -74,8 +75,18 @@ void cli_plant_opts_init(cli_plant_opts* o) {
   o->curve_step = o->curve_connect = o->curve_distance = -1;
 }
 
+int cli_parse_num(const char* s, double* out) {
+  if (!s || !*s) return 0;
+  char* end;
+  errno = 0;
+  double x = strtod(s, &end);
+  if (end == s || *end || errno || !isfinite(x)) return 0;
+  *out = x;
+  return 1;
+}
+
 // strict integer parsing: the whole text, within [lo, hi]
-static int parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out) {
+int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out) {
   if (!s || !*s) return 0;
   char* end;
   errno = 0;
@@ -88,18 +99,10 @@ static int parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out) {
 int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int* i) {
   const char* a = argv[*i];
   const char* val = NULL;
-#define TAKE()                                                                                     \
-  do {                                                                                             \
-    if (*i + 1 >= argc) {                                                                          \
-      cli_usage_error(cmd, "%s needs a value", a);                                                 \
-      return -1;                                                                                   \
-    }                                                                                              \
-    val = argv[++*i];                                                                              \
-  } while (0)
   int64_t v;
   if (!strcmp(a, "-n") || !strcmp(a, "--steps")) {
-    TAKE();
-    if (!parse_i64(val, 0, 1000000000, &v)) {
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 0, 1000000000, &v)) {
       cli_usage_error(cmd, "%s expects an integer >= 0, got '%s'", a, val);
       return -1;
     }
@@ -107,8 +110,8 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     return 1;
   }
   if (!strcmp(a, "--seed")) {
-    TAKE();
-    if (!parse_i64(val, 0, INT64_MAX, &v)) {
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 0, INT64_MAX, &v)) {
       cli_usage_error(cmd, "--seed expects an integer >= 0, got '%s'", val);
       return -1;
     }
@@ -116,8 +119,8 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     return 1;
   }
   if (!strcmp(a, "--max-modules")) {
-    TAKE();
-    if (!parse_i64(val, 1, INT64_MAX / 64, &v)) {
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 1, INT64_MAX / 64, &v)) {
       cli_usage_error(cmd, "--max-modules expects an integer >= 1, got '%s'", val);
       return -1;
     }
@@ -125,8 +128,8 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     return 1;
   }
   if (!strcmp(a, "--max-ops")) {
-    TAKE();
-    if (!parse_i64(val, 1, INT64_MAX, &v)) {
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 1, INT64_MAX, &v)) {
       cli_usage_error(cmd, "--max-ops expects an integer >= 1, got '%s'", val);
       return -1;
     }
@@ -134,7 +137,7 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     return 1;
   }
   if (!strcmp(a, "--set") || !strcmp(a, "--label")) {
-    TAKE();
+    CLI_TAKE();
     const char* eq = strchr(val, '=');
     if (!eq || eq == val || !eq[1]) {
       cli_usage_error(cmd, "%s expects %s, got '%s'", a, a[2] == 's' ? "NAME=VALUE" : "ID=NAME", val);
@@ -149,7 +152,7 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     } else {
       char idbuf[32];
       size_t n = (size_t)(eq - val);
-      if (n >= sizeof idbuf || !parse_i64((memcpy(idbuf, val, n), idbuf[n] = 0, idbuf), 0, 65535, &v)) {
+      if (n >= sizeof idbuf || !cli_parse_i64((memcpy(idbuf, val, n), idbuf[n] = 0, idbuf), 0, 65535, &v)) {
         cli_usage_error(cmd, "--label expects ID=NAME with an integer ID in 0..65535, got '%s'", val);
         return -1;
       }
@@ -162,7 +165,7 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     return 1;
   }
   if (!strcmp(a, "--curve-step") || !strcmp(a, "--curve-connect") || !strcmp(a, "--curve-distance")) {
-    TAKE();
+    CLI_TAKE();
     char* end;
     errno = 0;
     double x = strtod(val, &end);
@@ -178,7 +181,6 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     o->progress = 0;
     return 1;
   }
-#undef TAKE
   return 0;
 }
 

@@ -76,14 +76,6 @@ static int parse_vec(const char* s, vd_vec3* v) {
 }
 
 // a number, the whole text
-static int parse_num(const char* s, double* out) {
-  char* end;
-  errno = 0;
-  double x = strtod(s, &end);
-  if (end == s || *end || errno || !isfinite(x)) return 0;
-  *out = x;
-  return 1;
-}
 
 // --camera VIEW
 static int parse_camera(const char* s, vd_camera_kind* kind, double* az, double* el) {
@@ -101,8 +93,8 @@ static int parse_camera(const char* s, vd_camera_kind* kind, double* az, double*
       snprintf(buf, sizeof buf, "%s", s + 6);
       char* colon = strchr(buf, ':');
       if (colon) *colon = 0;
-      if (!parse_num(buf, az)) return 0;
-      if (colon && !parse_num(colon + 1, el)) return 0;
+      if (!cli_parse_num(buf, az)) return 0;
+      if (colon && !cli_parse_num(colon + 1, el)) return 0;
       if (*el < -90 || *el > 90) return 0;
     }
   } else {
@@ -160,7 +152,7 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       if (!parse_vec(val, &o->up))
         return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
     } else if (!strcmp(a, "--fov")) {
-      if (!parse_num(val, &o->fov) || o->fov <= 0 || o->fov >= 180)
+      if (!cli_parse_num(val, &o->fov) || o->fov <= 0 || o->fov >= 180)
         return cli_usage_error("render", "--fov expects degrees in (0, 180), got '%s'", val);
     } else if (!strcmp(a, "--size")) {
       int w, h;
@@ -186,24 +178,24 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       errno = 0;
       double lo = strtod(val, &end), hi = 0;
       int ok = end != val && *end == ',' && !errno && isfinite(lo);
-      if (ok) ok = parse_num(end + 1, &hi) && hi > lo;
+      if (ok) ok = cli_parse_num(end + 1, &hi) && hi > lo;
       if (!ok)
         return cli_usage_error("render",
                                "--range expects MIN,MAX with MIN < MAX (Pa or m), got '%s'", val);
       o->style.range_min = lo, o->style.range_max = hi;
     } else if (!strcmp(a, "--supersample")) {
       double k;
-      if (!parse_num(val, &k) || k != floor(k) || k < 1 || k > 4)
+      if (!cli_parse_num(val, &k) || k != floor(k) || k < 1 || k > 4)
         return cli_usage_error("render", "--supersample expects 1, 2, 3 or 4, got '%s'", val);
       o->def.supersample = (int)k;
     } else if (!strcmp(a, "--point-size")) {
-      if (!parse_num(val, &o->point_size) || o->point_size <= 0)
+      if (!cli_parse_num(val, &o->point_size) || o->point_size <= 0)
         return cli_usage_error("render", "--point-size expects a size > 0 in metres, got '%s'",
                                val);
     } else if (!strcmp(a, "--robot")) {
       o->def.robot_mjcf = val;
     } else if (!strcmp(a, "--time")) {
-      if (!parse_num(val, &o->time))
+      if (!cli_parse_num(val, &o->time))
         return cli_usage_error("render", "--time expects a time in seconds, got '%s'", val);
       o->has_time = 1;
     } else if (!strcmp(a, "--mp4")) {
@@ -211,7 +203,7 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
         return cli_usage_error("render", "--mp4 '%s' must end in .mp4", val);
       o->mp4 = val;
     } else if (!strcmp(a, "--fps")) {
-      if (!parse_num(val, &o->fps) || o->fps <= 0 || o->fps > 1000)
+      if (!cli_parse_num(val, &o->fps) || o->fps <= 0 || o->fps > 1000)
         return cli_usage_error("render", "--fps expects a frame rate in (0, 1000] (1/s), got '%s'",
                                val);
     } else if (!strcmp(a, "--depth")) {

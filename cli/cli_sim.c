@@ -182,18 +182,13 @@ static vd_status load_mesh_sdf(const char* path, vd_sdf** out, vd_error* err) {
 // ---------------------------------------------------------------------------------------------
 // option values
 
+// a finite number, or inf (a threshold that never fires)
 static int parse_num(const char* s, double* out) {
-  if (!s || !*s) return 0;
-  if (!strcmp(s, "inf") || !strcmp(s, "INF")) {
+  if (s && (!strcmp(s, "inf") || !strcmp(s, "INF"))) {
     *out = INFINITY;
     return 1;
   }
-  char* end;
-  errno = 0;
-  double v = strtod(s, &end);
-  if (errno || *end || !isfinite(v)) return 0;
-  *out = v;
-  return 1;
+  return cli_parse_num(s, out);
 }
 
 // "a,b,c" -> n numbers
