@@ -128,6 +128,8 @@ typedef struct vd_outfile {
 
 // Open path for writing (binary) under a temporary name in the same directory.
 vd_status vd_outfile_open(vd_outfile* f, const char* path, vd_error* err);
+// The temporary name vd_outfile_open uses for path in this process ("<path>.tmp.<pid>").
+void vd_outfile_tmp_path(const char* path, char* buf, size_t cap);
 // Flush, check for write errors, close and rename to the final path; on failure nothing is left.
 vd_status vd_outfile_commit(vd_outfile* f, vd_error* err);
 // Close and remove the temporary file (safe after a failed commit, and twice).

@@ -144,8 +144,9 @@ typedef struct vd_lsys_def {
   int steps;            // derivation steps; -1 = the file's `derivation length` (default -1)
   uint64_t seed;        // random seed, as if random.seed(seed) ran before the axiom (default 0)
   int64_t max_modules;  // largest L-string allowed, error VD_ERR_LIMIT beyond (default 50e6)
-  int64_t max_ops;      // interpreter work allowed per call: loop iterations plus function
-                        // calls, error VD_ERR_LIMIT beyond; 0 or less = default (1e9)
+  int64_t max_ops;      // interpreter work allowed per call: loop iterations, function calls
+                        // and modules read by each rewriting pass, error VD_ERR_LIMIT
+                        // beyond; 0 or less = default (1e9)
   // Nullable: called after each step with (step, steps, modules); return non-zero to stop.
   int (*progress)(void* user, int step, int steps, int64_t modules);
   void* progress_user;  // passed to progress

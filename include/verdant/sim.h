@@ -34,6 +34,24 @@ extern "C" {
 
 #define VD_SIM_FRAMES_VERSION 1  // version of the binary and JSON Lines frame formats
 #define VD_SIM_MAX_COLLIDERS 64  // most external colliders one state holds
+#define VD_SIM_MAX_SUBSTEP 5     // a failed step is retaken in halves, down to dt / 2^5
+#define VD_SIM_MAX_STRAIN 1.0    // a segment stretched beyond (1 + this) l0 fails its step (-)
+#define VD_SIM_BLOWUP_STRAIN 10.0 // ... and fails even the smallest substep beyond (1 + this) l0
+
+// Kinds of numerical warnings, counted in vd_sim_data::warning (MuJoCo's mjData.warning).
+typedef enum vd_sim_warning {
+  VD_SIM_WARN_NONFINITE = 0,  // a step made a non-finite state: undone and retaken in halves
+  VD_SIM_WARN_SOLVER,         // a factorisation of the direct solver failed: retaken in halves
+  VD_SIM_WARN_STRAIN,         // a segment stretched beyond VD_SIM_MAX_STRAIN: retaken in halves
+  VD_SIM_WARN_SUBSTEP,        // steps retaken as two half steps (each failure above causes one)
+  VD_SIM_WARN_UNSTABLE,       // substeps of dt / 2^VD_SIM_MAX_SUBSTEP that still failed (or were
+                              // kept stretched beyond VD_SIM_MAX_STRAIN)
+  VD_SIM_WARN_ARENA,          // the per-step arena could not hold the contact candidates
+  VD_SIM_WARN_COUNT
+} vd_sim_warning;
+
+// Lower-case name of a warning kind ("nonfinite", "solver", ...).
+const char* vd_sim_warning_name(vd_sim_warning w);
 
 // Material classes: each rod segment takes its material from one of these.
 typedef enum vd_sim_class {
@@ -78,11 +96,13 @@ typedef struct vd_sim_def {
   vd_vec3 gravity;                // gravity used by sag_free and copied to opt.gravity (m/s^2)
   double stake_spacing;           // tie the main stem to a fixed stake every this length (m), 0 off
   double stake_stiffness;         // stiffness of each stake tie (N/m)
+  int max_segments;               // most rod segments the model may have; larger is VD_ERR_LIMIT
 } vd_sim_def;
 
 // Defaults (sources in docs/physics.md):
 //   segment_length 0.02 m, clamp_length 0.01 m, clamp_roots 1, leaf_graphs 1, sag_free 0,
 //   gravity (0, 0, -9.81) m/s^2, stake_spacing 0 m (off), stake_stiffness 1e4 N/m,
+//   max_segments 1000000 (a model and one state take about 2 kB per segment),
 //   leaf_areal_density 0.22 kg/m^2, leaf_vein_ratio 0.015, leaf_plate_cd 1.17;
 //   materials            E (Pa)   nu    rho (kg/m^3)  drag cd   fracture
 //     green stem         1e9      0.3   1000          1.2       never
@@ -262,7 +282,8 @@ typedef struct vd_sim_data {
   int nevent;
   int ncontact;            // contacts found in the last step
   double max_penetration;  // deepest penetration left after the last step (m)
-  int64_t nwarning;        // numerical warnings (non-finite state, arena failure)
+  int64_t nwarning;        // numerical warnings of every kind (the sum of warning[])
+  int64_t warning[VD_SIM_WARN_COUNT];  // numerical warnings by kind (vd_sim_warning)
   void* work;              // solver scratch (private)
   size_t work_bytes;       // size of work
   vd_arena arena;          // per-step scratch (contacts)
@@ -281,8 +302,13 @@ void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d);
 // Free a state (NULL is fine).
 void vd_sim_data_destroy(vd_sim_data* d);
 
-// Advance one time step of m->opt.dt. Non-finite states are counted in d->nwarning and the
-// state is put back to the previous step; returns VD_ERR_VALUE then, else VD_OK.
+// Advance one time step of m->opt.dt. A step that fails (non-finite state, failed
+// factorisation, a segment stretched beyond VD_SIM_MAX_STRAIN) is undone and retaken as two
+// half steps, recursively down to dt / 2^VD_SIM_MAX_SUBSTEP; each failure is counted in
+// d->warning. At the smallest substep a state stretched up to VD_SIM_BLOWUP_STRAIN is kept
+// (counted as VD_SIM_WARN_UNSTABLE); a non-finite one, a failed factorisation or a larger
+// stretch is put back to the start of that substep (time says where) and VD_ERR_VALUE is
+// returned; else VD_OK. The state never holds a non-finite number.
 vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d);
 
 // Settling: what to run and when to stop.

@@ -11,13 +11,17 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+void vd_outfile_tmp_path(const char* path, char* buf, size_t cap) {
+  snprintf(buf, cap, "%s.tmp.%ld", path, (long)getpid());
+}
+
 vd_status vd_outfile_open(vd_outfile* f, const char* path, vd_error* err) {
   memset(f, 0, sizeof *f);
   if (!path || !path[0]) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "empty output path");
   if (strlen(path) >= sizeof f->path)
     return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "output path too long");
   snprintf(f->path, sizeof f->path, "%s", path);
-  snprintf(f->tmp, sizeof f->tmp, "%s.tmp.%ld", path, (long)getpid());
+  vd_outfile_tmp_path(path, f->tmp, sizeof f->tmp);
   f->fp = fopen(f->tmp, "wb");
   if (!f->fp) {
     int e = errno;
@@ -63,6 +67,10 @@ vd_status vd_file_read(const char* path, char** text, size_t* len, vd_error* err
   if (stat(path, &st) != 0)
     return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot open: %s", strerror(errno));
   if (S_ISDIR(st.st_mode)) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "is a directory");
+  // a regular file too large is refused before a byte is read
+  if (S_ISREG(st.st_mode) && (uint64_t)st.st_size > (uint64_t)VD_FILE_MAX)
+    return vd_error_set(err, VD_ERR_LIMIT, path, 0, 0, "file of %lld bytes, larger than the limit of %zu bytes",
+                        (long long)st.st_size, (size_t)VD_FILE_MAX);
   FILE* fp = fopen(path, "rb");
   if (!fp) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot open: %s", strerror(errno));
   // read in chunks: works for pipes and files whose size changes

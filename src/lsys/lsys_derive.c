@@ -454,6 +454,10 @@ static vd_status copy_module(vd_lsystem* ls, const vd_lstring* in, int64_t i, vd
 
 static vd_status apply_rules(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* out, pass_ctx* P,
                              int* fired) {
+  // a pass reads every module once: it costs that many operations, so a derivation of many
+  // steps over a long string is bounded by max_ops like a runaway loop
+  vd_status sp = vm_spend(ls, in->n);
+  if (sp) return sp;
   lstr_clear(out);
   if (!lstr_reserve(out, in->n + 16, in->par[in->n] + 16))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");

@@ -36,9 +36,14 @@ static int spend_ops(vd_lsystem* ls, int64_t n, int line, int col) {
   ls->ops_left -= n;
   if (ls->ops_left >= 0) return 0;
   vm_error(ls, VD_ERR_LIMIT, line, col,
-           "the run needs more than %lld interpreter operations (loop iterations and calls)",
+           "the run needs more than %lld interpreter operations (loop iterations, calls and modules "
+           "rewritten)",
            (long long)ls->max_ops);
   return 1;
+}
+
+vd_status vm_spend(vd_lsystem* ls, int64_t n) {
+  return spend_ops(ls, n, 0, 0) ? ls->err->status : VD_OK;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -251,6 +251,9 @@ tmpl* lsys_parse_tmpl_text(vd_lsystem* ls, const char* text, int len, int line, 
 #define LSYS_DEFAULT_MAX_OPS 1000000000LL  // vd_lsys_def.max_ops when unset
 // Start a run with a budget of max_ops interpreter operations (<= 0: the default).
 void vm_budget(vd_lsystem* ls, int64_t max_ops);
+// Take n operations from the run's budget (a rewriting pass costs one per module it reads);
+// sets the error and returns its status when the budget is spent, else VD_OK.
+vd_status vm_spend(vd_lsystem* ls, int64_t n);
 typedef struct vm_out {
   vd_lstring* s;       // where produce writes
   int64_t src;         // source index recorded on produced modules (when s->src)

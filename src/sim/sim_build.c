@@ -58,6 +58,7 @@ vd_sim_def vd_sim_def_default(void) {
   d.leaf_graphs = 1;
   d.sag_free = 0;
   d.gravity = vd_v3(0, 0, -9.81);
+  d.max_segments = 1000000;
   d.stake_spacing = 0;
   d.stake_stiffness = 1e4;
   return d;
@@ -125,9 +126,16 @@ typedef struct bld {
   int ntie;
   int* tie_node;
   int cap_tie;
+  int over;  // 1 when the model would pass def->max_segments
 } bld;
 
+// the error of a failed addition: the segment limit, or out of memory
 static vd_status oom(bld* b) {
+  if (b->over)
+    return vd_error_set(b->err, VD_ERR_LIMIT, "", 0, 0,
+                        "sim: the rod model needs more than %d segments (segment length %g m); use a longer "
+                        "segment length or raise the segment limit",
+                        b->def->max_segments, b->def->segment_length);
   return vd_error_set(b->err, VD_ERR_NOMEM, "", 0, 0, "sim: out of memory building the rod model");
 }
 
@@ -150,6 +158,10 @@ static int parent_at(const bld* b, int n) {
 
 static int add_seg(bld* b, int n0, int n1, int cls, int label, int instance, int plant,
                    double radius, unsigned flags) {
+  if (b->nseg >= b->def->max_segments) {
+    b->over = 1;
+    return -1;
+  }
   if (!vd_grow((void**)&b->seg, &b->cap_seg, b->nseg + 1, sizeof(bseg))) return -1;
   int t = b->nseg;
   bseg* s = &b->seg[t];
@@ -226,6 +238,7 @@ static vd_status check_def(const vd_sim_def* d, vd_error* err) {
   if (!(isfinite(d->gravity.x) && isfinite(d->gravity.y) && isfinite(d->gravity.z))) BAD("sim: gravity is not finite");
   if (!(isfinite(d->stake_spacing) && d->stake_spacing >= 0)) BAD("sim: stake spacing must be >= 0 (m), got %g", d->stake_spacing);
   if (!(isfinite(d->stake_stiffness) && d->stake_stiffness > 0)) BAD("sim: stake stiffness must be > 0 (N/m), got %g", d->stake_stiffness);
+  if (d->max_segments < 1) BAD("sim: max_segments must be >= 1, got %d", d->max_segments);
 #undef BAD
   return VD_OK;
 }
@@ -445,8 +458,9 @@ static vd_status build_chains(bld* b) {
     int cls = b->pclass[first];
     unsigned first_flags = b->absc[n0] && cls == VD_SIM_PEDICEL ? VD_SIM_ABSCISSION : 0;
     int last;
-    if (is_root && cls == VD_SIM_ROOT && b->def->clamp_roots) {
-      // roots stay in the soil: every rod segment fixed
+    if (cls == VD_SIM_ROOT && b->def->clamp_roots && b->node[start].fixed) {
+      // roots stay in the soil: every rod segment fixed, for roots at the plant's base and
+      // roots branching from a held node (the trunk's pot, another root)
       int nrod = (int)floor(total / b->def->segment_length + 0.5);
       if (nrod < 1) nrod = 1;
       last = start;
@@ -983,6 +997,14 @@ vd_status vd_sim_build(const vd_model* plant, const vd_sim_def* def, vd_sim_mode
   VD_ASSERT(plant && def);
   vd_status st = check_def(def, err);
   if (st) return st;
+  // the axes alone, resampled, must fit the segment limit: say so before building anything
+  double axes = 0;
+  for (int t = 0; t < plant->nseg; t++) axes += plant->seg_len0[t];
+  if (axes / def->segment_length > def->max_segments)
+    return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                        "sim: %.4g m of axes at a segment length of %g m make about %.3g rod segments, more than "
+                        "the limit of %d; use a longer segment length or raise the segment limit",
+                        axes, def->segment_length, axes / def->segment_length, def->max_segments);
   bld b;
   memset(&b, 0, sizeof b);
   b.p = plant, b.def = def, b.err = err;

@@ -133,7 +133,7 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
   size_t cap = (size_t)d->ncollider * (size_t)(m->nseg + m->nnode_all);
   sim_contact* c = vd_arena_alloc(&d->arena, cap * sizeof(sim_contact));
   if (!c) {
-    d->nwarning++;
+    sim_warn(d, VD_SIM_WARN_ARENA);
     return 0;
   }
   int n = 0;

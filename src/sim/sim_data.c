@@ -111,6 +111,7 @@ void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d) {
   d->ncontact = 0;
   d->max_penetration = 0;
   d->nwarning = 0;
+  memset(d->warning, 0, sizeof d->warning);
 }
 
 void vd_sim_data_destroy(vd_sim_data* d) {

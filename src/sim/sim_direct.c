@@ -64,6 +64,8 @@ static int inv_spd(const double* m, double* inv) {
 
 
 
+#define SIM_MAX_TURN 1.0  // largest frame rotation of one Newton update (rad)
+
 // body numbering: segment t is body t; spare node k (k = node - nnode) is body nseg + k
 static int node_body(const vd_sim_model* m, const vd_sim_data* d, int n) {
   if (n >= m->nnode) return d->node_mass[n] > 0 ? m->nseg + (n - m->nnode) : -1;
@@ -303,6 +305,22 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     }
     mv6(w->h + 36 * t, v, dy);
   }
+  // trust region: a Newton update that turns a frame by more than SIM_MAX_TURN or moves a
+  // node by more than its segment's rest length is scaled down as a whole (the linearisation
+  // is meaningless that far out; far from the solution a full step diverges)
+  double scale = 1;
+  for (int t = 0; t < nseg; t++) {
+    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
+    const double* dy = w->dy + 6 * t;
+    double turn = sqrt(dy[3] * dy[3] + dy[4] * dy[4] + dy[5] * dy[5]);
+    double move = sqrt(dy[0] * dy[0] + dy[1] * dy[1] + dy[2] * dy[2]) / m->seg_len0[t];
+    if (turn * scale > SIM_MAX_TURN) scale = SIM_MAX_TURN / turn;
+    if (move * scale > 1.0) scale = 1.0 / move;
+  }
+  if (scale < 1) {
+    for (int k = 0; k < 6 * (nseg + m->nspare); k++) w->dy[k] *= scale;
+    for (int k = 0; k < 6 * nseg; k++) w->dl[k] *= scale;
+  }
   // apply: positions, frames, multipliers
   for (int t = 0; t < nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
@@ -338,14 +356,12 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
   return 1;
 }
 
-void sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c) {
+int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c) {
   sim_work* w = (sim_work*)d->work;
   int iters = c->statics && m->opt.iterations < 4 ? 4 : m->opt.iterations;
   for (int it = 0; it < iters; it++) {
-    if (!iterate(m, d, w, c)) {
-      d->nwarning++;
-      return;
-    }
+    if (!iterate(m, d, w, c)) return 0;
     if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact);
   }
+  return 1;
 }

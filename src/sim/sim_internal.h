@@ -193,10 +193,18 @@ typedef struct sim_step_ctx {
   double extra_damping;          // mass damping added by settling (1/s)
   struct sim_contact* contacts;  // contact candidates of this step
   int ncontact;                  // their count
+  int last;                      // 1: the smallest substep, an overstretched state is kept
 } sim_step_ctx;
 
+// Count one numerical warning of kind k (vd_sim_warning) in d->warning and d->nwarning.
+static inline void sim_warn(vd_sim_data* d, int k) {
+  d->warning[k]++;
+  d->nwarning++;
+}
+
 // Both solvers: project all constraints for one step (positions and frames in d are moved).
-void sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
+// sim_solve_direct returns 0 when a factorisation failed (the step must be retaken), else 1.
+int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
 // inverse mass of a node (0 when kinematic)

@@ -4,6 +4,23 @@
 // checks. Settling runs steps until the plant is still, or solves statics directly.
 #include "sim_internal.h"
 
+const char* vd_sim_warning_name(vd_sim_warning w) {
+  static const char* names[VD_SIM_WARN_COUNT] = {"nonfinite", "solver", "strain", "substep", "unstable", "arena"};
+  return w >= 0 && w < VD_SIM_WARN_COUNT ? names[w] : "?";
+}
+
+// largest stretch strain |x_end - x_start| / l0 - 1 of the free segments (-)
+static double max_stretch(const vd_sim_model* m, const vd_sim_data* d) {
+  double r2 = 0;
+  for (int t = 0; t < m->nseg; t++) {
+    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
+    vd_vec3 e = vd_sub(d->node_pos[m->seg_node[2 * t + 1]], d->node_pos[d->seg_start[t]]);
+    double q = vd_dot(e, e) / (m->seg_len0[t] * m->seg_len0[t]);
+    if (q > r2) r2 = q;
+  }
+  return sqrt(r2) - 1;
+}
+
 // does the state hold only finite numbers?
 static int finite_state(const vd_sim_model* m, const vd_sim_data* d) {
   for (int i = 0; i < m->nnode_all; i++) {
@@ -109,8 +126,9 @@ static double torque_work(const vd_sim_model* m, const vd_sim_data* d, const sim
   return e;
 }
 
-// the step itself; statics: start from the current state, no inertia carried over
-static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* cin) {
+// the step itself; statics: start from the current state, no inertia carried over. Returns -1,
+// or the vd_sim_warning kind of a failure, with positions and frames put back (not counted)
+static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* cin) {
   sim_work* w = (sim_work*)d->work;
   sim_step_ctx c = *cin;
   double h = c.h;
@@ -167,10 +185,11 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
   }
   // constraints
   // statics needs the primal residual that only the direct solver keeps
+  int solved = 1;
   if (m->opt.solver == VD_SIM_GS && !c.statics)
     sim_solve_gs(m, d, &c);
   else
-    sim_solve_direct(m, d, &c);
+    solved = sim_solve_direct(m, d, &c);
   // contacts have the last word (no penetration), then friction
   d->ncontact = c.ncontact;
   d->max_penetration = 0;
@@ -182,12 +201,18 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
       if (-s > d->max_penetration) d->max_penetration = -s;
     }
   }
-  if (!finite_state(m, d)) {
-    // put the previous state back and report
+  // a failed step: put the previous state back and say why; at the smallest substep a state
+  // stretched up to VD_SIM_BLOWUP_STRAIN is kept (counted), beyond it the step fails
+  int fail = !finite_state(m, d) ? VD_SIM_WARN_NONFINITE : !solved ? VD_SIM_WARN_SOLVER : -1;
+  double strain = fail < 0 && !c.statics ? max_stretch(m, d) : 0;
+  if (strain > VD_SIM_MAX_STRAIN) {
+    if (!c.last || strain > VD_SIM_BLOWUP_STRAIN) fail = VD_SIM_WARN_STRAIN;
+    else sim_warn(d, VD_SIM_WARN_STRAIN), sim_warn(d, VD_SIM_WARN_UNSTABLE);
+  }
+  if (fail >= 0) {
     memcpy(d->node_pos, w->node_prev, (size_t)na * sizeof(vd_vec3));
     memcpy(d->seg_quat, w->seg_prev, (size_t)ns * sizeof(vd_quat));
-    d->nwarning++;
-    return VD_ERR_VALUE;
+    return fail;
   }
   // velocities from the step's motion
   double damp = 1.0 / (1.0 + (m->opt.mass_damping + c.extra_damping) * h);
@@ -209,16 +234,35 @@ static vd_status step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step
   if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
   for (int k = 0; k < d->ncollider; k++) d->collider[k].vel = vd_v3(0, 0, 0);
   d->time += c.statics ? 0.0 : h;
-  d->nstep++;
-  return VD_OK;
+  return -1;
+}
+
+// a dynamic step of h; a failed one is retaken as two steps of h / 2, down to
+// dt / 2^VD_SIM_MAX_SUBSTEP (smaller steps make the mass term M / h^2 dominate: the Newton
+// iterations start closer to the solution and the matrices are better conditioned)
+static vd_status step_retake(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* base, double h, int depth) {
+  sim_step_ctx c = *base;
+  c.h = h;
+  c.gamma = m->opt.damping / h;
+  c.last = depth == VD_SIM_MAX_SUBSTEP;
+  int fail = step_core(m, d, &c);
+  if (fail < 0) return VD_OK;
+  sim_warn(d, fail);
+  if (c.last) {
+    sim_warn(d, VD_SIM_WARN_UNSTABLE);
+    return VD_ERR_VALUE;
+  }
+  sim_warn(d, VD_SIM_WARN_SUBSTEP);
+  vd_status st = step_retake(m, d, base, 0.5 * h, depth + 1);
+  return st ? st : step_retake(m, d, base, 0.5 * h, depth + 1);
 }
 
 vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d) {
   sim_step_ctx c;
   memset(&c, 0, sizeof c);
-  c.h = m->opt.dt;
-  c.gamma = m->opt.damping / m->opt.dt;
-  return step_core(m, d, &c);
+  vd_status st = step_retake(m, d, &c, m->opt.dt, 0);
+  if (!st) d->nstep++;
+  return st;
 }
 
 vd_sim_settle_def vd_sim_settle_def_default(void) {
@@ -241,15 +285,14 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
     // dynamics with extra damping until the kinetic energy is small
     sim_step_ctx c;
     memset(&c, 0, sizeof c);
-    c.h = m->opt.dt;
-    c.gamma = m->opt.damping / m->opt.dt;
     c.extra_damping = s->extra_damping;
     // still means below the tolerance for a quarter second in a row (not one turning point)
     double t0 = d->time, calm = 0;
     while (d->time - t0 < s->max_time) {
-      if ((st = step_core(m, d, &c))) break;
+      if ((st = step_retake(m, d, &c, m->opt.dt, 0))) break;
+      d->nstep++;
       n++;
-      calm = vd_sim_kinetic_energy(m, d) < s->ke_tol ? calm + c.h : 0;
+      calm = vd_sim_kinetic_energy(m, d) < s->ke_tol ? calm + m->opt.dt : 0;
       if (calm >= 0.25) {
         ok = 1;
         break;
@@ -269,16 +312,20 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
     double e0 = potential_energy(m, d, w), hcap = 1e4;
     while (n < s->max_steps) {
       memcpy(w->lambda_save, d->seg_lambda, (size_t)m->nseg * 6 * sizeof(double));
-      if ((st = step_core(m, d, &c))) break;
+      // a failed step (non-finite, failed factorisation) is undone like one that raises the
+      // energy: h shrinks
+      int kind = step_core(m, d, &c), fail = kind >= 0;
+      if (fail) sim_warn(d, kind);
+      else d->nstep++;
       n++;
-      double e1 = potential_energy(m, d, w) - torque_work(m, d, w);
+      double e1 = fail ? INFINITY : potential_energy(m, d, w) - torque_work(m, d, w);
       // largest move of a node, or of a segment end by its rotation
-      double mv = 0;
-      for (int i = 0; i < m->nnode_all; i++) {
+      double mv = fail ? INFINITY : 0;
+      for (int i = 0; !fail && i < m->nnode_all; i++) {
         double l = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
         if (l > mv) mv = l;
       }
-      for (int t = 0; t < m->nseg; t++) {
+      for (int t = 0; !fail && t < m->nseg; t++) {
         double l = v_norm(quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])))) * m->seg_len0[t];
         if (l > mv) mv = l;
       }
@@ -289,7 +336,10 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
         memcpy(d->seg_lambda, w->lambda_save, (size_t)m->nseg * 6 * sizeof(double));
         hn = hp * 0.25;
         hcap = hp * 0.5;  // the trust region remembers the failure
-        if (hn < 1e-5) break;
+        if (hn < 1e-5) {
+          if (fail) st = VD_ERR_VALUE, sim_warn(d, VD_SIM_WARN_UNSTABLE);
+          break;
+        }
       } else {
         e0 = e1 + torque_work(m, d, w);
         if (mv < s->disp_tol) {
