@@ -134,7 +134,7 @@ TEST(harden, sim_tree_roots_held) {
   // a few steps on the ground: nothing is thrown about
   vd_sim_data* d = vd_sim_data_create(m);
   REQUIRE(d);
-  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   vd_sim_add_collider(d, &g);
   for (int k = 0; k < 5; k++) CHECK(vd_sim_step(m, d) == VD_OK);
   CHECK(vd_sim_max_displacement(m, d, NULL) < 0.01);
@@ -170,7 +170,7 @@ TEST(harden, sim_sweep_corners_stay_finite) {
             m->opt.gust_amplitude = 0.5, m->opt.gust_period = 0.5;
             vd_sim_data* d = vd_sim_data_create(m);
             REQUIRE(d);
-            vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+            vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
             vd_sim_add_collider(d, &g);
             int failed = 0, finite = 1;
             for (int n = 0; n < 15; n++) {
@@ -209,7 +209,7 @@ TEST(harden, sim_retake_keeps_soft_plant_bounded) {
   m->opt.gust_amplitude = 0.5, m->opt.gust_period = 0.5;
   vd_sim_data* d = vd_sim_data_create(m);
   REQUIRE(d);
-  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0)};
+  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   vd_sim_add_collider(d, &g);
   for (int n = 0; n < 50; n++) vd_sim_step(m, d);
   CHECK(sim_finite(m, d));
