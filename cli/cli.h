@@ -52,6 +52,15 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
 // Free what cli_load_plant put in info.
 void cli_grow_info_free(cli_grow_info* info);
 
+// Interrupts: SIGINT and SIGTERM remove the temporary files of the outputs being written (the
+// watched ones), then end the process by the same signal. Call once from main.
+void cli_signals_init(void);
+// Watch an output about to be written with vd_outfile (its temporary name is removed if a
+// signal ends the run); returns a slot for cli_unwatch, -1 when every slot is taken.
+int cli_watch(const char* path);
+// Stop watching (after the output was committed or aborted); -1 is ignored.
+void cli_unwatch(int slot);
+
 // Monotonic seconds.
 double cli_now(void);
 // Does path end with ext (case-insensitive, ext with the dot)?

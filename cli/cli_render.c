@@ -313,6 +313,7 @@ int cli_render(int argc, char** argv) {
   sibling(out, "label.png", p_label, sizeof p_label);
   sibling(out, "instance.png", p_inst, sizeof p_inst);
   sibling(out, "json", p_json, sizeof p_json);
+  int watch[5] = {cli_watch(out), cli_watch(p_depth), cli_watch(p_label), cli_watch(p_inst), cli_watch(p_json)};
   st = vd_render_write_png(&f, VD_LAYER_COLOR, out, &err);
   if (!st && depth) st = vd_render_write_png(&f, VD_LAYER_DEPTH, p_depth, &err);
   if (!st && masks) st = vd_render_write_png(&f, VD_LAYER_LABEL, p_label, &err);
@@ -327,6 +328,7 @@ int cli_render(int argc, char** argv) {
     files[nf] = NULL;
     st = vd_render_write_json(&f, files, p_json, &err);
   }
+  for (int k = 0; k < 5; k++) cli_unwatch(watch[k]);
   if (st)
     code = st == VD_ERR_IO ? (cli_report("render", &err, st), EXIT_FAIL)
                            : cli_report("render", &err, st);

@@ -30,8 +30,10 @@ static const char* sim_help =
     "      --ke-tol E          --settle stops when the kinetic energy stays below E (J), 1e-9\n"
     "      --sag-free          rest shape solved so that the modelled shape is the equilibrium\n"
     "      --stake S           tie the main stem to a fixed stake every S metres (greenhouse string)\n"
+    "      --max-steps N       most time steps of a run, duration / dt (default 1000000000)\n"
     "model:\n"
     "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
+    "      --max-segments N    most rod segments of the model (default 1000000, about 2 kB each)\n"
     "      --young [C=]E       Young's modulus (Pa) of all classes, or of class C\n"
     "      --density [C=]RHO   density (kg/m^3); --poisson [C=]NU Poisson ratio\n"
     "                          classes: green wood pedicel leaf fruit flower root\n"
@@ -132,6 +134,7 @@ typedef struct sim_opts {
   double ramp;
   int ramp_set;
   const char* wind_file;
+  double max_steps;
   vd_sim_def def;
   vd_sim_opt opt;
 } sim_opts;
@@ -259,7 +262,7 @@ static vd_status read_wind(const char* path, double** rows, int* n, vd_error* er
 
 typedef struct outputs {
   vd_outfile frames;
-  int frames_open, jsonl;
+  int frames_open, jsonl, watch;
   float* fbuf;
   size_t fbuf_n;
   unsigned char* bbuf;
@@ -284,6 +287,7 @@ static void put_f32(unsigned char* b, float f) {
 static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir, int jsonl, vd_error* err) {
   char path[4096];
   snprintf(path, sizeof path, "%s/frames.%s", dir, jsonl ? "jsonl" : "bin");
+  o->watch = cli_watch(path);
   vd_status st = vd_outfile_open(&o->frames, path, err);
   if (st) return st;
   o->frames_open = 1;
@@ -368,12 +372,14 @@ static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, co
   char path[4096];
   snprintf(path, sizeof path, "%s/rod.json", dir);
   vd_outfile f;
+  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     fputc('\n', f.fp);
     st = vd_outfile_commit(&f, err);
   }
+  cli_unwatch(w);
   cJSON_free(text);
   return st;
 }
@@ -392,8 +398,12 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
   char path[4096];
   snprintf(path, sizeof path, "%s/events.csv", dir);
   vd_outfile f;
+  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
-  if (st) return st;
+  if (st) {
+    cli_unwatch(w);
+    return st;
+  }
   fputs("time_s,segment,node,label,label_name,instance,class,force_N,moment_Nm,cs,cb_per_m,cause\n", f.fp);
   for (int k = 0; k < d->nevent; k++) {
     const vd_sim_event* e = &d->event[k];
@@ -401,7 +411,9 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
             label_name(plant, e->label), e->instance, vd_sim_class_name(e->cls), e->force, e->moment, e->cs, e->cb,
             cause_name(e->cause));
   }
-  return vd_outfile_commit(&f, err);
+  st = vd_outfile_commit(&f, err);
+  cli_unwatch(w);
+  return st;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -448,6 +460,9 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "max_penetration", d->max_penetration);
   cJSON_AddNumberToObject(root, "sag_free_out_of_reach", m->nsagfree_clamped);
   cJSON_AddNumberToObject(root, "warnings", (double)d->nwarning);
+  cJSON* wk = cJSON_AddObjectToObject(root, "warning_counts");
+  for (int k = 0; k < VD_SIM_WARN_COUNT; k++)
+    cJSON_AddNumberToObject(wk, vd_sim_warning_name((vd_sim_warning)k), (double)d->warning[k]);
   char* text = cJSON_Print(root);
   cJSON_Delete(root);
   if (!text) return 0;
@@ -516,6 +531,10 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
     } else if (!strcmp(a, "--segment-length")) {
       NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
+    } else if (!strcmp(a, "--max-segments")) {
+      NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
+    } else if (!strcmp(a, "--max-steps")) {
+      NUM(o->max_steps, x_ >= 1 && x_ <= 1e15 && x_ == floor(x_), "an integer in 1..1e15");
     } else if (!strcmp(a, "--young")) {
       VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, young), 1, 1)) return EXIT_USAGE;
@@ -618,6 +637,7 @@ int cli_sim(int argc, char** argv) {
   o.def = vd_sim_def_default();
   o.opt = vd_sim_opt_default();
   o.duration = 1.0;
+  o.max_steps = 1e9;
   o.ke_tol = 1e-9;
   o.fps = 30;
   int rc = parse_args(argc, argv, &o);
@@ -626,6 +646,11 @@ int cli_sim(int argc, char** argv) {
   if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
   if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
   if (!o.frames) o.frames = "bin";
+  // the run's steps, counted (a time sum stalls once time + dt == time): at most --max-steps
+  double nsteps = floor(o.duration / o.opt.dt + 0.5);
+  if (nsteps > o.max_steps)
+    return cli_usage_error("sim", "--duration %g s at --dt %g s is %.4g steps, more than --max-steps %.0f", o.duration,
+                           o.opt.dt, nsteps, o.max_steps);
   // load, compile, build
   vd_error err = {0};
   vd_plant_spec* spec = NULL;
@@ -636,6 +661,7 @@ int cli_sim(int argc, char** argv) {
   int nwind = 0;
   outputs out;
   memset(&out, 0, sizeof out);
+  out.watch = -1;
   cli_grow_info info;
   int code = EXIT_OK;
   vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
@@ -703,7 +729,7 @@ int cli_sim(int argc, char** argv) {
     double ramp = o.ramp_set ? o.ramp : total;
     int show = o.po.progress && total / m->opt.dt > 2000;
     if (out.frames_open) frames_write(&out, m, d), next_frame += 1.0 / o.fps;
-    while (!st && d->time - start < total - 0.5 * m->opt.dt) {
+    for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
       double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
       for (int k = 0; k < o.npull; k++) {
         pull* p = &o.pull[k];
@@ -728,11 +754,28 @@ int cli_sim(int argc, char** argv) {
     if (show) progress_bar(total, total), fputc('\n', stderr);
     double wall = cli_now() - t0;
     if (st) {
-      vd_error_set(&err, st, "", 0, 0, "the simulation became unstable at t = %.4f s (non-finite state); try a smaller --dt",
-                   d->time);
-      code = cli_report("sim", &err, st);
+      vd_error_set(&err, st, "", 0, 0,
+                   "the simulation became unstable at t = %.4f s: even steps of dt / %d made a non-finite state "
+                   "or a singular system (%lld numerical warnings); try a smaller --dt, more --iterations or "
+                   "--solver direct",
+                   d->time, 1 << VD_SIM_MAX_SUBSTEP, (long long)d->nwarning);
+      cli_report("sim", &err, st);
       code = EXIT_FAIL;
       goto done;
+    }
+    // numerical trouble that the run survived: say so (the counts are in --stats too)
+    if (d->nwarning) {
+      fprintf(stderr, "verdant sim: warning: %lld steps were retaken in halves (non-finite %lld, solver %lld, "
+                      "stretched %lld times)",
+              (long long)d->warning[VD_SIM_WARN_SUBSTEP], (long long)d->warning[VD_SIM_WARN_NONFINITE],
+              (long long)d->warning[VD_SIM_WARN_SOLVER], (long long)d->warning[VD_SIM_WARN_STRAIN]);
+      if (d->warning[VD_SIM_WARN_UNSTABLE])
+        fprintf(stderr, "; %lld steps stayed overstretched (more than %g%% strain) even at dt / %d: the result is "
+                        "not trustworthy, use a smaller --dt, more --iterations or --solver direct",
+                (long long)d->warning[VD_SIM_WARN_UNSTABLE], 100 * VD_SIM_MAX_STRAIN, 1 << VD_SIM_MAX_SUBSTEP);
+      if (d->warning[VD_SIM_WARN_ARENA])
+        fprintf(stderr, "; contacts were dropped in %lld steps (out of memory)", (long long)d->warning[VD_SIM_WARN_ARENA]);
+      fputc('\n', stderr);
     }
     // outputs
     if (out.frames_open) {
@@ -745,7 +788,7 @@ int cli_sim(int argc, char** argv) {
       if (o.out) {
         char path[4096];
         snprintf(path, sizeof path, "%s/plant.json", o.out);
-        st = vd_plant_write_json(spec, path, &err);
+        st = cli_write_plant(spec, path, 0, &err);
       }
       if (!st && o.final) st = cli_write_plant(spec, o.final, 0, &err);
     }
@@ -758,6 +801,7 @@ int cli_sim(int argc, char** argv) {
   }
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);
+  cli_unwatch(out.watch);
   vd_free(out.bbuf, out.fbuf_n);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);

@@ -33,7 +33,7 @@ extern "C" {
 
 #define VD_SIM_FRAMES_VERSION 1  // version of the binary and JSON Lines frame formats
 #define VD_SIM_MAX_COLLIDERS 64  // most external colliders one state holds
-#define VD_SIM_MAX_SUBSTEP 5     // a failed step is retaken in halves, down to dt / 2^5
+#define VD_SIM_MAX_SUBSTEP 7     // a failed step is retaken in halves, down to dt / 2^7
 #define VD_SIM_MAX_STRAIN 1.0    // a segment stretched beyond (1 + this) l0 fails its step (-)
 #define VD_SIM_BLOWUP_STRAIN 10.0 // ... and fails even the smallest substep beyond (1 + this) l0
 
