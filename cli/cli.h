@@ -14,6 +14,9 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2 };
 int cli_exit_code(vd_status st);
 // Print "verdant <cmd>: file:line:col: message" to stderr and return the exit code.
 int cli_report(const char* cmd, const vd_error* err, vd_status st);
+// An error without a file (a plant that does not compile, a rod model that cannot be built)
+// is about the input plant: name it.
+void cli_blame_input(vd_error* err, const char* path);
 // Print a usage error and return EXIT_USAGE.
 int cli_usage_error(const char* cmd, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 

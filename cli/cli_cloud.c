@@ -273,6 +273,7 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
   double t1 = cli_now();
   vd_model* m = NULL;
   st = vd_plant_compile(plant, &m, err);
+  cli_blame_input(err, po->path);
   vd_plant_stats ps;
   vd_plant_spec_stats(plant, &ps);
   vd_plant_spec_destroy(plant);

@@ -32,6 +32,10 @@ int cli_report(const char* cmd, const vd_error* err, vd_status st) {
   return cli_exit_code(st);
 }
 
+void cli_blame_input(vd_error* err, const char* path) {
+  if (err && err->status != VD_OK && !err->file[0] && path) snprintf(err->file, sizeof err->file, "%s", path);
+}
+
 int cli_usage_error(const char* cmd, const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);

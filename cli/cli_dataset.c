@@ -194,8 +194,11 @@ static int remove_stale(const dataset* ds) {
 // ---------------------------------------------------------------------------------------------
 // one item
 
+// *out_failed is set when the failure was writing or reading back the item's files (a failed
+// run, exit 1) rather than bad input (exit 2)
 static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const cli_cloud_opts* co,
-                           int i, int64_t* points, vd_error* err) {
+                           int i, int64_t* points, int* out_failed, vd_error* err) {
+  *out_failed = 0;
   double values[MAX_VARY];
   uint64_t seed = item_seed(ds, i, values);
   // the item's plant options: its seed, the --vary values as --set
@@ -216,11 +219,15 @@ static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const c
   item_path(ds, i, "json", rpath, sizeof rpath);
   cli_cloud_result res;
   vd_status st = cli_cloud_make(&po, &cco, cpath, &res, err);
-  if (st) return st;
+  if (st) {
+    *out_failed = res.write_failed;
+    return st;
+  }
   // the record: seed, values, counts, the file's size and checksum
   char hex[65];
   int64_t bytes;
   if (!sha256_file(cpath, hex, &bytes)) {
+    *out_failed = 1;
     vd_cloud_free(&res.cloud);
     return vd_error_set(err, VD_ERR_IO, cpath, 0, 0, "cannot read back the cloud: %s", strerror(errno));
   }
@@ -264,6 +271,7 @@ static vd_status make_item(const dataset* ds, const cli_plant_opts* po0, const c
   *points = res.cloud.n;
   vd_cloud_free(&res.cloud);
   st = write_json(rpath, rec, 0, err);
+  *out_failed = st != VD_OK;
   cJSON_Delete(rec);
   return st;
 }
@@ -581,7 +589,7 @@ int cli_dataset(int argc, char** argv) {
     return EXIT_USAGE;
   }
   // the items, --jobs at a time; the first failure (lowest item) stops the rest
-  int done = 0, failed_item = -1;
+  int done = 0, failed_item = -1, failed_output = 0;
   int64_t points = 0;
   vd_error first = {0};
   vd_status first_st = VD_OK;
@@ -594,13 +602,15 @@ int cli_dataset(int argc, char** argv) {
     if (stop >= 0) continue;
     vd_error err = {0};
     int64_t n = 0;
-    vd_status st = make_item(&ds, &po, &co, todo[k], &n, &err);
+    int out_failed = 0;
+    vd_status st = make_item(&ds, &po, &co, todo[k], &n, &out_failed, &err);
 #pragma omp critical(dataset_progress)
     {
       if (st && (failed_item < 0 || todo[k] < failed_item)) {
         failed_item = todo[k];
         first = err;
         first_st = st;
+        failed_output = out_failed;
       }
       if (!st) {
         done++;
@@ -616,7 +626,9 @@ int cli_dataset(int argc, char** argv) {
     char buf[1024];
     fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
             first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
-    return first_st == VD_ERR_IO || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);
+    // writing the dataset failed (disk full, unwritable) or memory ran out: a failed run;
+    // anything else is bad input
+    return failed_output || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);
   }
   // the manifest, once the whole dataset (every shard) is complete
   vd_error err = {0};

@@ -249,6 +249,7 @@ int cli_render(int argc, char** argv) {
   } else {
     st = cli_load_plant(&po, &plant, &ginfo, &err);
     if (!st) st = vd_plant_compile(plant, &model, &err);
+    cli_blame_input(&err, po.path);
   }
   if (st) {
     code = cli_report("render", &err, st);

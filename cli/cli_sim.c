@@ -210,53 +210,6 @@ static int parse_pull(const char* s, pull* p, int move) {
   return 1;
 }
 
-// wind time series: CSV rows t,vx,vy,vz (a header line is skipped); errors name the line
-static vd_status read_wind(const char* path, double** rows, int* n, vd_error* err) {
-  char* text;
-  size_t len;
-  vd_status st = vd_file_read(path, &text, &len, err);
-  if (st) return st;
-  int cap = 0, cnt = 0, line = 0;
-  double* r = NULL;
-  char* p = text;
-  while (*p && !st) {
-    line++;
-    char* e = strchr(p, '\n');
-    if (e) *e = 0;
-    char* s = p;
-    while (*s == ' ' || *s == '\t' || *s == '\r') s++;
-    if (*s && *s != '#' && !(line == 1 && (*s < '0' || *s > '9') && *s != '-' && *s != '.')) {
-      double v[4];
-      char* cr = strchr(s, '\r');
-      if (cr) *cr = 0;
-      if (!parse_list(s, v, 4))
-        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "expected 't,vx,vy,vz' (s, m/s)");
-      else if (cnt && v[0] < r[4 * (cnt - 1)])
-        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "time %g goes backwards", v[0]);
-      else if (!vd_grow((void**)&r, &cap, cnt + 1, 4 * sizeof(double)))
-        st = vd_error_set(err, VD_ERR_NOMEM, path, line, 0, "out of memory");
-      else
-        memcpy(r + 4 * cnt++, v, sizeof v);
-    }
-    p = e ? e + 1 : p + strlen(p);
-  }
-  vd_free(text, len + 1);
-  if (!st && !cnt) st = vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "no wind rows (t,vx,vy,vz)");
-  if (st) {
-    vd_free(r, (size_t)cap * 4 * sizeof(double));
-    return st;
-  }
-  // shrink to the exact size so the caller frees cnt rows
-  double* x = vd_realloc(r, (size_t)cap * 4 * sizeof(double), (size_t)cnt * 4 * sizeof(double));
-  if (!x) {
-    vd_free(r, (size_t)cap * 4 * sizeof(double));
-    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
-  }
-  *rows = x;
-  *n = cnt;
-  return VD_OK;
-}
-
 // ---------------------------------------------------------------------------------------------
 // outputs
 
@@ -559,6 +512,10 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       VAL();
       double v[3];
       if (!parse_list(val, v, 3)) return cli_usage_error(cmd, "%s expects X,Y,Z (%s), got '%s'", a, a[2] == 'g' ? "m/s^2" : "m/s", val);
+      for (int k = 0; k < 3; k++)
+        if (fabs(v[k]) > (a[2] == 'g' ? 1e4 : VD_SIM_MAX_WIND))
+          return cli_usage_error(cmd, "%s expects components within +-%g %s, got '%s'", a,
+                                 a[2] == 'g' ? 1e4 : VD_SIM_MAX_WIND, a[2] == 'g' ? "m/s^2" : "m/s", val);
       if (a[2] == 'g') o->opt.gravity = o->def.gravity = vd_v3(v[0], v[1], v[2]);
       else o->opt.wind = vd_v3(v[0], v[1], v[2]);
     } else if (!strcmp(a, "--gust")) {
@@ -666,9 +623,10 @@ int cli_sim(int argc, char** argv) {
   int code = EXIT_OK;
   vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
   if (!st) cli_grow_info_free(&info);
-  if (!st && o.wind_file) st = read_wind(o.wind_file, &wind, &nwind, &err);
+  if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
   if (!st) st = vd_plant_compile(spec, &plant, &err);
   if (!st) st = vd_sim_build(plant, &o.def, &m, &err);
+  cli_blame_input(&err, o.po.path);
   if (!st) {
     vd_vec3 g = m->opt.gravity;
     m->opt = o.opt;
@@ -755,24 +713,31 @@ int cli_sim(int argc, char** argv) {
     double wall = cli_now() - t0;
     if (st) {
       vd_error_set(&err, st, "", 0, 0,
-                   "the simulation became unstable at t = %.4f s: even steps of dt / %d made a non-finite state "
-                   "or a singular system (%lld numerical warnings); try a smaller --dt, more --iterations or "
-                   "--solver direct",
-                   d->time, 1 << VD_SIM_MAX_SUBSTEP, (long long)d->nwarning);
+                   "the simulation became unstable at t = %.4f s: even steps of dt / %d made a non-finite state, "
+                   "a singular system or a stretch beyond %g%% (%lld numerical warnings); try a smaller --dt or "
+                   "more --iterations%s",
+                   d->time, 1 << VD_SIM_MAX_SUBSTEP, 100 * VD_SIM_BLOWUP_STRAIN, (long long)d->nwarning,
+                   m->opt.solver == VD_SIM_GS ? " (Gauss-Seidel needs many on stiff material), or --solver direct" : "");
       cli_report("sim", &err, st);
       code = EXIT_FAIL;
       goto done;
     }
     // numerical trouble that the run survived: say so (the counts are in --stats too)
     if (d->nwarning) {
-      fprintf(stderr, "verdant sim: warning: %lld steps were retaken in halves (non-finite %lld, solver %lld, "
-                      "stretched %lld times)",
+      fprintf(stderr, "verdant sim: warning: %lld steps were retaken in halves (non-finite %lld, singular %lld, "
+                      "overstretched %lld)",
               (long long)d->warning[VD_SIM_WARN_SUBSTEP], (long long)d->warning[VD_SIM_WARN_NONFINITE],
               (long long)d->warning[VD_SIM_WARN_SOLVER], (long long)d->warning[VD_SIM_WARN_STRAIN]);
       if (d->warning[VD_SIM_WARN_UNSTABLE])
-        fprintf(stderr, "; %lld steps stayed overstretched (more than %g%% strain) even at dt / %d: the result is "
-                        "not trustworthy, use a smaller --dt, more --iterations or --solver direct",
-                (long long)d->warning[VD_SIM_WARN_UNSTABLE], 100 * VD_SIM_MAX_STRAIN, 1 << VD_SIM_MAX_SUBSTEP);
+        fprintf(stderr, "; %lld substeps of dt / %d stayed stretched beyond %g%%: the result is not trustworthy "
+                        "(a contact or tie holding part of the plant, or too large a time step: try a smaller --dt "
+                        "or more --iterations)",
+                (long long)d->warning[VD_SIM_WARN_UNSTABLE], 1 << VD_SIM_MAX_SUBSTEP, 100 * VD_SIM_MAX_STRAIN);
+      if (d->warning[VD_SIM_WARN_STRETCHED] && !d->warning[VD_SIM_WARN_UNSTABLE])
+        fprintf(stderr, "; %lld steps ended with a segment stretched beyond %g%%: the result is not trustworthy "
+                        "(a contact or tie holding part of the plant, a material too soft, or too large a time "
+                        "step: try a smaller --dt or more --iterations)",
+                (long long)d->warning[VD_SIM_WARN_STRETCHED], 100 * VD_SIM_MAX_STRAIN);
       if (d->warning[VD_SIM_WARN_ARENA])
         fprintf(stderr, "; contacts were dropped in %lld steps (out of memory)", (long long)d->warning[VD_SIM_WARN_ARENA]);
       fputc('\n', stderr);

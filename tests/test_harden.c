@@ -371,3 +371,52 @@ TEST(harden, determinism_simulations_across_threads) {
   vd_sim_model_destroy(m);
   vd_model_destroy(pm);
 }
+
+// ---------------------------------------------------------------------------------------------
+// wind time series files (vd_sim_parse_wind; also the fuzz_wind target)
+
+TEST(harden, wind_series_parse) {
+  const char* ok = "t,vx,vy,vz\r\n# gusts\n0,1,0,0\n  0.5 , 2,0,0\r\n\n1,3,-1,0.5\n";
+  double* rows = NULL;
+  int n = 0;
+  vd_error e = {0};
+  CHECK_STATUS(vd_sim_parse_wind(ok, strlen(ok), "w.csv", &rows, &n, &e), VD_OK, e);
+  CHECK_INT(n, 3);
+  if (n == 3) CHECK(rows[4] == 0.5 && rows[5] == 2 && rows[10] == -1 && rows[11] == 0.5);
+  vd_free(rows, (size_t)n * 4 * sizeof(double));
+  // each bad row names its line and column
+  static const struct {
+    const char* text;
+    vd_status st;
+    int line, col;
+  } bad[] = {
+      {"0,1,0,0\n1,2,0\n", VD_ERR_FORMAT, 2, 6},           // a component missing
+      {"0,1,0,0\n1,2,0,0,5\n", VD_ERR_FORMAT, 2, 8},       // one too many
+      {"0,1,0,0\n1,nan,0,0\n", VD_ERR_FORMAT, 2, 3},       // not finite
+      {"0,1,0,0\n1,inf,0,0\n", VD_ERR_FORMAT, 2, 3},
+      {"0,1e300,0,0\n", VD_ERR_FORMAT, 1, 3},              // beyond +-1000 m/s
+      {"0,1,0,0\n2,1,0,0\n1,1,0,0\n", VD_ERR_FORMAT, 3, 1}, // time backwards
+      {"0,1,0,0\n1,x,0,0\n", VD_ERR_FORMAT, 2, 3},         // not a number
+      {"t,vx,vy,vz\n", VD_ERR_FORMAT, 0, 0},               // no rows
+      {"", VD_ERR_FORMAT, 0, 0},                           // empty
+      {"0,1,0\0,0\n", VD_ERR_FORMAT, 1, 6},                // binary
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    vd_error eb = {0};
+    size_t len = k == 9 ? 10 : strlen(bad[k].text);
+    CHECK_STATUS(vd_sim_parse_wind(bad[k].text, len, "w.csv", &rows, &n, &eb), bad[k].st, eb);
+    CHECK_INT(eb.line, bad[k].line);
+    CHECK_INT(eb.col, bad[k].col);
+    CHECK(rows == NULL && n == 0);
+  }
+  // out of memory at every allocation: a status, nothing kept
+  const char* many = "0,1,0,0\n1,1,0,0\n2,1,0,0\n3,1,0,0\n4,1,0,0\n5,1,0,0\n6,1,0,0\n7,1,0,0\n8,1,0,0\n9,1,0,0\n";
+  for (int budget = 0; budget < 12; budget++) {
+    vd_error eo = {0};
+    vdt_oom_begin(budget);
+    vd_status st = vd_sim_parse_wind(many, strlen(many), "w.csv", &rows, &n, &eo);
+    vdt_oom_end();
+    CHECK(st == VD_OK || st == VD_ERR_NOMEM);
+    if (!st) vd_free(rows, (size_t)n * 4 * sizeof(double));
+  }
+}

@@ -149,6 +149,7 @@ typedef struct sim_work {
   int cap_tie_lambda;   // capacity of tie_lambda (rows)
   int model_ties;       // stake ties of the model (the first rows)
   int gravity_only;     // scratch flag
+  double strain;        // largest stretch strain at the end of the last step (-)
 } sim_work;
 
 // Allocate the work block for a model; NULL when out of memory. *bytes gets its size.
