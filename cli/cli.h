@@ -14,6 +14,9 @@ enum { EXIT_OK = 0, EXIT_FAIL = 1, EXIT_USAGE = 2 };
 int cli_exit_code(vd_status st);
 // Print "verdant <cmd>: file:line:col: message" to stderr and return the exit code.
 int cli_report(const char* cmd, const vd_error* err, vd_status st);
+// An error without a file (a plant that does not compile, a rod model that cannot be built)
+// is about the input plant: name it.
+void cli_blame_input(vd_error* err, const char* path);
 // Print a usage error and return EXIT_USAGE.
 int cli_usage_error(const char* cmd, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 
@@ -69,6 +72,14 @@ int cli_parse_num(const char* s, double* out);
     }                                                                                              \
     val = argv[++*i];                                                                              \
   } while (0)
+// Interrupts: SIGINT and SIGTERM remove the temporary files of the outputs being written (the
+// watched ones), then end the process by the same signal. Call once from main.
+void cli_signals_init(void);
+// Watch an output about to be written with vd_outfile (its temporary name is removed if a
+// signal ends the run); returns a slot for cli_unwatch, -1 when every slot is taken.
+int cli_watch(const char* path);
+// Stop watching (after the output was committed or aborted); -1 is ignored.
+void cli_unwatch(int slot);
 
 // Monotonic seconds.
 double cli_now(void);

@@ -13,6 +13,8 @@
 
 const char* cli_cloud_help =
     "  -N, --points N        points of the surface sensors (default 100000)\n"
+    "      --max-points N    most points, or rays of a scan, per cloud (default 50000000, about\n"
+    "                        80 bytes each); more is an error before any memory is taken\n"
     "      --sensor S        uniform | distance | scan (default uniform): uniform on the\n"
     "                        surface; density falling with distance from the scanners; or\n"
     "                        rays on each scanner's grid, the hits being the points\n"
@@ -54,6 +56,7 @@ static const char* cloud_usage =
 void cli_cloud_opts_init(cli_cloud_opts* o) {
   memset(o, 0, sizeof *o);
   o->def = vd_cloud_def_default();
+  o->def.max_points = 50000000;
   o->wdef = vd_cloud_write_def_default();
   vd_scanner s = vd_scanner_default();
   o->pattern = s.pattern;
@@ -127,6 +130,10 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
     if (!cli_parse_i64(val, 1, 2000000000, &v)) FAIL("%s expects an integer in 1..2000000000, got '%s'", a, val);
     o->def.points = v;
     o->points_given = 1;
+  } else if (!strcmp(a, "--max-points")) {
+    CLI_TAKE();
+    if (!cli_parse_i64(val, 1, 2000000000, &v)) FAIL("--max-points expects an integer in 1..2000000000, got '%s'", val);
+    o->def.max_points = v;
   } else if (!strcmp(a, "--sensor")) {
     CLI_TAKE();
     if (!strcmp(val, "uniform")) o->def.sensor = VD_SENSOR_UNIFORM;
@@ -248,6 +255,7 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
   double t1 = cli_now();
   vd_model* m = NULL;
   st = vd_plant_compile(plant, &m, err);
+  cli_blame_input(err, po->path);
   vd_plant_stats ps;
   vd_plant_spec_stats(plant, &ps);
   vd_plant_spec_destroy(plant);
@@ -301,7 +309,9 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
              co->def.sensor == VD_SENSOR_UNIFORM ? "uniform" : co->def.sensor == VD_SENSOR_DISTANCE ? "distance" : "scan",
              co->labels_instance ? "instance" : "semantic");
     wd.comment = comment;
+    int w = cli_watch(out);
     st = vd_cloud_write(&cloud, out, &wd, err);
+    cli_unwatch(w);
     if (st) res->write_failed = 1;
   }
   double t4 = cli_now();

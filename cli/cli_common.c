@@ -5,7 +5,9 @@
 #include <ctype.h>
 #include <math.h>
 #include <errno.h>
+#include <signal.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -31,6 +33,10 @@ int cli_report(const char* cmd, const vd_error* err, vd_status st) {
   return cli_exit_code(st);
 }
 
+void cli_blame_input(vd_error* err, const char* path) {
+  if (err && err->status != VD_OK && !err->file[0] && path) snprintf(err->file, sizeof err->file, "%s", path);
+}
+
 int cli_usage_error(const char* cmd, const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
@@ -39,6 +45,49 @@ int cli_usage_error(const char* cmd, const char* fmt, ...) {
   fprintf(stderr, "\n(see 'verdant %s --help')\n", cmd);
   va_end(ap);
   return EXIT_USAGE;
+}
+
+// ---------------------------------------------------------------------------------------------
+// interrupts: temporary names of the outputs in progress, removed by the signal handler (only
+// async-signal-safe calls there: atomic loads, unlink, signal, raise)
+
+#define CLI_WATCH_SLOTS 2080  // two files per dataset job (--jobs 1024) and a few more
+static char watch_path[CLI_WATCH_SLOTS][4224];
+static atomic_int watch_used[CLI_WATCH_SLOTS];
+
+static void on_signal(int sig) {
+  for (int k = 0; k < CLI_WATCH_SLOTS; k++)
+    if (atomic_load(&watch_used[k]) == 1) unlink(watch_path[k]);
+  signal(sig, SIG_DFL);
+  raise(sig);
+}
+
+void cli_signals_init(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaddset(&sa.sa_mask, SIGINT);
+  sigaddset(&sa.sa_mask, SIGTERM);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
+
+int cli_watch(const char* path) {
+  for (int k = 0; k < CLI_WATCH_SLOTS; k++) {
+    int expect = 0;
+    // claim a free slot (2 = being filled, not yet seen by the handler), fill it, publish it
+    if (atomic_compare_exchange_strong(&watch_used[k], &expect, 2)) {
+      vd_outfile_tmp_path(path, watch_path[k], sizeof watch_path[k]);
+      atomic_store(&watch_used[k], 1);
+      return k;
+    }
+  }
+  return -1;
+}
+
+void cli_unwatch(int slot) {
+  if (slot >= 0 && slot < CLI_WATCH_SLOTS) atomic_store(&watch_used[slot], 0);
 }
 
 double cli_now(void) {

@@ -13,6 +13,8 @@
 #include <nettle/sha2.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #ifdef _OPENMP
@@ -133,6 +135,7 @@ static vd_status write_json(const char* path, const cJSON* root, int pretty, vd_
   char* text = pretty ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
   if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
   vd_outfile f;
+  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
@@ -140,6 +143,7 @@ static vd_status write_json(const char* path, const cJSON* root, int pretty, vd_
     st = vd_outfile_commit(&f, err);
     vd_outfile_abort(&f);
   }
+  cli_unwatch(w);
   cJSON_free(text);
   return st;
 }
@@ -199,6 +203,31 @@ static cJSON* complete_record(const dataset* ds, int i, int* mismatch) {
     }
   }
   return rec;
+}
+
+// temporary files left by a run of this shard that was killed (SIGKILL, power loss): a name
+// "<item or manifest>.tmp.<pid>" whose process is gone is removed; returns how many
+static int remove_stale(const dataset* ds) {
+  DIR* dir = opendir(ds->dir);
+  if (!dir) return 0;
+  int removed = 0;
+  struct dirent* e;
+  while ((e = readdir(dir)) != NULL) {
+    const char* tmp = strstr(e->d_name, ".tmp.");
+    if (!tmp) continue;
+    char* end;
+    long pid = strtol(tmp + 5, &end, 10);
+    if (*end || pid <= 0 || pid == (long)getpid()) continue;
+    int index, mine = !strncmp(e->d_name, "manifest.json.tmp.", 18);
+    if (!mine && sscanf(e->d_name, "item_%d.", &index) == 1) mine = index >= 0 && index % ds->nshard == ds->shard;
+    // only when no process of that id runs here (another machine's run keeps its files)
+    if (!mine || kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", ds->dir, e->d_name);
+    removed += unlink(path) == 0;
+  }
+  closedir(dir);
+  return removed;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -300,8 +329,11 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
 // ---------------------------------------------------------------------------------------------
 // one item
 
+// *out_failed is set when the failure was writing or reading back the item's files, or drawing
+// its pictures (a failed run, exit 1) rather than bad input (exit 2)
 static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant_opts* po0, const cli_cloud_opts* co,
-                           int i, int64_t* points, vd_error* err) {
+                           int i, int64_t* points, int* out_failed, vd_error* err) {
+  *out_failed = 0;
   double values[MAX_VARY];
   uint64_t seed = item_seed(ds, i, values);
   // the item's plant options: its seed, the --vary values as --set
@@ -322,11 +354,15 @@ static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant
   item_path(ds, i, "json", rpath, sizeof rpath);
   cli_cloud_result res;
   vd_status st = cli_cloud_make(&po, &cco, cpath, &res, err);
-  if (st) return st;
+  if (st) {
+    *out_failed = res.write_failed;
+    return st;
+  }
   // the record: seed, values, counts, the file's size and checksum
   char hex[65];
   int64_t bytes;
   if (!sha256_file(cpath, hex, &bytes)) {
+    *out_failed = 1;
     vd_cloud_free(&res.cloud);
     return vd_error_set(err, VD_ERR_IO, cpath, 0, 0, "cannot read back the cloud: %s", strerror(errno));
   }
@@ -337,10 +373,14 @@ static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant
   }
   const char* slash = strrchr(cpath, '/');
   cJSON_AddNumberToObject(rec, "index", i);
-  cJSON_AddNumberToObject(rec, "seed", (double)seed);
+  // seeds and drawn values exactly (cJSON prints 15 digits when they nearly round-trip, and
+  // an item seed near 2^53 printed that way regenerated another item)
+  char num[40];
+  snprintf(num, sizeof num, "%llu", (unsigned long long)seed);
+  cJSON_AddRawToObject(rec, "seed", num);
   cJSON* vv = cJSON_AddObjectToObject(rec, "vary");
   for (int k = 0; k < ds->nvary; k++)
-    cJSON_AddNumberToObject(vv, ds->vary[k].name, values[k]);
+    snprintf(num, sizeof num, "%.17g", values[k]), cJSON_AddRawToObject(vv, ds->vary[k].name, num);
   cJSON_AddStringToObject(rec, "file", slash ? slash + 1 : cpath);
   cJSON_AddNumberToObject(rec, "points", (double)res.cloud.n);
   cJSON* lc = cJSON_AddObjectToObject(rec, "label_points");
@@ -368,6 +408,7 @@ static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant
   // the pictures, then the record that makes the item complete
   if (ds->images) st = make_images(ds, pool, &po, i, seed, rec, err);
   if (!st) st = write_json(rpath, rec, 0, err);
+  *out_failed = st != VD_OK;
   cJSON_Delete(rec);
   return st;
 }
@@ -389,33 +430,58 @@ static void progress(const dataset* ds, int done, int total, double t0) {
   fflush(stderr);
 }
 
-// manifest.json when every item of the dataset is complete; 0 written, 1 not yet, -1 error
+// a record read back prints its seed and vary values exactly again (as written by make_item)
+static void exact_numbers(cJSON* rec) {
+  char num[40];
+  cJSON* seed = cJSON_GetObjectItemCaseSensitive(rec, "seed");
+  if (cJSON_IsNumber(seed) && seed->valuedouble >= 0 && seed->valuedouble < 9007199254740992.0) {
+    snprintf(num, sizeof num, "%.0f", seed->valuedouble);
+    cJSON_ReplaceItemInObjectCaseSensitive(rec, "seed", cJSON_CreateRaw(num));
+  }
+  cJSON* v;
+  cJSON_ArrayForEach(v, cJSON_GetObjectItemCaseSensitive(rec, "vary")) {
+    if (!cJSON_IsNumber(v)) continue;
+    snprintf(num, sizeof num, "%.17g", v->valuedouble);
+    char* raw = cJSON_malloc(strlen(num) + 1);
+    if (!raw) continue;
+    strcpy(raw, num);
+    v->type = cJSON_Raw;
+    v->valuestring = raw;
+  }
+}
+
+// put ",\n\t\"key\":\t<value>" on f (value printed compactly, then deleted)
+static int put_field(FILE* f, int* first, const char* key, cJSON* value) {
+  char* text = value ? cJSON_PrintUnformatted(value) : NULL;
+  cJSON_Delete(value);
+  if (!text) return 0;
+  fprintf(f, "%s\n\t\"%s\":\t%s", *first ? "" : ",", key, text);
+  *first = 0;
+  cJSON_free(text);
+  return 1;
+}
+
+// manifest.json when every item of the dataset is complete; 0 written, 1 not yet, -1 error.
+// Written as a stream, one item at a time: its memory does not grow with the item count.
 static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error* err) {
-  cJSON* items = cJSON_CreateArray();
-  cJSON* root = cJSON_CreateObject();
-  if (!items || !root) {
-    cJSON_Delete(items);
-    cJSON_Delete(root);
+  // first pass: every item complete? the label table (every id once, in order of first
+  // appearance; with instance labels each item keeps its own table) and the total points
+  int64_t total = 0;
+  cJSON* labels = cJSON_CreateArray();
+  if (!labels) {
     vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
     return -1;
   }
-  int64_t total = 0;
-  cJSON* labels = cJSON_CreateArray();
   for (int i = 0; i < ds->count; i++) {
     int mismatch = 0;
     cJSON* rec = complete_record(ds, i, &mismatch);
     if (!rec) {
-      cJSON_Delete(items);
-      cJSON_Delete(root);
       cJSON_Delete(labels);
       return 1;
     }
-    // the label table: every id once, in order of first appearance (semantic labels); with
-    // instance labels each item keeps its own table
-    const cJSON* lt = cJSON_GetObjectItemCaseSensitive(rec, "labels");
     const cJSON* e;
     if (!ds->instance_labels) {
-      cJSON_ArrayForEach(e, lt) {
+      cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(rec, "labels")) {
         const cJSON* id = cJSON_GetObjectItemCaseSensitive(e, "id");
         int seen = 0;
         const cJSON* o;
@@ -425,60 +491,103 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
         }
         if (!seen) cJSON_AddItemToArray(labels, cJSON_Duplicate(e, 1));
       }
-      cJSON_DeleteItemFromObjectCaseSensitive(rec, "labels");
     }
-    cJSON_DeleteItemFromObjectCaseSensitive(rec, "parameters");
     const cJSON* pts = cJSON_GetObjectItemCaseSensitive(rec, "points");
     total += cJSON_IsNumber(pts) ? (int64_t)pts->valuedouble : 0;
-    cJSON_AddItemToArray(items, rec);
+    cJSON_Delete(rec);
   }
-  cJSON_AddStringToObject(root, "format", DATASET_FORMAT);
-  cJSON_AddNumberToObject(root, "version", DATASET_VERSION);
-  cJSON_AddStringToObject(root, "plant", po->path);
-  cJSON_AddNumberToObject(root, "count", ds->count);
-  if (ds->master < (1ull << 53)) {
-    cJSON_AddNumberToObject(root, "master_seed", (double)ds->master);
-  } else {  // beyond a double's integers: as text
-    char seedtxt[32];
-    snprintf(seedtxt, sizeof seedtxt, "%llu", (unsigned long long)ds->master);
-    cJSON_AddStringToObject(root, "master_seed", seedtxt);
+  // the header fields
+  char path[4200];
+  snprintf(path, sizeof path, "%s/manifest.json", ds->dir);
+  vd_outfile f;
+  int w = cli_watch(path);
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (st) {
+    cli_unwatch(w);
+    cJSON_Delete(labels);
+    return -1;
   }
-  cJSON_AddStringToObject(root, "cloud_format", ds->ext);
-  cJSON_AddNumberToObject(root, "points", (double)total);
-  cJSON* par = cJSON_AddObjectToObject(root, "parameters");
-  cJSON_AddStringToObject(par, "id", ds->params);
-  cJSON_AddItemToObject(par, "arguments", cJSON_Duplicate(ds->arguments, 1));
-  cJSON* vv = cJSON_AddObjectToObject(par, "vary");
-  for (int k = 0; k < ds->nvary; k++) {
-    double ab[2] = {ds->vary[k].a, ds->vary[k].b};
-    cJSON_AddItemToObject(vv, ds->vary[k].name, cJSON_CreateDoubleArray(ab, 2));
+  FILE* fp = f.fp;
+  int first = 1, ok = 1;
+  fputc('{', fp);
+  ok &= put_field(fp, &first, "format", cJSON_CreateString(DATASET_FORMAT));
+  ok &= put_field(fp, &first, "version", cJSON_CreateNumber(DATASET_VERSION));
+  ok &= put_field(fp, &first, "plant", cJSON_CreateString(po->path));
+  ok &= put_field(fp, &first, "count", cJSON_CreateNumber(ds->count));
+  char seedtxt[32];
+  snprintf(seedtxt, sizeof seedtxt, "%llu", (unsigned long long)ds->master);
+  if (ds->master < (1ull << 53))
+    ok &= put_field(fp, &first, "master_seed", cJSON_CreateRaw(seedtxt));
+  else  // beyond a double's integers: as text
+    ok &= put_field(fp, &first, "master_seed", cJSON_CreateString(seedtxt));
+  ok &= put_field(fp, &first, "cloud_format", cJSON_CreateString(ds->ext));
+  ok &= put_field(fp, &first, "points", cJSON_CreateNumber((double)total));
+  cJSON* par = cJSON_CreateObject();
+  if (par) {
+    cJSON_AddStringToObject(par, "id", ds->params);
+    cJSON_AddItemToObject(par, "arguments", cJSON_Duplicate(ds->arguments, 1));
+    cJSON* vv = cJSON_AddObjectToObject(par, "vary");
+    for (int k = 0; k < ds->nvary; k++) {
+      double ab[2] = {ds->vary[k].a, ds->vary[k].b};
+      cJSON_AddItemToObject(vv, ds->vary[k].name, cJSON_CreateDoubleArray(ab, 2));
+    }
   }
-  cJSON_AddStringToObject(root, "regenerate",
-                          "verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
-                          "<parameters.arguments> -o item.<cloud_format>");
+  ok &= put_field(fp, &first, "parameters", par);
+  ok &= put_field(fp, &first, "regenerate",
+                  cJSON_CreateString("verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
+                                     "<parameters.arguments> -o item.<cloud_format>"));
   if (ds->images) {
-    cJSON* im = cJSON_AddObjectToObject(root, "images");
-    cJSON_AddNumberToObject(im, "per_item", ds->images);
-    cJSON_AddNumberToObject(im, "width", ds->img_w);
-    cJSON_AddNumberToObject(im, "height", ds->img_h);
-    cJSON_AddStringToObject(im, "depth", "16-bit grey PNG, millimetres along the optical axis, 0 = nothing");
-    cJSON_AddStringToObject(im, "masks", "16-bit grey PNG ids: label (the labels table), instance; 0 = background");
-    char regen[256];
-    snprintf(regen, sizeof regen,
-             "verdant render PLANT --seed <item seed> [--set NAME=<item vary value>]... --camera "
-             "orbit:<azimuth>:<elevation> --size %dx%d --no-legend --depth --masks -o view.png",
-             ds->img_w, ds->img_h);
-    cJSON_AddStringToObject(im, "regenerate", regen);
+    cJSON* im = cJSON_CreateObject();
+    if (im) {
+      cJSON_AddNumberToObject(im, "per_item", ds->images);
+      cJSON_AddNumberToObject(im, "width", ds->img_w);
+      cJSON_AddNumberToObject(im, "height", ds->img_h);
+      cJSON_AddStringToObject(im, "depth", "16-bit grey PNG, millimetres along the optical axis, 0 = nothing");
+      cJSON_AddStringToObject(im, "masks", "16-bit grey PNG ids: label (the labels table), instance; 0 = background");
+      char regen[256];
+      snprintf(regen, sizeof regen,
+               "verdant render PLANT --seed <item seed> [--set NAME=<item vary value>]... --camera "
+               "orbit:<azimuth>:<elevation> --size %dx%d --no-legend --depth --masks -o view.png",
+               ds->img_w, ds->img_h);
+      cJSON_AddStringToObject(im, "regenerate", regen);
+    }
+    ok &= put_field(fp, &first, "images", im);
   }
   if (ds->instance_labels)
     cJSON_Delete(labels);  // in the items
   else
-    cJSON_AddItemToObject(root, "labels", labels);
-  cJSON_AddItemToObject(root, "items", items);
-  char path[4200];
-  snprintf(path, sizeof path, "%s/manifest.json", ds->dir);
-  vd_status st = write_json(path, root, 1, err);
-  cJSON_Delete(root);
+    ok &= put_field(fp, &first, "labels", labels);
+  // second pass: the items, one line each
+  fputs(",\n\t\"items\":\t[", fp);
+  for (int i = 0; ok && i < ds->count; i++) {
+    int mismatch = 0;
+    cJSON* rec = complete_record(ds, i, &mismatch);
+    if (!rec) {  // removed since the first pass
+      vd_outfile_abort(&f);
+      cli_unwatch(w);
+      return 1;
+    }
+    if (!ds->instance_labels) cJSON_DeleteItemFromObjectCaseSensitive(rec, "labels");
+    cJSON_DeleteItemFromObjectCaseSensitive(rec, "parameters");
+    exact_numbers(rec);
+    char* text = cJSON_PrintUnformatted(rec);
+    cJSON_Delete(rec);
+    if (!text) {
+      ok = 0;
+      break;
+    }
+    fprintf(fp, "%s\n\t\t%s", i ? "," : "", text);
+    cJSON_free(text);
+  }
+  fputs("]\n}\n", fp);
+  if (!ok) {
+    vd_outfile_abort(&f);
+    cli_unwatch(w);
+    vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    return -1;
+  }
+  st = vd_outfile_commit(&f, err);
+  cli_unwatch(w);
   return st ? -1 : 0;
 }
 
@@ -619,6 +728,7 @@ int cli_dataset(int argc, char** argv) {
     fprintf(stderr, "verdant dataset: %s: cannot create the folder: %s\n", ds.dir, strerror(errno));
     return EXIT_FAIL;
   }
+  remove_stale(&ds);
   // this shard's items that are not complete yet
   int* todo = vd_malloc((size_t)ds.count * sizeof(int));
   if (!todo) {
@@ -646,7 +756,7 @@ int cli_dataset(int argc, char** argv) {
     return EXIT_USAGE;
   }
   // the items, --jobs at a time; the first failure (lowest item) stops the rest
-  int done = 0, failed_item = -1;
+  int done = 0, failed_item = -1, failed_output = 0;
   int64_t points = 0;
   vd_error first = {0};
   vd_status first_st = VD_OK;
@@ -674,13 +784,15 @@ int cli_dataset(int argc, char** argv) {
     if (stop >= 0) continue;
     vd_error err = {0};
     int64_t n = 0;
-    vd_status st = make_item(&ds, &pool, &po, &co, todo[k], &n, &err);
+    int out_failed = 0;
+    vd_status st = make_item(&ds, &pool, &po, &co, todo[k], &n, &out_failed, &err);
 #pragma omp critical(dataset_progress)
     {
       if (st && (failed_item < 0 || todo[k] < failed_item)) {
         failed_item = todo[k];
         first = err;
         first_st = st;
+        failed_output = out_failed;
       }
       if (!st) {
         done++;
@@ -697,7 +809,9 @@ int cli_dataset(int argc, char** argv) {
     char buf[1024];
     fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
             first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
-    return first_st == VD_ERR_IO || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);
+    // writing the dataset failed (disk full, unwritable) or memory ran out: a failed run;
+    // anything else is bad input
+    return failed_output || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);
   }
   // the manifest, once the whole dataset (every shard) is complete
   vd_error err = {0};

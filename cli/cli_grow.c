@@ -130,6 +130,7 @@ int cli_grow(int argc, char** argv) {
   vd_status st = cli_load_plant(&po, &plant, &info, &err);
   if (st) return cli_report("grow", &err, st);
   if (out) st = cli_write_plant(plant, out, ascii, &err);
+  cli_blame_input(&err, po.path);  // a plant that does not compile (output errors name the output)
   if (!st && stats && !print_stats(plant, &info)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   vd_plant_spec_destroy(plant);
   cli_grow_info_free(&info);

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Writing a plant by the output file's extension: plant JSON, OBJ (+MTL) or PLY mesh.
+#include <string.h>
+
 #include "cli.h"
 
-vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
+static vd_status write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
   if (cli_has_ext(path, ".json")) return vd_plant_write_json(plant, path, err);
   // meshes: compile, tessellate the rest shape, write with the label table
   vd_model* m = NULL;
@@ -18,5 +20,17 @@ vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int asci
     vd_mesh_free(&mesh);
   }
   vd_model_destroy(m);
+  return st;
+}
+
+vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
+  // the file and, for OBJ, its material library: temporary names removed if a signal ends the run
+  char mtl[4200];
+  size_t n = strlen(path);
+  snprintf(mtl, sizeof mtl, "%.*s.mtl", (int)(cli_has_ext(path, ".obj") ? n - 4 : n), path);
+  int w0 = cli_watch(path), w1 = cli_has_ext(path, ".obj") ? cli_watch(mtl) : -1;
+  vd_status st = write_plant(plant, path, ascii, err);
+  cli_unwatch(w0);
+  cli_unwatch(w1);
   return st;
 }

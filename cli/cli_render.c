@@ -266,6 +266,8 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
   sibling(out, "label.png", p_label, sizeof p_label);
   sibling(out, "instance.png", p_inst, sizeof p_inst);
   sibling(out, "json", p_json, sizeof p_json);
+  // an interrupt removes the temporary files of these outputs
+  int watch[5] = {cli_watch(out), cli_watch(p_depth), cli_watch(p_label), cli_watch(p_inst), cli_watch(p_json)};
   // colour, then depth and masks, then the sidecar naming them
   vd_status st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
   if (!st && depth) st = vd_render_write_png(f, VD_LAYER_DEPTH, p_depth, err);
@@ -283,6 +285,7 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
     files[nf] = NULL;
     st = vd_render_write_json(f, files, p_json, err);
   }
+  for (int k = 0; k < 5; k++) cli_unwatch(watch[k]);
   return st;
 }
 
@@ -347,6 +350,7 @@ int cli_render(int argc, char** argv) {
   } else {
     st = cli_load_plant(&o.po, &plant, &ginfo, &err);
     if (!st) st = vd_plant_compile(plant, &model, &err);
+    cli_blame_input(&err, o.po.path);
   }
   if (st) {
     code = cli_report("render", &err, st);

@@ -31,8 +31,10 @@ static const char* sim_help =
     "      --ke-tol E          --settle stops when the kinetic energy stays below E (J), 1e-9\n"
     "      --sag-free          rest shape solved so that the modelled shape is the equilibrium\n"
     "      --stake S           tie the main stem to a fixed stake every S metres (greenhouse string)\n"
+    "      --max-steps N       most time steps of a run, duration / dt (default 1000000000)\n"
     "model:\n"
     "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
+    "      --max-segments N    most rod segments of the model (default 1000000, about 2 kB each)\n"
     "      --young [C=]E       Young's modulus (Pa) of all classes, or of class C\n"
     "      --density [C=]RHO   density (kg/m^3); --poisson [C=]NU Poisson ratio\n"
     "                          classes: green wood pedicel leaf fruit flower root\n"
@@ -244,6 +246,7 @@ typedef struct sim_opts {
   char mesh_path[8][512];  // --collider-mesh files
   vd_vec3 mesh_pos[8];     // ... and their placements (m)
   int nmesh;
+  double max_steps;
   vd_sim_def def;
   vd_sim_opt opt;
 } sim_opts;
@@ -319,59 +322,12 @@ static int parse_pull(const char* s, pull* p, int move) {
   return 1;
 }
 
-// wind time series: CSV rows t,vx,vy,vz (a header line is skipped); errors name the line
-static vd_status read_wind(const char* path, double** rows, int* n, vd_error* err) {
-  char* text;
-  size_t len;
-  vd_status st = vd_file_read(path, &text, &len, err);
-  if (st) return st;
-  int cap = 0, cnt = 0, line = 0;
-  double* r = NULL;
-  char* p = text;
-  while (*p && !st) {
-    line++;
-    char* e = strchr(p, '\n');
-    if (e) *e = 0;
-    char* s = p;
-    while (*s == ' ' || *s == '\t' || *s == '\r') s++;
-    if (*s && *s != '#' && !(line == 1 && (*s < '0' || *s > '9') && *s != '-' && *s != '.')) {
-      double v[4];
-      char* cr = strchr(s, '\r');
-      if (cr) *cr = 0;
-      if (!parse_list(s, v, 4))
-        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "expected 't,vx,vy,vz' (s, m/s)");
-      else if (cnt && v[0] < r[4 * (cnt - 1)])
-        st = vd_error_set(err, VD_ERR_FORMAT, path, line, 1, "time %g goes backwards", v[0]);
-      else if (!vd_grow((void**)&r, &cap, cnt + 1, 4 * sizeof(double)))
-        st = vd_error_set(err, VD_ERR_NOMEM, path, line, 0, "out of memory");
-      else
-        memcpy(r + 4 * cnt++, v, sizeof v);
-    }
-    p = e ? e + 1 : p + strlen(p);
-  }
-  vd_free(text, len + 1);
-  if (!st && !cnt) st = vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "no wind rows (t,vx,vy,vz)");
-  if (st) {
-    vd_free(r, (size_t)cap * 4 * sizeof(double));
-    return st;
-  }
-  // shrink to the exact size so the caller frees cnt rows
-  double* x = vd_realloc(r, (size_t)cap * 4 * sizeof(double), (size_t)cnt * 4 * sizeof(double));
-  if (!x) {
-    vd_free(r, (size_t)cap * 4 * sizeof(double));
-    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
-  }
-  *rows = x;
-  *n = cnt;
-  return VD_OK;
-}
-
 // ---------------------------------------------------------------------------------------------
 // outputs
 
 typedef struct outputs {
   vd_outfile frames, colliders;
-  int frames_open, colliders_open, jsonl;
+  int frames_open, colliders_open, jsonl, watch, cwatch;
   float* fbuf;
   size_t fbuf_n;
   unsigned char* bbuf;
@@ -396,12 +352,14 @@ static void put_f32(unsigned char* b, float f) {
 static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir, int jsonl, vd_error* err) {
   char path[4096];
   snprintf(path, sizeof path, "%s/frames.%s", dir, jsonl ? "jsonl" : "bin");
+  o->watch = cli_watch(path);
   vd_status st = vd_outfile_open(&o->frames, path, err);
   if (st) return st;
   o->frames_open = 1;
   o->jsonl = jsonl;
   // the colliders' poses at the same instants (for pictures of the run)
   snprintf(path, sizeof path, "%s/colliders.jsonl", dir);
+  o->cwatch = cli_watch(path);
   if ((st = vd_outfile_open(&o->colliders, path, err))) return st;
   o->colliders_open = 1;
   if (!jsonl) {
@@ -489,12 +447,14 @@ static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, co
   char path[4096];
   snprintf(path, sizeof path, "%s/rod.json", dir);
   vd_outfile f;
+  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     fputc('\n', f.fp);
     st = vd_outfile_commit(&f, err);
   }
+  cli_unwatch(w);
   cJSON_free(text);
   return st;
 }
@@ -513,8 +473,12 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
   char path[4096];
   snprintf(path, sizeof path, "%s/events.csv", dir);
   vd_outfile f;
+  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
-  if (st) return st;
+  if (st) {
+    cli_unwatch(w);
+    return st;
+  }
   fputs("time_s,segment,node,label,label_name,instance,class,force_N,moment_Nm,cs,cb_per_m,cause\n", f.fp);
   for (int k = 0; k < d->nevent; k++) {
     const vd_sim_event* e = &d->event[k];
@@ -522,7 +486,9 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
             label_name(plant, e->label), e->instance, vd_sim_class_name(e->cls), e->force, e->moment, e->cs, e->cb,
             cause_name(e->cause));
   }
-  return vd_outfile_commit(&f, err);
+  st = vd_outfile_commit(&f, err);
+  cli_unwatch(w);
+  return st;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -570,6 +536,9 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "contacts", d->ncontact);
   cJSON_AddNumberToObject(root, "sag_free_out_of_reach", m->nsagfree_clamped);
   cJSON_AddNumberToObject(root, "warnings", (double)d->nwarning);
+  cJSON* wk = cJSON_AddObjectToObject(root, "warning_counts");
+  for (int k = 0; k < VD_SIM_WARN_COUNT; k++)
+    cJSON_AddNumberToObject(wk, vd_sim_warning_name((vd_sim_warning)k), (double)d->warning[k]);
   char* text = cJSON_Print(root);
   cJSON_Delete(root);
   if (!text) return 0;
@@ -638,6 +607,10 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
     } else if (!strcmp(a, "--segment-length")) {
       NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
+    } else if (!strcmp(a, "--max-segments")) {
+      NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
+    } else if (!strcmp(a, "--max-steps")) {
+      NUM(o->max_steps, x_ >= 1 && x_ <= 1e15 && x_ == floor(x_), "an integer in 1..1e15");
     } else if (!strcmp(a, "--young")) {
       VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, young), 1, 1)) return EXIT_USAGE;
@@ -662,6 +635,10 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       VAL();
       double v[3];
       if (!parse_list(val, v, 3)) return cli_usage_error(cmd, "%s expects X,Y,Z (%s), got '%s'", a, a[2] == 'g' ? "m/s^2" : "m/s", val);
+      for (int k = 0; k < 3; k++)
+        if (fabs(v[k]) > (a[2] == 'g' ? 1e4 : VD_SIM_MAX_WIND))
+          return cli_usage_error(cmd, "%s expects components within +-%g %s, got '%s'", a,
+                                 a[2] == 'g' ? 1e4 : VD_SIM_MAX_WIND, a[2] == 'g' ? "m/s^2" : "m/s", val);
       if (a[2] == 'g') o->opt.gravity = o->def.gravity = vd_v3(v[0], v[1], v[2]);
       else o->opt.wind = vd_v3(v[0], v[1], v[2]);
     } else if (!strcmp(a, "--gust")) {
@@ -755,6 +732,7 @@ int cli_sim(int argc, char** argv) {
   o.def = vd_sim_def_default();
   o.opt = vd_sim_opt_default();
   o.duration = 1.0;
+  o.max_steps = 1e9;
   o.ke_tol = 1e-9;
   o.fps = 30;
   int rc = parse_args(argc, argv, &o);
@@ -763,6 +741,11 @@ int cli_sim(int argc, char** argv) {
   if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
   if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
   if (!o.frames) o.frames = "bin";
+  // the run's steps, counted (a time sum stalls once time + dt == time): at most --max-steps
+  double nsteps = floor(o.duration / o.opt.dt + 0.5);
+  if (nsteps > o.max_steps)
+    return cli_usage_error("sim", "--duration %g s at --dt %g s is %.4g steps, more than --max-steps %.0f", o.duration,
+                           o.opt.dt, nsteps, o.max_steps);
   // load, compile, build
   vd_error err = {0};
   vd_plant_spec* spec = NULL;
@@ -774,13 +757,15 @@ int cli_sim(int argc, char** argv) {
   vd_sdf* sdf[8] = {NULL};
   outputs out;
   memset(&out, 0, sizeof out);
+  out.watch = out.cwatch = -1;
   cli_grow_info info;
   int code = EXIT_OK;
   vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
   if (!st) cli_grow_info_free(&info);
-  if (!st && o.wind_file) st = read_wind(o.wind_file, &wind, &nwind, &err);
+  if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
   if (!st) st = vd_plant_compile(spec, &plant, &err);
   if (!st) st = vd_sim_build(plant, &o.def, &m, &err);
+  cli_blame_input(&err, o.po.path);
   if (!st) {
     vd_vec3 g = m->opt.gravity;
     m->opt = o.opt;
@@ -853,7 +838,7 @@ int cli_sim(int argc, char** argv) {
     double ramp = o.ramp_set ? o.ramp : total;
     int show = o.po.progress && total / m->opt.dt > 2000;
     if (out.frames_open) frames_write(&out, m, d), next_frame += 1.0 / o.fps;
-    while (!st && d->time - start < total - 0.5 * m->opt.dt) {
+    for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
       double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
       for (int k = 0; k < o.npull; k++) {
         pull* p = &o.pull[k];
@@ -878,11 +863,35 @@ int cli_sim(int argc, char** argv) {
     if (show) progress_bar(total, total), fputc('\n', stderr);
     double wall = cli_now() - t0;
     if (st) {
-      vd_error_set(&err, st, "", 0, 0, "the simulation became unstable at t = %.4f s (non-finite state); try a smaller --dt",
-                   d->time);
-      code = cli_report("sim", &err, st);
+      vd_error_set(&err, st, "", 0, 0,
+                   "the simulation became unstable at t = %.4f s: even steps of dt / %d made a non-finite state, "
+                   "a singular system or a stretch beyond %g%% (%lld numerical warnings); try a smaller --dt or "
+                   "more --iterations%s",
+                   d->time, 1 << VD_SIM_MAX_SUBSTEP, 100 * VD_SIM_BLOWUP_STRAIN, (long long)d->nwarning,
+                   m->opt.solver == VD_SIM_GS ? " (Gauss-Seidel needs many on stiff material), or --solver direct" : "");
+      cli_report("sim", &err, st);
       code = EXIT_FAIL;
       goto done;
+    }
+    // numerical trouble that the run survived: say so (the counts are in --stats too)
+    if (d->nwarning) {
+      fprintf(stderr, "verdant sim: warning: %lld steps were retaken in halves (non-finite %lld, singular %lld, "
+                      "overstretched %lld)",
+              (long long)d->warning[VD_SIM_WARN_SUBSTEP], (long long)d->warning[VD_SIM_WARN_NONFINITE],
+              (long long)d->warning[VD_SIM_WARN_SOLVER], (long long)d->warning[VD_SIM_WARN_STRAIN]);
+      if (d->warning[VD_SIM_WARN_UNSTABLE])
+        fprintf(stderr, "; %lld substeps of dt / %d stayed stretched beyond %g%%: the result is not trustworthy "
+                        "(a contact or tie holding part of the plant, or too large a time step: try a smaller --dt "
+                        "or more --iterations)",
+                (long long)d->warning[VD_SIM_WARN_UNSTABLE], 1 << VD_SIM_MAX_SUBSTEP, 100 * VD_SIM_MAX_STRAIN);
+      if (d->warning[VD_SIM_WARN_STRETCHED] && !d->warning[VD_SIM_WARN_UNSTABLE])
+        fprintf(stderr, "; %lld steps ended with a segment stretched beyond %g%%: the result is not trustworthy "
+                        "(a contact or tie holding part of the plant, a material too soft, or too large a time "
+                        "step: try a smaller --dt or more --iterations)",
+                (long long)d->warning[VD_SIM_WARN_STRETCHED], 100 * VD_SIM_MAX_STRAIN);
+      if (d->warning[VD_SIM_WARN_ARENA])
+        fprintf(stderr, "; contacts were dropped in %lld steps (out of memory)", (long long)d->warning[VD_SIM_WARN_ARENA]);
+      fputc('\n', stderr);
     }
     // outputs
     if (out.frames_open) {
@@ -900,7 +909,7 @@ int cli_sim(int argc, char** argv) {
       if (o.out) {
         char path[4096];
         snprintf(path, sizeof path, "%s/plant.json", o.out);
-        st = vd_plant_write_json(spec, path, &err);
+        st = cli_write_plant(spec, path, 0, &err);
       }
       if (!st && o.final) st = cli_write_plant(spec, o.final, 0, &err);
     }
@@ -914,6 +923,8 @@ int cli_sim(int argc, char** argv) {
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);
   if (out.colliders_open) vd_outfile_abort(&out.colliders);
+  cli_unwatch(out.watch);
+  cli_unwatch(out.cwatch);
   vd_free(out.bbuf, out.fbuf_n);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);

@@ -66,6 +66,7 @@ int cli_validate(int argc, char** argv) {
     po.progress = prog;
     if (!st) cli_grow_info_free(&info);
     if (!st) st = vd_plant_compile(spec, &plant, &err);
+    cli_blame_input(&err, po.path);
     if (st) {
       vd_plant_spec_destroy(spec);
       return cli_report("validate", &err, st);
@@ -87,6 +88,11 @@ int cli_validate(int argc, char** argv) {
   if (st) {
     cli_report("validate", &err, st);
     return EXIT_FAIL;
+  }
+  // a filter that matches nothing is a usage error, not a pass
+  if (n == 0) {
+    vd_free(r, 0);
+    return cli_usage_error("validate", "--case '%s' matches no validation case", filter ? filter : "");
   }
   int fails = 0;
   for (int k = 0; k < n; k++) fails += !r[k].pass;

@@ -28,6 +28,7 @@ static const char* main_help =
 
 int main(int argc, char** argv) {
   vd_set_log(log_to_stderr, NULL);
+  cli_signals_init();
   if (argc < 2) {
     fputs(main_help, stderr);
     return EXIT_USAGE;

@@ -10,24 +10,32 @@ set -u
 cd "$(dirname "$0")/.."
 SECONDS_PER=${1:-30}
 shift || true
-TARGETS=${*:-"fuzz_lsys fuzz_plant_json fuzz_expr fuzz_cloud fuzz_curves fuzz_frames"}
+# every fuzz/fuzz_*.c is a target unless some are named
+TARGETS=${*:-$(cd fuzz && ls fuzz_*.c | sed 's/\.c$//' | tr '\n' ' ')}
 CC=${FUZZ_CC:-clang}
 OUT=build-fuzz
 SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 CFLAGS="-std=c11 -g -O1 -ffp-contract=off -Iinclude -Isrc $(pkg-config --cflags libcjson) $SAN"
 LIBS="$(pkg-config --libs libcjson) -lm"
 
-# library objects, rebuilt when the source or any header is newer
+# library objects, rebuilt when the source or any header is newer (on every core at once)
 mkdir -p "$OUT/obj"
 newest_h=$(ls -t include/verdant/*.h src/*/*.h fuzz/*.h | head -1)
 objs=()
+jobs=$(nproc 2>/dev/null || echo 2)
 for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/cloud/*.c src/sim/*.c; do
   obj="$OUT/obj/$(basename "${src%.c}").o"
   objs+=("$obj")
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$newest_h" -nt "$obj" ]; then
-    $CC $CFLAGS -fsanitize=fuzzer-no-link -c "$src" -o "$obj" || exit 2
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
+    $CC $CFLAGS -fsanitize=fuzzer-no-link -c "$src" -o "$obj" &
   fi
 done
+fail=0
+for p in $(jobs -rp); do wait "$p" || fail=1; done
+wait || true
+for o in "${objs[@]}"; do [ -f "$o" ] || fail=1; done
+[ $fail -eq 0 ] || exit 2
 
 status=0
 printf '%-16s %10s %8s %8s %9s\n' target execs seconds corpus findings
@@ -38,9 +46,8 @@ for t in $TARGETS; do
   log="$OUT/$t.log"
   touch "$OUT/$t.stamp"
   # the first crash, leak or timeout stops the run; its input is saved in findings/<target>/
-  dict=lsys.dict; [ "$t" = fuzz_plant_json ] && dict=plant_json.dict; [ "$t" = fuzz_cloud ] && dict=cloud.dict
-  [ "$t" = fuzz_curves ] && dict=curves.dict
-  [ "$t" = fuzz_frames ] && dict=frames.dict
+  # the dictionary fuzz/<name>.dict of fuzz_<name>, else the L-Py one (fuzz_expr)
+  dict=lsys.dict; [ -f "fuzz/${t#fuzz_}.dict" ] && dict="${t#fuzz_}.dict"
   "$bin" -max_len=4096 -timeout=5 -rss_limit_mb=2048 -max_total_time="$SECONDS_PER" \
     -dict="fuzz/$dict" -print_final_stats=1 -artifact_prefix="$OUT/findings/$t/" \
     "$OUT/corpus/$t" "fuzz/corpus/$t" >"$log" 2>&1

@@ -87,13 +87,15 @@ typedef struct vd_cloud_def {
   vd_mesh_def mesh;          // tessellation (caps are always closed); default vd_mesh_def_default()
   int threads;               // OpenMP threads, 0 = OpenMP's default; the output never depends
                              // on it; default 0
+  int64_t max_points;        // most points (surface modes) or rays (scan), about 80 bytes each;
+                             // beyond is VD_ERR_LIMIT before anything is allocated; default 2e9
   int64_t max_attempts;      // most draws for one point, and a hundredth of it per point on
                              // average over a chunk, before giving up (>= 1); default 100000
 } vd_cloud_def;
 
 // Defaults: points 100000, seed 0, uniform sensor, inverse-square law, no table, no noise
 // (sigma 0 m, slope 0 m/m), occlusion off, interior removal on, no scanners, default
-// tessellation, threads 0 (OpenMP's choice), max_attempts 100000.
+// tessellation, threads 0 (OpenMP's choice), max_points 2000000000, max_attempts 100000.
 vd_cloud_def vd_cloud_def_default(void);
 
 // A labelled point cloud. Point arrays live in one block; the label table in another.

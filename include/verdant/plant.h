@@ -28,6 +28,8 @@ extern "C" {
 
 #define VD_PLANT_FORMAT_VERSION 1  // version of the plant JSON schema (docs/formats.md)
 #define VD_LABEL_NAME_MAX 48       // longest label name including the NUL
+#define VD_PLANT_MAX_COORD 1e9     // largest |coordinate| and radius a plant may have (m): beyond
+                                   // it meshes and clouds written as float32 would hold inf
 
 // What the physics and robot modules treat specially; derived from the label's name.
 typedef enum vd_organ {

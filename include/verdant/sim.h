@@ -34,18 +34,20 @@ extern "C" {
 
 #define VD_SIM_FRAMES_VERSION 1  // version of the binary and JSON Lines frame formats
 #define VD_SIM_MAX_COLLIDERS 64  // most external colliders one state holds
-#define VD_SIM_MAX_SUBSTEP 5     // a failed step is retaken in halves, down to dt / 2^5
-#define VD_SIM_MAX_STRAIN 1.0    // a segment stretched beyond (1 + this) l0 fails its step (-)
-#define VD_SIM_BLOWUP_STRAIN 10.0 // ... and fails even the smallest substep beyond (1 + this) l0
+#define VD_SIM_MAX_SUBSTEP 7     // a failed step is retaken in halves, down to dt / 2^7
+#define VD_SIM_MAX_STRAIN 1.0    // a step that stretches a segment beyond (1 + this) l0, and to more
+                                 // than twice the largest stretch at its start, fails (-)
+#define VD_SIM_BLOWUP_STRAIN 10.0 // a step that stretches a segment beyond (1 + this) l0 fails (-)
 
 // Kinds of numerical warnings, counted in vd_sim_data::warning (MuJoCo's mjData.warning).
 typedef enum vd_sim_warning {
   VD_SIM_WARN_NONFINITE = 0,  // a step made a non-finite state: undone and retaken in halves
   VD_SIM_WARN_SOLVER,         // a factorisation of the direct solver failed: retaken in halves
-  VD_SIM_WARN_STRAIN,         // a segment stretched beyond VD_SIM_MAX_STRAIN: retaken in halves
+  VD_SIM_WARN_STRAIN,         // a step stretched a segment beyond VD_SIM_MAX_STRAIN: retaken
   VD_SIM_WARN_SUBSTEP,        // steps retaken as two half steps (each failure above causes one)
   VD_SIM_WARN_UNSTABLE,       // substeps of dt / 2^VD_SIM_MAX_SUBSTEP that still failed (or were
                               // kept stretched beyond VD_SIM_MAX_STRAIN)
+  VD_SIM_WARN_STRETCHED,      // steps that ended with a segment stretched beyond VD_SIM_MAX_STRAIN
   VD_SIM_WARN_ARENA,          // the per-step arena could not hold the contact candidates
   VD_SIM_WARN_COUNT
 } vd_sim_warning;
@@ -303,12 +305,14 @@ void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d);
 void vd_sim_data_destroy(vd_sim_data* d);
 
 // Advance one time step of m->opt.dt. A step that fails (non-finite state, failed
-// factorisation, a segment stretched beyond VD_SIM_MAX_STRAIN) is undone and retaken as two
-// half steps, recursively down to dt / 2^VD_SIM_MAX_SUBSTEP; each failure is counted in
-// d->warning. At the smallest substep a state stretched up to VD_SIM_BLOWUP_STRAIN is kept
-// (counted as VD_SIM_WARN_UNSTABLE); a non-finite one, a failed factorisation or a larger
-// stretch is put back to the start of that substep (time says where) and VD_ERR_VALUE is
-// returned; else VD_OK. The state never holds a non-finite number.
+// factorisation, a segment stretched beyond VD_SIM_MAX_STRAIN and to more than twice the
+// largest stretch at the start of the step, or beyond VD_SIM_BLOWUP_STRAIN) is undone and
+// retaken as two half steps, recursively down to dt / 2^VD_SIM_MAX_SUBSTEP; each failure is
+// counted in d->warning. At the smallest substep a stretched state below VD_SIM_BLOWUP_STRAIN
+// is kept (counted as VD_SIM_WARN_UNSTABLE); a non-finite one, a failed factorisation or a
+// larger stretch is put back to the start of that substep (time says where) and VD_ERR_VALUE
+// is returned; else VD_OK. A step that ends stretched beyond VD_SIM_MAX_STRAIN is counted as
+// VD_SIM_WARN_STRETCHED. The state never holds a non-finite number.
 vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d);
 
 // Settling: what to run and when to stop.
@@ -335,6 +339,18 @@ int vd_sim_add_collider(vd_sim_data* d, const vd_sim_collider* c);
 void vd_sim_set_collider_pose(const vd_sim_model* m, vd_sim_data* d, int i, vd_vec3 pos, vd_quat q);
 // Add a user tie (compliance > 0); returns its index or -1 when out of memory.
 int vd_sim_add_tie(vd_sim_data* d, int node, vd_vec3 target, double compliance);
+
+// Largest wind velocity component of a time series (m/s) and most rows.
+#define VD_SIM_MAX_WIND 1000.0
+#define VD_SIM_MAX_WIND_ROWS 10000000
+// Parse a wind time series (CSV rows t,vx,vy,vz in s and m/s, times not decreasing; a first
+// line that is not numeric is a header; '#' starts a comment) for opt.wind_series; name
+// (Nullable) is used in errors, which give line and column. *rows (nrows x 4) is allocated:
+// free it with vd_free(*rows, *n * 4 * sizeof(double)).
+vd_status vd_sim_parse_wind(const char* text, size_t len, const char* name, double** rows, int* n,
+                            vd_error* err);
+// Read and parse a wind time series file (see vd_sim_parse_wind).
+vd_status vd_sim_read_wind(const char* path, double** rows, int* n, vd_error* err);
 
 // Node that represents an organ: the sphere centre of a fruit, else the node of the organ
 // farthest from the root. label may be a label name or an organ name; instance 0 picks the

@@ -36,6 +36,7 @@ vd_cloud_def vd_cloud_def_default(void) {
   def.scanner = NULL;
   def.mesh = vd_mesh_def_default();
   def.threads = 0;
+  def.max_points = VD_CLOUD_MAX_POINTS;
   def.max_attempts = 100000;
   return def;
 }

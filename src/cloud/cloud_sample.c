@@ -117,6 +117,12 @@ static vd_status check_def(const vd_cloud_def* def, vd_error* err) {
   if (def->sensor != VD_SENSOR_SCAN && (def->points < 1 || def->points > VD_CLOUD_MAX_POINTS))
     BAD("cloud def: points must be in 1..%lld, got %lld", (long long)VD_CLOUD_MAX_POINTS,
         (long long)def->points);
+  if (def->max_points < 1) BAD("cloud def: max_points must be >= 1");
+  if (def->sensor != VD_SENSOR_SCAN && def->points > def->max_points)
+    return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                        "a cloud of %lld points is more than the limit of %lld (max_points; it would take about "
+                        "%.3g GB)",
+                        (long long)def->points, (long long)def->max_points, 80e-9 * (double)def->points);
   if (def->density < VD_DENSITY_CONSTANT || def->density > VD_DENSITY_TABLE)
     BAD("cloud def: unknown density law");
   if (!(def->noise_sigma >= 0) || !isfinite(def->noise_sigma))
@@ -166,6 +172,11 @@ static vd_status check_def(const vd_cloud_def* def, vd_error* err) {
   }
   if (rays > VD_CLOUD_MAX_RAYS)
     BAD("scan: %lld rays in all (at most %lld)", (long long)rays, (long long)VD_CLOUD_MAX_RAYS);
+  if (rays > def->max_points)
+    return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                        "a scan of %lld rays is more than the limit of %lld (max_points; it would take about "
+                        "%.3g GB)",
+                        (long long)rays, (long long)def->max_points, 80e-9 * (double)rays);
 #undef BAD
   return VD_OK;
 }

@@ -7,15 +7,16 @@
 #include "plant_internal.h"
 
 // ---------------------------------------------------------------------------------------------
-// validation: every index in range, every number finite, parents without cycles
+// validation: every index in range, every number finite (coordinates and radii within
+// VD_PLANT_MAX_COORD), parents without cycles
 
 static int finite3(vd_vec3 v) {
-  return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
+  return fabs(v.x) <= VD_PLANT_MAX_COORD && fabs(v.y) <= VD_PLANT_MAX_COORD && fabs(v.z) <= VD_PLANT_MAX_COORD;
 }
 
-// a radius is valid when finite and not negative
+// a radius is valid when finite, not negative and not beyond VD_PLANT_MAX_COORD
 static int radius_ok(double r) {
-  return isfinite(r) && r >= 0;
+  return r >= 0 && r <= VD_PLANT_MAX_COORD;
 }
 
 // index i is valid in [lo, n)
@@ -26,7 +27,8 @@ static int in_range(int i, int lo, int n) {
 static vd_status validate_nodes_segments(const vd_plant_spec* s, vd_error* err) {
   for (int i = 0; i < s->nnode; i++)
     if (!finite3(s->node[i]))
-      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "node %d: position is not finite", i);
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "node %d: position is not finite or beyond +-%g m", i,
+                          VD_PLANT_MAX_COORD);
   for (int i = 0; i < s->nseg; i++) {
     const vd_segment_spec* g = &s->seg[i];
     const char* bad = NULL;
@@ -35,9 +37,9 @@ static vd_status validate_nodes_segments(const vd_plant_spec* s, vd_error* err) 
     else if (!in_range(g->node1, 0, s->nnode))
       bad = "node1 out of range";
     else if (!radius_ok(g->r0))
-      bad = "r0 is negative or not finite";
+      bad = "r0 is negative, not finite or beyond 1e9 m";
     else if (!radius_ok(g->r1))
-      bad = "r1 is negative or not finite";
+      bad = "r1 is negative, not finite or beyond 1e9 m";
     else if (!finite3(g->up))
       bad = "up is not finite";
     else if (!in_range(g->parent, -1, s->nseg) || g->parent == i)
@@ -60,9 +62,9 @@ static vd_status validate_spheres(const vd_plant_spec* s, vd_error* err) {
     const vd_sphere_spec* g = &s->sphere[i];
     const char* bad = NULL;
     if (!finite3(g->center))
-      bad = "center is not finite";
+      bad = "center is not finite or beyond +-1e9 m";
     else if (!radius_ok(g->radius))
-      bad = "radius is negative or not finite";
+      bad = "radius is negative, not finite or beyond 1e9 m";
     else if (!in_range(g->node, -1, s->nnode))
       bad = "node out of range";
     else if (!in_range(g->parent, -1, s->nseg))
@@ -81,7 +83,8 @@ static vd_status validate_spheres(const vd_plant_spec* s, vd_error* err) {
 static vd_status validate_meshes(const vd_plant_spec* s, vd_error* err) {
   for (int i = 0; i < s->nvert; i++)
     if (!finite3(s->vert[i]))
-      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "vertex %d: position is not finite", i);
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "vertex %d: position is not finite or beyond +-%g m", i,
+                          VD_PLANT_MAX_COORD);
   for (int i = 0; i < s->nmesh; i++) {
     const vd_mesh_spec* g = &s->mesh[i];
     const char* bad = NULL;

@@ -64,7 +64,8 @@ static int inv_spd(const double* m, double* inv) {
 
 
 
-#define SIM_MAX_TURN 1.0  // largest frame rotation of one Newton update (rad)
+#define SIM_MAX_TURN 1.0   // largest frame rotation of one Newton update (rad)
+#define SIM_MAX_MOVE 10.0  // largest node move of one Newton update (rest lengths of its segment)
 
 // body numbering: segment t is body t; spare node k (k = node - nnode) is body nseg + k
 static int node_body(const vd_sim_model* m, const vd_sim_data* d, int n) {
@@ -306,8 +307,9 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     mv6(w->h + 36 * t, v, dy);
   }
   // trust region: a Newton update that turns a frame by more than SIM_MAX_TURN or moves a
-  // node by more than its segment's rest length is scaled down as a whole (the linearisation
-  // is meaningless that far out; far from the solution a full step diverges)
+  // node by more than SIM_MAX_MOVE rest lengths of its segment is scaled down as a whole (the
+  // linearisation means nothing that far out; from there a full update diverges). Corrections
+  // of a light node's prediction reach a few rest lengths in normal runs; these do not.
   double scale = 1;
   for (int t = 0; t < nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
@@ -315,7 +317,7 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     double turn = sqrt(dy[3] * dy[3] + dy[4] * dy[4] + dy[5] * dy[5]);
     double move = sqrt(dy[0] * dy[0] + dy[1] * dy[1] + dy[2] * dy[2]) / m->seg_len0[t];
     if (turn * scale > SIM_MAX_TURN) scale = SIM_MAX_TURN / turn;
-    if (move * scale > 1.0) scale = 1.0 / move;
+    if (move * scale > SIM_MAX_MOVE) scale = SIM_MAX_MOVE / move;
   }
   if (scale < 1) {
     for (int k = 0; k < 6 * (nseg + m->nspare); k++) w->dy[k] *= scale;

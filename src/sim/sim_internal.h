@@ -178,6 +178,7 @@ typedef struct sim_work {
   int model_ties;       // stake ties of the model (the first rows)
   int gravity_only;     // scratch flag
   sim_self self;        // self-collision primitives and exclusion
+  double strain;        // largest stretch strain at the end of the last step (-)
 } sim_work;
 
 // Allocate the work block for a model; NULL when out of memory. *bytes gets its size.

@@ -5,7 +5,8 @@
 #include "sim_internal.h"
 
 const char* vd_sim_warning_name(vd_sim_warning w) {
-  static const char* names[VD_SIM_WARN_COUNT] = {"nonfinite", "solver", "strain", "substep", "unstable", "arena"};
+  static const char* names[VD_SIM_WARN_COUNT] = {"nonfinite", "solver",    "strain", "substep",
+                                                 "unstable",  "stretched", "arena"};
   return w >= 0 && w < VD_SIM_WARN_COUNT ? names[w] : "?";
 }
 
@@ -134,6 +135,9 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   double h = c.h;
   int na = m->nnode_all, ns = m->nseg;
   vd_arena_reset(&d->arena);
+  // the stretch at the start: a step may not double it beyond VD_SIM_MAX_STRAIN (a stretch the
+  // state already had, e.g. from a contact holding a node, is not a new failure)
+  double strain0 = c.statics ? 0 : max_stretch(m, d);
   // loads at the start of the step
   sim_forces(m, d, w);
   memcpy(w->node_prev, d->node_pos, (size_t)na * sizeof(vd_vec3));
@@ -205,10 +209,11 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   // stretched up to VD_SIM_BLOWUP_STRAIN is kept (counted), beyond it the step fails
   int fail = !finite_state(m, d) ? VD_SIM_WARN_NONFINITE : !solved ? VD_SIM_WARN_SOLVER : -1;
   double strain = fail < 0 && !c.statics ? max_stretch(m, d) : 0;
-  if (strain > VD_SIM_MAX_STRAIN) {
+  if (strain > VD_SIM_BLOWUP_STRAIN || (strain > VD_SIM_MAX_STRAIN && strain > 2 * strain0)) {
     if (!c.last || strain > VD_SIM_BLOWUP_STRAIN) fail = VD_SIM_WARN_STRAIN;
     else sim_warn(d, VD_SIM_WARN_STRAIN), sim_warn(d, VD_SIM_WARN_UNSTABLE);
   }
+  w->strain = strain;
   if (fail >= 0) {
     memcpy(d->node_pos, w->node_prev, (size_t)na * sizeof(vd_vec3));
     memcpy(d->seg_quat, w->seg_prev, (size_t)ns * sizeof(vd_quat));
@@ -262,6 +267,7 @@ vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d) {
   memset(&c, 0, sizeof c);
   vd_status st = step_retake(m, d, &c, m->opt.dt, 0);
   if (!st) d->nstep++;
+  if (!st && ((sim_work*)d->work)->strain > VD_SIM_MAX_STRAIN) sim_warn(d, VD_SIM_WARN_STRETCHED);
   return st;
 }
 
@@ -291,6 +297,7 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
     while (d->time - t0 < s->max_time) {
       if ((st = step_retake(m, d, &c, m->opt.dt, 0))) break;
       d->nstep++;
+      if (w->strain > VD_SIM_MAX_STRAIN) sim_warn(d, VD_SIM_WARN_STRETCHED);
       n++;
       calm = vd_sim_kinetic_energy(m, d) < s->ke_tol ? calm + m->opt.dt : 0;
       if (calm >= 0.25) {
