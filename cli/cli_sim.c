@@ -66,6 +66,9 @@ static const char* sim_help =
     "                          ramped from 0 over --ramp seconds; repeatable\n"
     "      --move ORGAN=DX,DY,DZ   displace an organ (m) by a stiff tie, ramped over --ramp\n"
     "      --ramp T            ramp time of pulls and moves (s); default the run's duration\n"
+    ;
+// (in two parts: C99 compilers need only take string literals up to 4095 bytes)
+static const char* sim_help_output =
     "output:\n"
     "      --frames F          bin (default), jsonl or none\n"
     "      --fps N             frames per simulated second, default 30\n"
@@ -378,7 +381,8 @@ static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir
   return VD_OK;
 }
 
-static void frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d) {
+// one frame; nonzero when a write has failed (a full disk: the run stops, the commit reports it)
+static int frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d) {
   FILE* f = o->frames.fp;
   cli_colliders_write(o->colliders.fp, d);
   if (o->jsonl) {
@@ -394,7 +398,7 @@ static void frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d
     for (int t = 0; t < m->nseg; t++)
       if (d->seg_broken[t]) fprintf(f, "%s%d", first ? "" : ",", t), first = 0;
     fputs("]}\n", f);
-    return;
+    return ferror(f) || ferror(o->colliders.fp);
   }
   unsigned char* b = o->bbuf;
   put_f64(b, d->time);
@@ -407,6 +411,7 @@ static void frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d
   }
   for (int t = 0; t < m->nseg; t++) *b++ = (unsigned char)(d->seg_broken[t] ? 1 : 0);
   fwrite(o->bbuf, 1, o->fbuf_n, f);
+  return ferror(f) || ferror(o->colliders.fp);
 }
 
 // the rod topology that frames refer to
@@ -723,6 +728,7 @@ int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(sim_help, stdout);
+      fputs(sim_help_output, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;
     }
@@ -855,7 +861,7 @@ int cli_sim(int argc, char** argv) {
       }
       st = vd_sim_step(m, d);
       if (out.frames_open && d->time >= next_frame - 1e-12) {
-        frames_write(&out, m, d);
+        if (frames_write(&out, m, d)) break;  // reported by the commit below
         next_frame += 1.0 / o.fps;
       }
       if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);
@@ -898,8 +904,10 @@ int cli_sim(int argc, char** argv) {
       st = vd_outfile_commit(&out.frames, &err);
       out.frames_open = 0;
     }
-    if (out.colliders_open) {
-      vd_status s2 = vd_outfile_commit(&out.colliders, st ? NULL : &err);
+    if (out.colliders_open) {  // kept only beside complete frames
+      vd_status s2 = VD_OK;
+      if (st) vd_outfile_abort(&out.colliders);
+      else s2 = vd_outfile_commit(&out.colliders, &err);
       st = st ? st : s2;
       out.colliders_open = 0;
     }

@@ -10,6 +10,11 @@ set -eu
 # nettle-dev
 need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3
   libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev)
+# --dev adds the tools of CI's hardening runs: clang with libFuzzer (make fuzz, fuzz-smoke),
+# clang-tidy and cppcheck (make lint)
+if [ "${1:-}" = "--dev" ]; then
+  need+=(clang libclang-rt-14-dev clang-tidy cppcheck)
+fi
 missing=()
 for p in "${need[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
