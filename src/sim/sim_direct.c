@@ -96,7 +96,8 @@ static void init_bodies(const vd_sim_model* m, vd_sim_data* d, sim_work* w, doub
     double* g = w->gb + 6 * t;
     memset(hb, 0, 36 * sizeof(double));
     int n = m->seg_node[2 * t + 1];
-    double mass = d->node_mass[n];
+    // the node's mass plus h times its air drag damping (drag linearised at v_n, implicit)
+    double mass = d->node_mass[n] + h * w->node_drag[n];
     hb[0] = hb[7] = hb[14] = mass;
     // rotational inertia in world axes
     double r[9], iw[9];
@@ -125,8 +126,8 @@ static void init_bodies(const vd_sim_model* m, vd_sim_data* d, sim_work* w, doub
     double* g = w->gb + 6 * b;
     memset(hb, 0, 36 * sizeof(double));
     memset(g, 0, 6 * sizeof(double));
-    double mass = d->node_mass[n];
-    if (mass <= 0) continue;
+    if (d->node_mass[n] <= 0) continue;
+    double mass = d->node_mass[n] + h * w->node_drag[n];
     hb[0] = hb[7] = hb[14] = mass;
     hb[21] = hb[28] = hb[35] = 1.0;  // the spare has no frame: a decoupled unit block
     vd_vec3 dx = vd_sub(vd_sub(d->node_pos[n], w->node_prev[n]), vd_scale(d->node_vel[n], h));

@@ -50,12 +50,15 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
                                               : vd_v3(0, 0, 0);
   }
   for (int t = 0; t < m->nseg; t++) w->seg_text[t] = d->seg_torque[t];
+  memset(w->node_drag, 0, (size_t)nn * sizeof(double));
   // Stokes drag (numerical damping only)
   if (o->stokes_viscosity > 0)
     for (int n = 0; n < nn; n++)
-      if (sim_node_w(m, d, n) > 0)
-        w->node_fext[n] = vd_madd(w->node_fext[n], d->node_vel[n],
-                                  -6 * VD_PI * o->stokes_viscosity * m->node_radius[n]);
+      if (sim_node_w(m, d, n) > 0) {
+        double c = 6 * VD_PI * o->stokes_viscosity * m->node_radius[n];
+        w->node_fext[n] = vd_madd(w->node_fext[n], d->node_vel[n], -c);
+        w->node_drag[n] += c;
+      }
   if (!o->drag) return;
   vd_vec3 wind = sim_wind_at(o, d->time);
   double q = 0.5 * o->air_density;
@@ -71,17 +74,22 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
     vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
     double area = 2 * m->seg_radius[t] * m->seg_len0[t];
     vd_vec3 f = vd_scale(up, q * m->seg_cd[t] * area * v_norm(up));
+    // damping of F = k |u| u: dF/du has eigenvalues k |u| and 2 k |u|; the larger is taken
+    double c = 2 * q * m->seg_cd[t] * area * v_norm(up);
     const double* ln = m->seg_leaf_normal + 3 * t;
     if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
       vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
       double a = v_norm(nw);
       double un = vd_dot(u, nw) / a;
       f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
+      c += 2 * q * m->leaf_cd * a * fabs(un);
     }
     // half to each end that moves (all of it when the other end is held)
     double sa = wa > 0 ? (wb > 0 ? 0.5 : 1.0) : 0.0;
     w->node_fext[na] = vd_madd(w->node_fext[na], f, sa);
     w->node_fext[nb] = vd_madd(w->node_fext[nb], f, 1.0 - sa);
+    w->node_drag[na] += sa * c;
+    w->node_drag[nb] += (1.0 - sa) * c;
   }
   // spheres (fruits, buds) on their centre node
   for (int n = 0; n < nn; n++) {
@@ -90,5 +98,6 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
     int o2 = m->node_owner[n];
     double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
     w->node_fext[n] = vd_madd(w->node_fext[n], u, q * cd * VD_PI * r * r * v_norm(u));
+    w->node_drag[n] += 2 * q * cd * VD_PI * r * r * v_norm(u);
   }
 }

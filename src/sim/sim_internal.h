@@ -161,6 +161,7 @@ typedef struct sim_work {
   vd_quat* seg_prev;    // frames at the start of the step (nseg)
   vd_vec3* node_fext;   // total external force this step (N) (nnode_all)
   vd_vec3* seg_text;    // total external torque this step (N m) (nseg)
+  double* node_drag;    // air drag damping -dF/dv of each node, taken implicitly (kg/s) (nnode_all)
   double* c_prev;       // constraint values at the start of the step (nseg x 6)
   double* lambda_save;  // multipliers before a statics step, to undo it (nseg x 6)
   int* spare_of;        // spare index -> segment (nspare)
@@ -260,7 +261,8 @@ double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* norma
 
 // Wind velocity at time t (m/s).
 vd_vec3 sim_wind_at(const vd_sim_opt* o, double t);
-// Accumulate external forces and torques of this step into w->node_fext and w->seg_text.
+// Accumulate external forces and torques of this step into w->node_fext and w->seg_text, and
+// the air drag's damping coefficient of each node (kg/s) into w->node_drag.
 void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w);
 
 // ---------------------------------------------------------------------------------------------

@@ -149,13 +149,19 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     for (int i = 0; i < na; i++) d->node_vel[i] = vd_v3(0, 0, 0);
     for (int t = 0; t < ns; t++) d->seg_omega[t] = vd_v3(0, 0, 0);
   } else {
-    // prediction: semi-implicit Euler on velocities, then positions and frames
+    // prediction: semi-implicit Euler on velocities, then positions and frames; air drag is
+    // linearly implicit, m (v - v_n) = h (f_n - c (v - v_n)) with c = -dF/dv (w->node_drag):
+    // explicit drag diverges once h c / m > 2, which light organs in wind reach at 1 ms.
+    // The direct solver keeps the loads in its residual g and starts its Newton iterations
+    // from the inertial motion alone (fl = 0): a node of 1e-8 kg carries no weight against its
+    // rod, and starting it where wind and gravity alone would put it (centimetres off at 10 ms)
+    // linearises its segment's rotation far from the solution
     memset(d->seg_lambda, 0, (size_t)ns * 6 * sizeof(double));
     memset(w->tie_lambda, 0, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
+    double fl = m->opt.solver == VD_SIM_GS ? h : 0.0;
     for (int i = 0; i < na; i++) {
-      double wi = sim_node_w(m, d, i);
-      if (wi <= 0) continue;
-      vd_vec3 v = vd_madd(d->node_vel[i], w->node_fext[i], h * wi);
+      if (sim_node_w(m, d, i) <= 0) continue;
+      vd_vec3 v = vd_madd(d->node_vel[i], w->node_fext[i], fl / (d->node_mass[i] + h * w->node_drag[i]));
       d->node_pos[i] = vd_madd(d->node_pos[i], v, h);
     }
     for (int t = 0; t < ns; t++) {
@@ -169,7 +175,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
       vd_vec3 d3 = vd_v3(r[2], r[5], r[8]);
       vd_vec3 io = vd_madd(vd_scale(om, ib), d3, (it - ib) * vd_dot(d3, om));
       vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(om, io));
-      vd_vec3 op = vd_madd(om, m3_mul_v(iinv, tq), h);
+      vd_vec3 op = vd_madd(om, m3_mul_v(iinv, tq), fl);
       d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_scale(op, h));
     }
   }
