@@ -881,22 +881,30 @@ int cli_sim(int argc, char** argv) {
     }
     // numerical trouble that the run survived: say so (the counts are in --stats too)
     if (d->nwarning) {
-      fprintf(stderr, "verdant sim: warning: %lld steps were retaken in halves (non-finite %lld, singular %lld, "
-                      "overstretched %lld)",
-              (long long)d->warning[VD_SIM_WARN_SUBSTEP], (long long)d->warning[VD_SIM_WARN_NONFINITE],
-              (long long)d->warning[VD_SIM_WARN_SOLVER], (long long)d->warning[VD_SIM_WARN_STRAIN]);
-      if (d->warning[VD_SIM_WARN_UNSTABLE])
-        fprintf(stderr, "; %lld substeps of dt / %d stayed stretched beyond %g%%: the result is not trustworthy "
+      const char* sep = "verdant sim: warning: ";
+      if (d->warning[VD_SIM_WARN_SUBSTEP]) {
+        fprintf(stderr, "%s%lld steps were retaken in halves (non-finite %lld, singular %lld, overstretched %lld)", sep,
+                (long long)d->warning[VD_SIM_WARN_SUBSTEP], (long long)d->warning[VD_SIM_WARN_NONFINITE],
+                (long long)d->warning[VD_SIM_WARN_SOLVER], (long long)d->warning[VD_SIM_WARN_STRAIN]);
+        sep = "; ";
+      }
+      if (d->warning[VD_SIM_WARN_UNSTABLE]) {
+        fprintf(stderr, "%s%lld substeps of dt / %d stayed stretched beyond %g%%: the result is not trustworthy "
                         "(a contact or tie holding part of the plant, or too large a time step: try a smaller --dt "
                         "or more --iterations)",
-                (long long)d->warning[VD_SIM_WARN_UNSTABLE], 1 << VD_SIM_MAX_SUBSTEP, 100 * VD_SIM_MAX_STRAIN);
-      if (d->warning[VD_SIM_WARN_STRETCHED] && !d->warning[VD_SIM_WARN_UNSTABLE])
-        fprintf(stderr, "; %lld steps ended with a segment stretched beyond %g%%: the result is not trustworthy "
+                sep, (long long)d->warning[VD_SIM_WARN_UNSTABLE], 1 << VD_SIM_MAX_SUBSTEP, 100 * VD_SIM_MAX_STRAIN);
+        sep = "; ";
+      }
+      if (d->warning[VD_SIM_WARN_STRETCHED] && !d->warning[VD_SIM_WARN_UNSTABLE]) {
+        fprintf(stderr, "%s%lld steps ended with a segment stretched beyond %g%%: the result is not trustworthy "
                         "(a contact or tie holding part of the plant, a material too soft, or too large a time "
                         "step: try a smaller --dt or more --iterations)",
-                (long long)d->warning[VD_SIM_WARN_STRETCHED], 100 * VD_SIM_MAX_STRAIN);
+                sep, (long long)d->warning[VD_SIM_WARN_STRETCHED], 100 * VD_SIM_MAX_STRAIN);
+        sep = "; ";
+      }
       if (d->warning[VD_SIM_WARN_ARENA])
-        fprintf(stderr, "; contacts were dropped in %lld steps (out of memory)", (long long)d->warning[VD_SIM_WARN_ARENA]);
+        fprintf(stderr, "%scontacts were dropped in %lld steps (out of memory)", sep,
+                (long long)d->warning[VD_SIM_WARN_ARENA]);
       fputc('\n', stderr);
     }
     // outputs
