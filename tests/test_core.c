@@ -17,6 +17,22 @@ TEST(core, error_format) {
   CHECK_STR(vd_status_str((vd_status)999), "unknown status");
 }
 
+// a quoted line of a binary file must not put raw bytes on the user's terminal
+TEST(core, error_message_printable) {
+  vd_error e = {0};
+  char buf[600];
+  vd_error_set(&e, VD_ERR_FORMAT, "b.pcd", 1, 0, "unknown header line '%s'", "\xfa\x01ok \xc3\xa9t\xc3\xa9\x7f");
+  CHECK_STR(vd_error_format(&e, buf, sizeof buf), "b.pcd:1: unknown header line '\\xfa\\x01ok \xc3\xa9t\xc3\xa9\\x7f'");
+  // a long binary message is cut, never overflows
+  char big[400];
+  memset(big, 0xff, sizeof big - 1);
+  big[sizeof big - 1] = 0;
+  vd_error e2 = {0};
+  vd_error_set(&e2, VD_ERR_FORMAT, "", 0, 0, "%s", big);
+  CHECK(strlen(e2.msg) < sizeof e2.msg);
+  CHECK(strncmp(e2.msg, "\\xff\\xff", 8) == 0);
+}
+
 TEST(core, alloc_counts_bytes) {
   int64_t b0 = vd_alloc_bytes();
   void* p = vd_malloc(100);

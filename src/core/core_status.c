@@ -18,6 +18,36 @@ const char* vd_status_str(vd_status s) {
   return status_text[s];
 }
 
+// length of the valid UTF-8 sequence at s (1..4), 0 when it is not one
+static int utf8_len(const unsigned char* s) {
+  if (s[0] < 0x80) return 1;
+  int n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 && s[0] < 0xe0 ? 2 : 0;
+  for (int k = 1; k < n; k++)
+    if ((s[k] & 0xc0) != 0x80) return 0;
+  return n;
+}
+
+// copy a message for a terminal: control bytes and bytes that are not UTF-8 (a quoted line of a
+// binary file) become \xNN; tabs and newlines stay
+static void printable(const char* in, char* out, size_t cap) {
+  const unsigned char* s = (const unsigned char*)in;
+  size_t o = 0;
+  while (*s && o + 1 < cap) {
+    int n = utf8_len(s);
+    if (n == 1 && (*s >= 0x20 || *s == '\t' || *s == '\n') && *s != 0x7f) {
+      out[o++] = (char)*s++;
+    } else if (n > 1) {
+      if (o + (size_t)n >= cap) break;
+      for (int k = 0; k < n; k++) out[o++] = (char)*s++;
+    } else {
+      if (o + 4 >= cap) break;
+      snprintf(out + o, 5, "\\x%02x", *s++);
+      o += 4;
+    }
+  }
+  out[o] = 0;
+}
+
 vd_status vd_error_set(vd_error* err, vd_status status, const char* file, int line, int col,
                        const char* fmt, ...) {
   if (!err) return status;
@@ -27,10 +57,12 @@ vd_status vd_error_set(vd_error* err, vd_status status, const char* file, int li
   err->line = line;
   err->col = col;
   snprintf(err->file, sizeof err->file, "%s", file ? file : "");
+  char raw[sizeof err->msg];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+  vsnprintf(raw, sizeof raw, fmt, ap);
   va_end(ap);
+  printable(raw, err->msg, sizeof err->msg);
   return status;
 }
 
