@@ -11,7 +11,7 @@ ifeq ($(SANITIZE),1)
   CMAKE_FLAGS += -DVD_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 endif
 
-.PHONY: all deps configure test bench demo install clean fuzz fuzz-smoke
+.PHONY: all deps configure test bench demo install clean fuzz fuzz-smoke lint
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -49,5 +49,9 @@ fuzz:
 fuzz-smoke:
 	@bash fuzz/run.sh 5
 
+# static analysis: clang-tidy (.clang-tidy) and cppcheck over src/ and cli/; any finding fails
+lint:
+	@JOBS=$(JOBS) bash scripts/lint.sh
+
 clean:
-	rm -rf build build-sanitize
+	rm -rf build build-sanitize build-lint

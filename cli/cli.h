@@ -60,6 +60,8 @@ void cli_grow_info_free(cli_grow_info* info);
 
 // Parse a whole decimal integer within [lo, hi]; 1 on success.
 int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out);
+// Parse two whole decimal integers A<sep>B, each within [lo, hi] ("640x480", "2/8"); 1 on success.
+int cli_parse_i64_pair(const char* s, char sep, int64_t lo, int64_t hi, int64_t* a, int64_t* b);
 // Parse a whole finite number; 1 on success.
 int cli_parse_num(const char* s, double* out);
 // Inside an option parser with locals a (the option), val, i, argc, argv and cmd: take the

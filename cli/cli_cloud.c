@@ -281,10 +281,10 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
       if (vd_norm(vd_sub(s.target, s.pos)) == 0)
         st = vd_error_set(err, VD_ERR_ARG, "", 0, 0,
                           "--scanner %d: the scanner sits on its target; give a target", i + 1);
-      sc[i] = s;
+      sc[i] = s;  // NOLINT(clang-analyzer-core.NullDereference): sc is allocated whenever n + nfile > 0
     }
     for (int i = 0; i < nfile; i++)
-      sc[n + i] = fsc[i];
+      sc[n + i] = fsc[i];  // NOLINT(clang-analyzer-core.NullDereference): sc is allocated whenever n + nfile > 0
   }
   vd_free(fsc, (size_t)nfile * sizeof *fsc);
   // sample

@@ -145,6 +145,16 @@ int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out) {
   return 1;
 }
 
+int cli_parse_i64_pair(const char* s, char sep, int64_t lo, int64_t hi, int64_t* a, int64_t* b) {
+  const char* at = s ? strchr(s, sep) : NULL;
+  char head[32];
+  size_t n = at ? (size_t)(at - s) : 0;
+  if (!at || n >= sizeof head) return 0;
+  memcpy(head, s, n);
+  head[n] = 0;
+  return cli_parse_i64(head, lo, hi, a) && cli_parse_i64(at + 1, lo, hi, b);
+}
+
 int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int* i) {
   const char* a = argv[*i];
   const char* val = NULL;
@@ -289,7 +299,7 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
     vd_free(text, len + 1);
     for (int i = 0; !st && i < o->nlabel; i++) {
       const char* eq = strchr(o->label[i], '=');
-      st = vd_plant_set_label(*out, atoi(o->label[i]), eq + 1);
+      st = vd_plant_set_label(*out, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
     }
     return st;
   }
@@ -334,7 +344,7 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   }
   for (int i = 0; !st && i < o->nlabel; i++) {
     const char* eq = strchr(o->label[i], '=');
-    st = vd_plant_set_label(plant, atoi(o->label[i]), eq + 1);
+    st = vd_plant_set_label(plant, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
   }
   if (!st) st = vd_plant_complete_labels(plant);
   if (!st) {

@@ -9,6 +9,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <nettle/sha2.h>
 #include <stdlib.h>
@@ -169,7 +170,7 @@ static cJSON* complete_record(const dataset* ds, int i, int* mismatch) {
     cJSON_Delete(rec);
     return NULL;
   }
-  if (strcmp(params->valuestring, ds->params)) {
+  if (strcmp(params->valuestring, ds->params) != 0) {
     *mismatch = 1;
     cJSON_Delete(rec);
     return NULL;
@@ -218,8 +219,12 @@ static int remove_stale(const dataset* ds) {
     char* end;
     long pid = strtol(tmp + 5, &end, 10);
     if (*end || pid <= 0 || pid == (long)getpid()) continue;
-    int index, mine = !strncmp(e->d_name, "manifest.json.tmp.", 18);
-    if (!mine && sscanf(e->d_name, "item_%d.", &index) == 1) mine = index >= 0 && index % ds->nshard == ds->shard;
+    int mine = !strncmp(e->d_name, "manifest.json.tmp.", 18);
+    if (!mine && !strncmp(e->d_name, "item_", 5)) {
+      char* iend;
+      long index = strtol(e->d_name + 5, &iend, 10);
+      mine = iend != e->d_name + 5 && index >= 0 && index % ds->nshard == ds->shard;
+    }
     // only when no process of that id runs here (another machine's run keeps its files)
     if (!mine || kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
     char path[4200];
@@ -334,7 +339,7 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
 static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant_opts* po0, const cli_cloud_opts* co,
                            int i, int64_t* points, int* out_failed, vd_error* err) {
   *out_failed = 0;
-  double values[MAX_VARY];
+  double values[MAX_VARY] = {0};
   uint64_t seed = item_seed(ds, i, values);
   // the item's plant options: its seed, the --vary values as --set
   cli_plant_opts po = *po0;
@@ -658,7 +663,7 @@ int cli_dataset(int argc, char** argv) {
       if (!val) return cli_usage_error("dataset", "%s needs a folder", a);
       ds.dir = val, i++;
     } else if (!strcmp(a, "--format")) {
-      if (!val || (strcmp(val, "ply") && strcmp(val, "pcd") && strcmp(val, "xyz") && strcmp(val, "csv") && strcmp(val, "las")))
+      if (!val || (strcmp(val, "ply") != 0 && strcmp(val, "pcd") != 0 && strcmp(val, "xyz") != 0 && strcmp(val, "csv") != 0 && strcmp(val, "las") != 0))
         return cli_usage_error("dataset", "--format expects ply, pcd, xyz, csv or las");
       ds.ext = val, i++;
     } else if (!strcmp(a, "--jobs")) {
@@ -666,10 +671,10 @@ int cli_dataset(int argc, char** argv) {
       if (!val || errno || *end || v < 1 || v > 1024) return cli_usage_error("dataset", "--jobs expects an integer in 1..1024");
       ds.jobs = (int)v, i++;
     } else if (!strcmp(a, "--shard")) {
-      int si, sn, len = 0;
-      if (!val || sscanf(val, "%d/%d%n", &si, &sn, &len) != 2 || val[len] || sn < 1 || si < 0 || si >= sn)
+      int64_t si, sn;
+      if (!cli_parse_i64_pair(val, '/', 0, INT_MAX, &si, &sn) || sn < 1 || si >= sn)
         return cli_usage_error("dataset", "--shard expects I/N with 0 <= I < N, got '%s'", val ? val : "");
-      ds.shard = si, ds.nshard = sn, i++;
+      ds.shard = (int)si, ds.nshard = (int)sn, i++;
     } else if (!strcmp(a, "--vary")) {
       if (ds.nvary == MAX_VARY) return cli_usage_error("dataset", "too many --vary options (%d at most)", MAX_VARY);
       if (!val || !parse_vary(val, &ds.vary[ds.nvary]))
@@ -680,11 +685,10 @@ int cli_dataset(int argc, char** argv) {
       if (!val || errno || *end || v < 1 || v > 1000) return cli_usage_error("dataset", "--images expects an integer in 1..1000");
       ds.images = (int)v, i++;
     } else if (!strcmp(a, "--image-size")) {
-      int w, h;
-      char tail;
-      if (!val || sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+      int64_t w, h;
+      if (!cli_parse_i64_pair(val, 'x', 1, 8192, &w, &h))
         return cli_usage_error("dataset", "--image-size expects WxH with 1..8192 pixels each, got '%s'", val ? val : "");
-      ds.img_w = w, ds.img_h = h, image_size_given = 1, i++;
+      ds.img_w = (int)w, ds.img_h = (int)h, image_size_given = 1, i++;
     } else if (!strcmp(a, "--force")) {
       ds.force = 1;
     } else if (!strcmp(a, "--stats")) {

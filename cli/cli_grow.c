@@ -35,10 +35,10 @@ static cJSON* label_counts(const vd_plant_spec* p) {
     return NULL;
   }
   size_t k = 0;
-  for (int i = 0; i < p->nseg; i++) key[k++] = ((uint64_t)(uint32_t)p->seg[i].label << 32) | (uint32_t)p->seg[i].instance;
+  for (int i = 0; i < p->nseg; i++) key[k++] = ((uint64_t)(uint32_t)p->seg[i].label << 32) | (uint32_t)p->seg[i].instance;  // NOLINT(clang-analyzer-core.NullDereference): key holds n entries whenever n > 0
   for (int i = 0; i < p->nsphere; i++)
-    key[k++] = ((uint64_t)(uint32_t)p->sphere[i].label << 32) | (uint32_t)p->sphere[i].instance;
-  for (int i = 0; i < p->nmesh; i++) key[k++] = ((uint64_t)(uint32_t)p->mesh[i].label << 32) | (uint32_t)p->mesh[i].instance;
+    key[k++] = ((uint64_t)(uint32_t)p->sphere[i].label << 32) | (uint32_t)p->sphere[i].instance;  // NOLINT(clang-analyzer-core.NullDereference): key holds n entries whenever n > 0
+  for (int i = 0; i < p->nmesh; i++) key[k++] = ((uint64_t)(uint32_t)p->mesh[i].label << 32) | (uint32_t)p->mesh[i].instance;  // NOLINT(clang-analyzer-core.NullDereference): key holds n entries whenever n > 0
   if (n) qsort(key, n, sizeof(uint64_t), cmp_u64);
   // every label of the table appears, with 0 when nothing carries it
   for (int l = 0; l < p->nlabel; l++) {

@@ -155,12 +155,11 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       if (!cli_parse_num(val, &o->fov) || o->fov <= 0 || o->fov >= 180)
         return cli_usage_error("render", "--fov expects degrees in (0, 180), got '%s'", val);
     } else if (!strcmp(a, "--size")) {
-      int w, h;
-      char tail;
-      if (sscanf(val, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192)
+      int64_t w, h;
+      if (!cli_parse_i64_pair(val, 'x', 1, 8192, &w, &h))
         return cli_usage_error("render", "--size expects WxH with 1..8192 pixels each, got '%s'",
                                val);
-      o->def.width = w, o->def.height = h;
+      o->def.width = (int)w, o->def.height = (int)h;
     } else if (!strcmp(a, "--color-by")) {
       if (!strcmp(val, "label"))
         o->style.color_by = VD_COLOR_LABEL;

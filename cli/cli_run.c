@@ -73,7 +73,7 @@ vd_status cli_sim_def_parse(const cJSON* o, const char* path, vd_sim_def* def, v
   if (!cJSON_IsObject(o))
     return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
                         "no \"build\" settings (a run of an older 'verdant sim': make it again)");
-  double flags[4];
+  double flags[4] = {0};
   vd_status st = VD_OK;
   static const char* ints[4] = {"clamp_roots", "leaf_graphs", "sag_free", NULL};
   st = get_num(o, "segment_length", 0, &def->segment_length, path, "build", err);
@@ -193,7 +193,7 @@ static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
       int kind = -1;
       for (int k = 0; k < 4 && cJSON_IsString(shape); k++)
         if (!strcmp(shape->valuestring, shape_names[k])) kind = k;
-      double q[4], pos[3];
+      double q[4] = {0}, pos[3] = {0};
       if (kind < 0 || !get_vec(c, "size", col.size, 3) || !get_vec(c, "pos", pos, 3) ||
           !get_vec(c, "quat", q, 4)) {
         st = vd_error_set(err, VD_ERR_FORMAT, path, line, 0,
@@ -215,7 +215,7 @@ static vd_status read_colliders(cli_run* run, const char* path, vd_error* err) {
       idx++;
     }
     cJSON_Delete(o);
-    run->col_start[++frame] = run->ncol;
+    run->col_start[++frame] = run->ncol;  // NOLINT(clang-analyzer-core.NullDereference): col_start holds nframe + 1 entries; frame < nframe here
     p = next;
   }
   vd_free(text, len + 1);
@@ -268,7 +268,7 @@ vd_status cli_run_open(const char* dir, cli_run* run, vd_error* err) {
   cJSON* rod = cJSON_ParseWithLength(text, len);
   vd_free(text, len + 1);
   const cJSON* format = cJSON_GetObjectItemCaseSensitive(rod, "format");
-  if (!cJSON_IsString(format) || strcmp(format->valuestring, "verdant-rod")) {
+  if (!cJSON_IsString(format) || strcmp(format->valuestring, "verdant-rod") != 0) {
     cJSON_Delete(rod);
     return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,
                         "not a verdant rod file (\"format\": \"verdant-rod\")");

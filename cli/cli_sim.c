@@ -271,7 +271,7 @@ static int class_value(const char* cmd, const char* opt, const char* val, vd_sim
       cli_usage_error(cmd, "%s: unknown class '%s' (green, wood, pedicel, leaf, fruit, flower, root)", opt, name);
       return 0;
     }
-    c0 = c, c1 = c + 1;
+    c0 = (int)c, c1 = (int)c + 1;
     num = eq + 1;
   }
   double v[2];
@@ -368,7 +368,7 @@ static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir
   if (!jsonl) {
     // header: magic, version, node count, segment count, reserved (little-endian)
     unsigned char h[24];
-    memcpy(h, "VDSIMFRM", 8);
+    memcpy(h, "VDSIMFRM", 8);  // NOLINT(bugprone-not-null-terminated-result): an 8-byte magic, no NUL
     put_u32(h + 8, VD_SIM_FRAMES_VERSION);
     put_u32(h + 12, (uint32_t)m->nnode_all);
     put_u32(h + 16, (uint32_t)m->nseg);
@@ -409,7 +409,7 @@ static int frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d)
     vd_quat q = d->seg_quat[t];
     put_f32(b, (float)q.w), put_f32(b + 4, (float)q.x), put_f32(b + 8, (float)q.y), put_f32(b + 12, (float)q.z);
   }
-  for (int t = 0; t < m->nseg; t++) *b++ = (unsigned char)(d->seg_broken[t] ? 1 : 0);
+  for (int t = 0; t < m->nseg; t++) *b++ = (unsigned char)(d->seg_broken[t] ? 1 : 0);  // NOLINT(clang-analyzer-core.NullDereference): bbuf exists for binary frames; JSONL returned above
   fwrite(o->bbuf, 1, o->fbuf_n, f);
   return ferror(f) || ferror(o->colliders.fp);
 }
@@ -528,8 +528,8 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "steps", (double)steps);
   cJSON_AddNumberToObject(root, "time", d->time);
   cJSON_AddNumberToObject(root, "wall_seconds", wall);
-  cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? steps / wall : 0);
-  cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? steps * m->opt.dt / wall : 0);
+  cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
+  cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * m->opt.dt / wall : 0);
   if (settle_steps >= 0) {
     cJSON_AddBoolToObject(root, "settled", settled);
     cJSON_AddNumberToObject(root, "settle_steps", settle_steps);
@@ -582,7 +582,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
     VAL();                                                                                        \
     double x_;                                                                                    \
     if (!parse_num(val, &x_) || !isfinite(x_) || !(cond)) return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val); \
-    dst = x_;                                                                                     \
+    (dst) = x_;                                                                                   \
   } while (0)
     const char* val = NULL;
     if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
@@ -699,7 +699,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->ramp_set = 1;
     } else if (!strcmp(a, "--frames")) {
       VAL();
-      if (strcmp(val, "bin") && strcmp(val, "jsonl") && strcmp(val, "none"))
+      if (strcmp(val, "bin") != 0 && strcmp(val, "jsonl") != 0 && strcmp(val, "none") != 0)
         return cli_usage_error(cmd, "--frames expects bin, jsonl or none, got '%s'", val);
       o->frames = val;
     } else if (!strcmp(a, "--fps")) {
@@ -788,7 +788,7 @@ int cli_sim(int argc, char** argv) {
     if (p->node < 0)
       st = vd_error_set(&err, VD_ERR_VALUE, o.po.path, 0, 0, "no organ '%s'%s%.0d in the plant (labels or organ names)",
                         p->organ, p->instance ? "#" : "", p->instance);
-    else if (p->move && (p->tie = vd_sim_add_tie(d, p->node, d->node_pos[p->node], 1e-5)) < 0)
+    else if (p->move && (p->tie = vd_sim_add_tie(d, p->node, d->node_pos[p->node], 1e-5)) < 0)  // NOLINT(clang-analyzer-core.NullDereference): d exists whenever st is VD_OK
       st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   if (!st && !o.no_ground) {
@@ -820,7 +820,7 @@ int cli_sim(int argc, char** argv) {
       snprintf(path, sizeof path, "%s/plant_initial.json", o.out);
       st = vd_plant_write_json(spec, path, &err);
     }
-    if (!st && strcmp(o.frames, "none")) st = frames_begin(&out, m, o.out, !strcmp(o.frames, "jsonl"), &err);
+    if (!st && strcmp(o.frames, "none") != 0) st = frames_begin(&out, m, o.out, !strcmp(o.frames, "jsonl"), &err);
     if (st) {
       cli_report("sim", &err, st);
       code = EXIT_FAIL;

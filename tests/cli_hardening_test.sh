@@ -179,6 +179,9 @@ expect "dataset: --count beyond 1e8" 2 "$V" dataset "$P" --count 1000000000 -o "
 expect "dataset: --count not a number" 2 "$V" dataset "$P" --count 1e3 -o "$T/ds"
 expect "dataset: --jobs 0" 2 "$V" dataset "$P" --count 2 --jobs 0 -o "$T/ds"
 expect "dataset: --shard 3/2" 2 "$V" dataset "$P" --count 2 --shard 3/2 -o "$T/ds"
+# integers beyond int were undefined behaviour in sscanf("%d") (found by clang-tidy cert-err34-c)
+expect "dataset: --shard overflowing int" 2 "$V" dataset "$P" --count 2 --shard 1/99999999999 -o "$T/ds"
+expect "dataset: --image-size overflowing int" 2 "$V" dataset "$P" --count 2 --image-size 4294967396x64 -o "$T/ds"
 expect "dataset: --vary B < A" 2 "$V" dataset "$P" --count 2 --vary DAYS=2:1 -o "$T/ds"
 expect "dataset: --vary nan" 2 "$V" dataset "$P" --count 2 --vary DAYS=nan:1 -o "$T/ds"
 expect "dataset: missing -o" 2 "$V" dataset "$P" --count 2
@@ -218,6 +221,7 @@ head -c 3000 /dev/urandom >"$T/binary.pcd"
 expect "render: binary garbage as PCD" 2 "$V" render "$T/binary.pcd" -o "$T/r.png"
 expect "render: --size 0x0" 2 "$V" render "$T/c_ok.ply" -o "$T/r.png" --size 0x0
 expect "render: --size 100000x2" 2 "$V" render "$T/c_ok.ply" -o "$T/r.png" --size 100000x2
+expect "render: --size overflowing int" 2 "$V" render "$T/c_ok.ply" -o "$T/r.png" --size 4294967396x64
 expect "render: --fov nan" 2 "$V" render "$T/c_ok.ply" -o "$T/r.png" --fov nan
 expect "render: --eye inf" 2 "$V" render "$T/c_ok.ply" -o "$T/r.png" --eye inf,0,0 --lookat 0,0,0
 expect "render: --point-size inf" 2 "$V" render "$T/c_ok.ply" -o "$T/r.png" --point-size inf

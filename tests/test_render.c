@@ -517,7 +517,7 @@ TEST(render, robot_from_mjcf) {
   CHECK_INT(f.label[mid], 0);
   CHECK_STATUS(vd_render_set_robot_qpos(r, &q, 2, &err), VD_ERR_ARG, err);
   vd_render_destroy(r);
-  // a broken or missing MJCF is a format error naming the file
+  // a broken MJCF is a format error naming the file
   fp = fopen(path, "w");
   REQUIRE(fp);
   fputs("<mujoco><worldbody><geom type=\"capsule\"", fp);
@@ -526,9 +526,11 @@ TEST(render, robot_from_mjcf) {
   vd_status st = vd_render_create(&d, &bad, &err);
   if (st != VD_ERR_UNSUPPORTED) CHECK_STATUS(st, VD_ERR_FORMAT, err);
   CHECK(bad == NULL);
+  // a missing one cannot be opened (before MuJoCo is asked)
   snprintf(path, sizeof path, "%s/missing.xml", vdt_tmpdir());
-  st = vd_render_create(&d, &bad, &err);
-  if (st != VD_ERR_UNSUPPORTED) CHECK_STATUS(st, VD_ERR_FORMAT, err);
+  vd_error err2 = {0};
+  st = vd_render_create(&d, &bad, &err2);
+  if (st != VD_ERR_UNSUPPORTED) CHECK_STATUS(st, VD_ERR_IO, err2);
 }
 
 TEST(render, png_round_trip) {

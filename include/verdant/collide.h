@@ -79,7 +79,7 @@ vd_status vd_sdf_build(const double* vert, int nvert, const int* tri, int ntri,
 void vd_sdf_destroy(vd_sdf* sdf);
 // Signed distance at local point p by trilinear interpolation; grad (Nullable) gets the
 // interpolant's gradient. Outside the grid: distance to the grid box plus the value there.
-double vd_sdf_eval(const vd_sdf* sdf, vd_vec3 p, vd_vec3* grad);
+double vd_sdf_eval(const vd_sdf* g, vd_vec3 p, vd_vec3* grad);
 
 // ---------------------------------------------------------------------------------------------
 // colliders and single queries
@@ -177,11 +177,11 @@ typedef struct vd_collide_exclusion {
 } vd_collide_exclusion;
 
 // Exclude every pair of primitives whose nodes are at most `hops` capsule edges apart (0: they
-// share a node; 1: also the next capsule along, ...). sphere_node (Nullable: none attached) gives
+// share a node; 1: also the next capsule along, ...). sph_node (Nullable: none attached) gives
 // each sphere's attachment node or -1. Build once per model; free with
 // vd_collide_exclusion_free.
-vd_status vd_collide_exclusion_build(int nnode, int ncapsule, const int* capsule_node, int nsphere,
-                                     const int* sphere_node, int hops, vd_collide_exclusion* out,
+vd_status vd_collide_exclusion_build(int nnode, int ncapsule, const int* cap_node, int nsphere,
+                                     const int* sph_node, int hops, vd_collide_exclusion* out,
                                      vd_error* err);
 // Also exclude every pair closer than margin (m) in the state rest (the modelled shape, with ex
 // set in it or not): organs that touch by design, a fruit against the pedicel segments around
@@ -230,9 +230,9 @@ vd_status vd_collide_self(const vd_collide_prims* prims, const vd_collide_def* d
 vd_status vd_collide_colliders(const vd_collide_prims* prims, const vd_collider* col, int ncol,
                                const vd_collide_def* def, vd_arena* arena, vd_contact_list* out,
                                vd_error* err);
-// The contact of one pair of plant primitives i, j (the narrow phase): 1 and *c filled when
+// The contact of one pair of plant primitives i, j (the narrow phase): 1 and *out filled when
 // their surfaces are closer than margin, else 0.
-int vd_collide_pair(const vd_collide_prims* prims, int i, int j, double margin, vd_contact* c);
+int vd_collide_pair(const vd_collide_prims* prims, int i, int j, double margin, vd_contact* out);
 
 // Candidate pairs of the broad phase, to reuse over several steps (a Verlet list).
 typedef struct vd_pair_list {

@@ -71,9 +71,9 @@ typedef struct vd_mesh {
 // Exact vertex and triangle counts vd_geom_tessellate would produce (def Nullable: defaults).
 vd_status vd_geom_count(const vd_model* m, const vd_data* d, const vd_mesh_def* def, int* nvert,
                         int* ntri, vd_error* err);
-// Tessellate state d (Nullable: the rest shape) of model m into out (def Nullable: defaults).
+// Tessellate state d (Nullable: the rest shape) of model m into mesh (def Nullable: defaults).
 vd_status vd_geom_tessellate(const vd_model* m, const vd_data* d, const vd_mesh_def* def,
-                             vd_mesh* out, vd_error* err);
+                             vd_mesh* mesh, vd_error* err);
 // Free a mesh's arrays and zero it (NULL and empty meshes are fine).
 void vd_mesh_free(vd_mesh* mesh);
 
@@ -193,8 +193,8 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
                           vd_solids* out, vd_error* err);
 // The solid of primitive (kind, prim), or -1 when it has none (thin meshes, bad indices).
 int vd_solids_own(const vd_solids* so, int kind, int prim);
-// 1 when p is inside solid s or on its boundary (within eps).
-int vd_solid_contains(const vd_solids* so, int s, vd_vec3 p);
+// 1 when p is inside solid i or on its boundary (within eps).
+int vd_solid_contains(const vd_solids* so, int i, vd_vec3 p);
 // A solid containing p other than the primitive (kind, prim) and the tube neighbours it is
 // joined to, or -1 when none (kind -1: exclude nothing).
 int vd_solids_inside(const vd_solids* so, vd_vec3 p, int kind, int prim);

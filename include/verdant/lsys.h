@@ -162,9 +162,9 @@ vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsyst
 vd_status vd_lsys_load(const char* path, vd_lsystem** out, vd_error* err);
 // Free an lsystem (NULL is fine).
 void vd_lsys_destroy(vd_lsystem* ls);
-// Replace global `name` by the value of the Python expression `value` (--set NAME=VALUE).
+// Replace global `name` by the value of the Python expression `text` (--set NAME=TEXT).
 // The global must exist in the file (VD_ERR_NAME otherwise).
-vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* value, vd_error* err);
+vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* text, vd_error* err);
 // Current numeric value of a global; VD_ERR_NAME if absent, VD_ERR_TYPE if not a number.
 vd_status vd_lsys_get_global(const vd_lsystem* ls, const char* name, double* value);
 // The file's derivation length (after globals are set).

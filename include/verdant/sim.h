@@ -330,7 +330,7 @@ typedef struct vd_sim_settle_def {
 vd_sim_settle_def vd_sim_settle_def_default(void);
 // Settle the state under the current loads. *converged (Nullable) tells whether the tolerance
 // was met; *steps (Nullable) the steps taken. Fractures may happen on the way.
-vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_settle_def* def,
+vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_settle_def* s,
                         int* converged, int* steps);
 
 // Add an external collider; returns its index or -1 when VD_SIM_MAX_COLLIDERS are in use.

@@ -117,7 +117,7 @@ static vd_status comment_line(reader* r, const char* s, size_t len, int line) {
     if (!errno && v >= 0 && v <= 65535 && (*end == 0 || *end == '\r')) r->nview = (int)v;
     return VD_OK;
   }
-  if (strncmp(p, "label ", 6)) return VD_OK;
+  if (strncmp(p, "label ", 6) != 0) return VD_OK;
   char* end;
   errno = 0;
   long id = strtol(p + 6, &end, 10);
@@ -270,7 +270,7 @@ static vd_status read_binary_rows(reader* r, const unsigned char* data, size_t a
       if (cs->field[k] < 0) continue;
       if (!put_field(c, i, cs->field[k], get_le(rec + cs->offset[k], cs->type[k]))) {
         return fail(r, 0, "column '%s' of point %lld (byte %llu): bad value", cs->name[k], (long long)i,
-                    (unsigned long long)(base + (size_t)i * (size_t)cs->record + (size_t)cs->offset[k]));
+                    (unsigned long long)base + (unsigned long long)i * (unsigned long long)cs->record + (unsigned long long)cs->offset[k]);
       }
     }
   }
@@ -284,7 +284,7 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
   text t = {s, len, 0, 0};
   const char* ls;
   size_t ll;
-  if (!next_line(&t, &ls, &ll) || ll != 3 || memcmp(ls, "ply", 3))
+  if (!next_line(&t, &ls, &ll) || ll != 3 || memcmp(ls, "ply", 3) != 0)
     return fail(r, 1, "not a PLY file (expected 'ply')");
   int binary = -1, in_vertex = 0, seen_vertex = 0;
   int64_t n = -1;
@@ -304,7 +304,7 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
     if (k < 1) return fail(r, t.line, "header line too long");
     if (!strcmp(tok[0], "end_header")) break;
     if (!strcmp(tok[0], "format")) {
-      if (k != 3 || strcmp(tok[2], "1.0")) return fail(r, t.line, "expected 'format TYPE 1.0'");
+      if (k != 3 || strcmp(tok[2], "1.0") != 0) return fail(r, t.line, "expected 'format TYPE 1.0'");
       if (!strcmp(tok[1], "ascii")) binary = 0;
       else if (!strcmp(tok[1], "binary_little_endian")) binary = 1;
       else return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, t.line, 0, "PLY format '%s' is not supported", tok[1]);
@@ -315,7 +315,7 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
         in_vertex = 0;
         continue;
       }
-      if (strcmp(tok[1], "vertex"))
+      if (strcmp(tok[1], "vertex") != 0)
         return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, t.line, 0,
                             "element '%s' before the vertex element is not supported", tok[1]);
       char* end;
@@ -370,7 +370,7 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
   size_t ll;
   cols cs;
   memset(&cs, 0, sizeof cs);
-  int sizes[64], counts[64], nsize = -1, ntype = -1, ncount = -1, binary = -1;
+  int sizes[64] = {0}, counts[64] = {0}, nsize = -1, ntype = -1, ncount = -1, binary = -1;
   char types[64];
   int64_t points = -1;
   char buf[4096];
@@ -418,7 +418,7 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
       if (k == 2 && !strcmp(tok[1], "ascii")) binary = 0;
       else if (k == 2 && !strcmp(tok[1], "binary")) binary = 1;
       else return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, t.line, 0, "PCD DATA '%s' is not supported (ascii or binary)", k > 1 ? tok[1] : "");
-    } else if (strcmp(key, "VERSION") && strcmp(key, "WIDTH") && strcmp(key, "HEIGHT") && strcmp(key, "VIEWPOINT")) {
+    } else if (strcmp(key, "VERSION") != 0 && strcmp(key, "WIDTH") != 0 && strcmp(key, "HEIGHT") != 0 && strcmp(key, "VIEWPOINT") != 0) {
       return fail(r, t.line, "unknown header line '%s'", key);
     }
   }
@@ -549,7 +549,7 @@ static double le_f64(const unsigned char* p) {
 
 static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
   const unsigned char* b = (const unsigned char*)s;
-  if (len < 375 || memcmp(b, "LASF", 4)) return fail(r, 0, "not a LAS file (expected 'LASF')");
+  if (len < 375 || memcmp(b, "LASF", 4) != 0) return fail(r, 0, "not a LAS file (expected 'LASF')");
   if (b[24] != 1 || b[25] != 4)
     return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, 0, 0, "LAS %d.%d: only 1.4 is read", b[24], b[25]);
   unsigned hsize = (unsigned)le(b + 94, 2);

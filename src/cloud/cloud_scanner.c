@@ -46,7 +46,7 @@ static vd_status parse(const cJSON* root, const char* path, vd_vec3 lo, vd_vec3 
   const cJSON* fr = cJSON_GetObjectItemCaseSensitive(root, "frame");
   int bbox = 0;
   if (fr) {
-    if (!cJSON_IsString(fr) || (strcmp(fr->valuestring, "world") && strcmp(fr->valuestring, "bbox")))
+    if (!cJSON_IsString(fr) || (strcmp(fr->valuestring, "world") != 0 && strcmp(fr->valuestring, "bbox") != 0))
       BAD("field 'frame': expected \"world\" or \"bbox\"");
     bbox = !strcmp(fr->valuestring, "bbox");
   }
@@ -62,7 +62,7 @@ static vd_status parse(const cJSON* root, const char* path, vd_vec3 lo, vd_vec3 
   int i = 0;
   for (const cJSON* e = arr->child; e; e = e->next, i++) {
     vd_scanner s = vd_scanner_default();
-    double p[3], t[3] = {0, 0, 0}, fov[2], res[2];
+    double p[3] = {0}, t[3] = {0, 0, 0}, fov[2] = {0}, res[2] = {0};
     const char* what = NULL;
     if (!cJSON_IsObject(e)) what = "expected an object";
     if (!what && numbers(e, "position", p, 3) != 1) what = "'position': expected 3 numbers";
@@ -77,7 +77,7 @@ static vd_status parse(const cJSON* root, const char* path, vd_vec3 lo, vd_vec3 
       what = "'resolution': expected [across, down] integers in 1..100000";
     const cJSON* pat = what ? NULL : cJSON_GetObjectItemCaseSensitive(e, "pattern");
     if (pat && (!cJSON_IsString(pat) ||
-                (strcmp(pat->valuestring, "angular") && strcmp(pat->valuestring, "pinhole"))))
+                (strcmp(pat->valuestring, "angular") != 0 && strcmp(pat->valuestring, "pinhole") != 0)))
       what = "'pattern': expected \"angular\" or \"pinhole\"";
     if (what) {
       vd_free(sc, (size_t)n * sizeof *sc);

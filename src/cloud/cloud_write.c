@@ -126,7 +126,7 @@ static void put_str(unsigned char* p, const char* str, size_t cap) {
 static void one_line(const char* s, char* buf, size_t cap) {
   size_t n = 0;
   for (; s && *s && n + 1 < cap; s++, n++)
-    buf[n] = (unsigned char)*s < 0x20 ? ' ' : *s;
+    buf[n] = (char)((unsigned char)*s < 0x20 ? ' ' : *s);
   buf[n] = 0;
 }
 
@@ -257,7 +257,7 @@ static const struct {
 
 static void vlr_header(unsigned char* p, int record, unsigned len, const char* desc) {
   memset(p, 0, LAS_VLR_HEADER);
-  memcpy(p + 2, "LASF_Spec", 9);
+  memcpy(p + 2, "LASF_Spec", 9);  // NOLINT(bugprone-not-null-terminated-result): a fixed-width LAS field, no NUL
   put_u16(p + 18, (unsigned)record);
   put_u16(p + 20, len);
   put_str(p + 22, desc, 31);
@@ -300,7 +300,7 @@ static vd_status write_las(FILE* fp, const vd_cloud* c, const vd_cloud_write_def
   // the public header block
   unsigned char h[LAS_HEADER];
   memset(h, 0, sizeof h);
-  memcpy(h, "LASF", 4);
+  memcpy(h, "LASF", 4);  // NOLINT(bugprone-not-null-terminated-result): a fixed-width LAS field, no NUL
   put_u16(h + 6, 1u << 4);  // global encoding: WKT coordinate system bit (required for PDRF 6+)
   h[24] = 1, h[25] = 4;
   put_str(h + 26, "verdant synthetic cloud", 31);

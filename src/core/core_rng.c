@@ -25,6 +25,7 @@ void vd_rng_seed_array(vd_rng* r, const uint32_t* key, int len) {
   init_genrand(r, 19650218u);
   int i = 1, j = 0;
   for (int k = MT_N > len ? MT_N : len; k; k--) {
+    // cppcheck-suppress objectIndex ; j stays below len, which is 1 when key is &zero
     r->mt[i] = (r->mt[i] ^ ((r->mt[i - 1] ^ (r->mt[i - 1] >> 30)) * 1664525u)) + key[j] + (uint32_t)j;
     i++;
     j++;

@@ -86,7 +86,7 @@ static int best_split(const builder* bd, int start, int count, const double cmin
     for (int a = 0; a < 3; a++) {
       if (!live[a]) continue;
       bin* b = &bins[a][bin_of(it->c[a], cmin[a], scale[a], nbin)];
-      b->count++;
+      b->count++;  // NOLINT(clang-analyzer-core.uninitialized.Assign): nbin is in 2..MAX_BINS (vd_bvh_build checks)
       box_grow2(b->lo, b->hi, it->lo, it->hi);
     }
   }
@@ -101,7 +101,7 @@ static int best_split(const builder* bd, int start, int count, const double cmin
     box_empty(lo, hi);
     int cnt = 0;
     for (int b = nbin - 1; b > 0; b--) {
-      if (bins[a][b].count) box_grow2(lo, hi, bins[a][b].lo, bins[a][b].hi);
+      if (bins[a][b].count) box_grow2(lo, hi, bins[a][b].lo, bins[a][b].hi);  // NOLINT(clang-analyzer-core.uninitialized.Branch): nbin is in 2..MAX_BINS (vd_bvh_build checks)
       cnt += bins[a][b].count;
       right_area[b] = half_area(lo, hi);
       right_count[b] = cnt;
@@ -111,6 +111,7 @@ static int best_split(const builder* bd, int start, int count, const double cmin
     for (int b = 1; b < nbin; b++) {
       if (bins[a][b - 1].count) box_grow2(lo, hi, bins[a][b - 1].lo, bins[a][b - 1].hi);
       cnt += bins[a][b - 1].count;
+      // cppcheck-suppress uninitvar ; right_count[1..nbin-1] is set by the sweep above
       if (cnt == 0 || right_count[b] == 0) continue;
       double cost = cnt * half_area(lo, hi) + right_count[b] * right_area[b];
       if (cost < best) {

@@ -36,7 +36,7 @@ static void box_disc(vd_solid* s, vd_vec3 c, vd_vec3 a, double r, double pad) {
 }
 
 static void solid_init(vd_solid* s, int kind, int prim, int label, int instance) {
-  memset(s, 0, sizeof *s);
+  memset(s, 0, sizeof *s);  // NOLINT(clang-analyzer-core.NonNullParamChecker): solids exist whenever ns > 0
   s->kind = kind, s->prim = prim, s->label = label, s->instance = instance;
   s->joined[0] = s->joined[1] = -1;
   s->q = vd_quat_identity();
@@ -111,7 +111,7 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
   for (int i = 0; i < m->nseg; i++, k++) {
     vd_solid* s = &out->solid[k];
     solid_init(s, VD_PRIM_SEGMENT, i, m->seg_label[i], m->seg_instance[i]);
-    out->seg_solid[i] = k;
+    out->seg_solid[i] = k;  // NOLINT(clang-analyzer-core.NullDereference): arrays carved from one block sized by these counts
     vd_vec3 c0 = get3(node_pos, m->seg_node[2 * i]), c1 = get3(node_pos, m->seg_node[2 * i + 1]);
     vd_quat q = {seg_quat[4 * i], seg_quat[4 * i + 1], seg_quat[4 * i + 2], seg_quat[4 * i + 3]};
     vd_vec3 axis = vd_quat_rotate(q, vd_v3(0, 0, 1));
@@ -136,7 +136,7 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
   for (int i = 0; i < m->nsphere; i++, k++) {
     vd_solid* s = &out->solid[k];
     solid_init(s, VD_PRIM_SPHERE, i, m->sphere_label[i], m->sphere_instance[i]);
-    out->sphere_solid[i] = k;
+    out->sphere_solid[i] = k;  // NOLINT(clang-analyzer-core.NullDereference): arrays carved from one block sized by these counts
     s->c = get3(sphere_pos, i);
     s->r0 = s->r1 = m->sphere_radius[i];
     s->slices = md.slices > 0 ? md.slices : m->sphere_slices[i];
@@ -165,7 +165,7 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
   // a BVH over the boxes
   for (int i = 0; i < ns; i++)
     for (int c = 0; c < 3; c++) {
-      box[6 * i + c] = out->solid[i].lo[c];
+      box[6 * i + c] = out->solid[i].lo[c];  // NOLINT(clang-analyzer-core.NullDereference): arrays carved from one block sized by these counts
       box[6 * i + 3 + c] = out->solid[i].hi[c];
     }
   vd_bvh_def bd = vd_bvh_def_default();

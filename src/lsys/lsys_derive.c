@@ -151,7 +151,7 @@ vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* text,
   int before = ls->nglobal;
   expr* e = lsys_parse_expr_text(ls, text, (int)strlen(text), 0, 1);
   vd_status st = VD_OK;
-  value v;
+  value v = {0};
   if (!e) {
     st = ls->err->status ? ls->err->status : VD_ERR_SYNTAX;
   } else {
@@ -413,7 +413,7 @@ static int match_right(const vd_lsystem* ls, const rule* r, const vd_lstring* s,
       // the pattern leaves the branch: skip the rest of it
       if (depth == 0) return 0;
       int64_t o = open[--depth];
-      j = m[o] + 1;
+      j = m[o] + 1;  // NOLINT(clang-analyzer-core.NullDereference): m holds every module of a non-empty L-string
       continue;
     }
     j = next_axial(ls, s, m, j);
@@ -567,7 +567,7 @@ static void lstr_swap(vd_lstring* a, vd_lstring* b) {
 static vd_status apply_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, pass_ctx* P) {
   if (ls->rule_first[sec][ls->rule_index_nsym] == 0) return VD_OK;
   for (int d = 0; d < ls->max_depth[sec]; d++) {
-    int fired;
+    int fired = 0;
     vd_status st = apply_rules(ls, sec, cur, tmp, P, &fired);
     if (st) return st;
     lstr_swap(cur, tmp);
@@ -666,7 +666,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   for (int step = 0; step < steps && !ls->stop_requested; step++) {
     ls->iteration = step;
     if ((st = call_hook(ls, ls->hook_starteach))) goto done;
-    int fired;
+    int fired = 0;
     if ((st = apply_rules(ls, SEC_PRODUCTION, out, &tmp, &P, &fired))) goto done;
     lstr_swap(out, &tmp);
     if (has_cut(out)) apply_cut(out);

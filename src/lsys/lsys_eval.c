@@ -481,7 +481,7 @@ static vd_status eval_call(vd_lsystem* ls, const expr* e, value* frame, value* o
     value base;
     if (vm_eval(ls, e->a->a, frame, &base)) return ls->err->status;
     const char* attr = ls->str[e->a->slot];
-    if (base.t != V_NS)
+    if (base.t != V_NS)  // NOLINT(clang-analyzer-core.UndefinedBinaryOperatorResult): vm_eval fills its value when it returns VD_OK; the analyzer does not follow the variadic vm_error
       return vm_error(ls, VD_ERR_UNSUPPORTED, e->line, e->col, "unsupported: attribute '%s' of %s", attr,
                       type_name(base));
     int b = builtin_in_ns((int)base.n, attr, (int)strlen(attr));
@@ -495,7 +495,7 @@ static vd_status eval_call(vd_lsystem* ls, const expr* e, value* frame, value* o
   value args[64];
   for (int i = 0; i < e->nargs; i++)
     if (vm_eval(ls, e->args[i], frame, &args[i])) return ls->err->status;
-  if (callee.t == V_BUILTIN) return call_builtin(ls, (int)callee.n, e->nargs, args, out, e->line, e->col);
+  if (callee.t == V_BUILTIN) return call_builtin(ls, (int)callee.n, e->nargs, args, out, e->line, e->col);  // NOLINT(clang-analyzer-core.UndefinedBinaryOperatorResult): vm_eval fills its value when it returns VD_OK; the analyzer does not follow the variadic vm_error
   if (callee.t == V_NS && callee.n == NS_RANDOM)  // `random` after `from random import *` is random()
     return call_builtin(ls, B_RANDOM, e->nargs, args, out, e->line, e->col);
   if (callee.t == V_FUNC) return vm_call_func(ls, (int)callee.n, e->nargs, args, out, e->line, e->col);
@@ -503,7 +503,7 @@ static vd_status eval_call(vd_lsystem* ls, const expr* e, value* frame, value* o
 }
 
 vd_status vm_eval(vd_lsystem* ls, const expr* e, value* frame, value* out) {
-  value a, b;
+  value a = {0}, b = {0};
   switch (e->op) {
     case E_CONST: *out = e->k; return VD_OK;
     case E_LOCAL:

@@ -895,7 +895,7 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
       cap = ncap;
     }
     tmod* m = &mods[t->n++];
-    m->sym = sym;
+    m->sym = sym;  // NOLINT(clang-analyzer-core.NullDereference): mods grown above before t->n grows
     m->line = lineno;
     m->col = mcol;
     if (sym == VD_SYM_CUT) t->has_cut = 1;
@@ -1519,12 +1519,11 @@ static vd_status parse_import(parser* P, const pline* ln) {
     if (L.t != T_NAME)
       return perr(ls, VD_ERR_SYNTAX, ln->lineno, lx_col(&L), "expected a module name");
     const char* m = L.s + L.start;
-    int mlen = L.tlen;
     int mcol = lx_col(&L);
     // dotted name
     int p = L.pos;
     while (p < L.len && (isalnum((unsigned char)L.s[p]) || L.s[p] == '_' || L.s[p] == '.')) p++;
-    mlen = p - L.start;
+    int mlen = p - L.start;
     L.pos = p;
     if (lx_next(&L)) return ls->err->status;
     int ok = name_is(m, mlen, "random") || name_is(m, mlen, "math") ||
@@ -1709,13 +1708,9 @@ static vd_status parse_rule(parser* P, int* li, int section, int group) {
     hend = arrow;
   } else {
     // header ends at the last top-level ':' (the body follows)
-    for (int i = 0;;) {
-      int c = find_top(s, i, len, ":");
-      if (c < 0) break;
-      colon = c;
-      i = c + 1;
-      break;  // first colon: rule headers hold no ':' of their own
-    }
+    // the first colon: rule headers hold no ':' of their own
+    int c = find_top(s, 0, len, ":");
+    if (c >= 0) colon = c;
     if (colon < 0) {
       if (find_top(s, 0, len, "-static->") >= 0 || find_top(s, 0, len, "->") >= 0) {
         st = perr(ls, VD_ERR_UNSUPPORTED, ln->lineno, ln->col0, "unsupported: rule arrow other than '-->'");
@@ -1816,7 +1811,7 @@ static vd_status parse_def(parser* P, int* li) {
   pline* ln = &P->lines[*li];
   lexer L;
   lx_init(&L, ls, ln->s, ln->len, ln->lineno, ln->col0, 0);
-  if (lx_next(&L) || lx_next(&L)) return ls->err->status;
+  if (lx_next(&L) || lx_next(&L)) return ls->err->status;  // NOLINT(misc-redundant-expression): lx_next advances: skip 'def', then read the name
   if (L.t != T_NAME) return perr(ls, VD_ERR_SYNTAX, ln->lineno, lx_col(&L), "expected a function name after 'def'");
   func* f = aalloc(ls, sizeof(func));
   if (!f) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");

@@ -49,7 +49,7 @@ typedef struct tstate {
 } tstate;
 
 // One run of the turtle over one L-string.
-typedef struct turtle {
+typedef struct turtle {  // NOLINT(clang-analyzer-optin.performance.Padding): fields grouped by meaning; a few per derivation
   const vd_lsystem* ls; // Nullable: names and strings
   const vd_lstring* s;  // the string being read
   vd_turtle_def def;    // settings

@@ -221,7 +221,7 @@ static vd_status get_number(rd* r, const cJSON* v, const char* where, double lo,
 static vd_status get_vec3(rd* r, const cJSON* v, const char* where, vd_vec3* out) {
   if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3)
     return fail(r, "%s: expected [x, y, z]", where);
-  double x[3];
+  double x[3] = {0};
   int k = 0;
   for (const cJSON* e = v->child; e; e = e->next, k++) {
     char w[160];
@@ -793,7 +793,7 @@ static vd_status sample(build* b) {
       len += vd_norm(vd_sub(c->pt[cv->p0 + q], c->pt[cv->p0 + q - 1]));
     double n = ceil(len / b->def.sample_step - 1e-9);
     if (n < 1) n = 1;
-    if (ns + n + 1 > b->def.max_samples || ns + n + 1 > 0x7fffffff)
+    if ((double)ns + n + 1 > (double)b->def.max_samples || (double)ns + n + 1 > 0x7fffffff)
       return vd_error_set(b->err, VD_ERR_LIMIT, c->file, 0, 0,
                           "curves: more than %lld samples at sample_step %g m; use a larger step",
                           (long long)b->def.max_samples, b->def.sample_step);
@@ -856,7 +856,7 @@ static int nearest_on_curve(const build* b, int k, vd_vec3 x, double* d) {
   int best = -1;
   double bd = HUGE_VAL;
   for (int i = b->base[k]; i < b->base[k + 1]; i++) {
-    if (!(b->flag[i] & ALIVE)) continue;
+    if (!(b->flag[i] & ALIVE)) continue;  // NOLINT(clang-analyzer-core.NullDereference): arrays sized by the sample count, > 0 here
     double e = vd_norm(vd_sub(b->pos[i], x));
     if (e < bd) bd = e, best = i;
   }
@@ -920,8 +920,8 @@ static vd_status connect(build* b, vd_curves_stats* stats) {
   }
   // the root curve runs both ways from the root sample
   for (int i = b->base[rc]; i < b->base[rc + 1]; i++)
-    b->parent[i] = i < b->root ? i + 1 : (i > b->root ? i - 1 : -1);
-  b->start_rad[rc] = b->rad[b->root];
+    b->parent[i] = i < b->root ? i + 1 : (i > b->root ? i - 1 : -1);  // NOLINT(clang-analyzer-core.NullDereference): arrays sized by the sample count, > 0 here
+  b->start_rad[rc] = b->rad[b->root];  // NOLINT(clang-analyzer-core.NullDereference): arrays sized by the sample count, > 0 here
   b->flag[b->root] |= KEY;
   for (int k = 0; k < nc; k++)
     b->depth[k] = -1;

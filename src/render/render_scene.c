@@ -595,9 +595,9 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
 
 vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double fwd[3],
                                const double right[3], const double up[3], vd_error* err) {
-  if (r->cloud_lists_valid && !memcmp(eye, r->cloud_eye, sizeof r->cloud_eye) &&
-      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd) &&
-      !memcmp(up, r->cloud_up, sizeof r->cloud_up))
+  if (r->cloud_lists_valid && !memcmp(eye, r->cloud_eye, sizeof r->cloud_eye) &&  // NOLINT(bugprone-suspicious-memory-comparison,cert-exp42-c,cert-flp37-c): bitwise equality is what a cache of the last view wants
+      !memcmp(fwd, r->cloud_fwd, sizeof r->cloud_fwd) &&  // NOLINT(bugprone-suspicious-memory-comparison,cert-exp42-c,cert-flp37-c): bitwise equality is what a cache of the last view wants
+      !memcmp(up, r->cloud_up, sizeof r->cloud_up))  // NOLINT(bugprone-suspicious-memory-comparison,cert-exp42-c,cert-flp37-c): bitwise equality is what a cache of the last view wants
     return VD_OK;
   // largest group, for one scratch buffer
   int most = 0;

@@ -440,7 +440,6 @@ static vd_status build_chains(bld* b) {
         }
       } else {
         start = add_node(b, pnode(p, n0), 1);
-        is_root = 1;
         if (start < 0) {
           st = oom(b);
           goto done;
@@ -800,7 +799,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
   m->opt = vd_sim_opt_default();
   m->opt.gravity = def->gravity;
   m->leaf_cd = def->leaf_plate_cd;
-#define P(f, o) m->f = (void*)(block + o)
+#define P(f, o) m->f = (void*)(block + (o))
   P(node_pos0, o_np), P(node_mass, o_nm), P(node_radius, o_nr), P(node_owner, o_no), P(node_fixed, o_nf);
   P(node_sphere, o_nsph), P(seg_node, o_sn), P(seg_parent, o_sp), P(seg_flags, o_sf), P(seg_class, o_sc);
   P(seg_label, o_sl), P(seg_instance, o_si), P(seg_plant, o_spl), P(seg_spare, o_ssp), P(seg_order, o_so);

@@ -230,6 +230,7 @@ static double shape_sd(const vd_collider* c, vd_vec3 p, vd_vec3* n) {
     return d;
   }
   default:
+    // cppcheck-suppress incorrectStringBooleanError ; the string is the failed assert's message
     VD_ASSERT(0 && "unknown collider shape");
     *n = vd_v3(0, 0, 1);
     return HUGE_VAL;
@@ -731,7 +732,7 @@ static vd_status narrow_phase(const vd_collide_prims* P, const int* pair, int np
       if (la.x > hb.x || lb.x > ha.x || la.y > hb.y || lb.y > ha.y || la.z > hb.z || lb.z > ha.z)
         continue;
     }
-    out->ntested++;
+    out->ntested++;  // NOLINT(clang-analyzer-core.uninitialized.Assign): check_prims zeroes *out
     vd_contact c;
     if (!vd_collide_pair(P, a, b, def->margin, &c)) continue;
     if (buf.n >= def->max_contacts) {

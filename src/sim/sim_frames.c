@@ -70,7 +70,7 @@ static vd_status open_bin(vd_sim_frames* f, vd_error* err) {
   unsigned char h[HEADER_BYTES];
   if (fread(h, 1, sizeof h, f->fp) != sizeof h)
     return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0, "shorter than the 24-byte header");
-  if (memcmp(h, "VDSIMFRM", 8))
+  if (memcmp(h, "VDSIMFRM", 8) != 0)
     return vd_error_set(err, VD_ERR_FORMAT, f->path, 0, 0,
                         "not a verdant frames file (no VDSIMFRM)");
   uint32_t ver = get_u32(h + 8), nn = get_u32(h + 12), ns = get_u32(h + 16);

@@ -330,7 +330,7 @@ vd_status vd_sdf_build(const double* vert, int nvert, const int* tri, int ntri,
   if (st) return st;
 
   // grid box: the mesh bounds plus padding, at least two nodes along each axis
-  vd_vec3 lo = m.v[0], hi = m.v[0];
+  vd_vec3 lo = m.v[0], hi = m.v[0];  // NOLINT(clang-analyzer-core.NullDereference): ntri > 0 with indices below nvert: m.v has vertices
   for (int i = 1; i < m.nv; i++)
     lo = vd_vmin(lo, m.v[i]), hi = vd_vmax(hi, m.v[i]);
   lo = vd_sub(lo, vd_v3(def.padding, def.padding, def.padding));
