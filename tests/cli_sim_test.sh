@@ -127,7 +127,7 @@ f 3 7 8 4
 f -8 -4 -2 -6
 f 2 4 8 6
 EOF
-expect "sim mesh collider" 0 "$V" sim "$SRC/data/tomato.lpy" --duration 0.05 --stats --collider-mesh "$T/cube.obj:0.08,0,0.25"
+expect "sim mesh collider" 0 "$V" sim "$SRC/data/tomato.lpy" --duration 0.05 --stats --self-collision --collider-mesh "$T/cube.obj:0.08,0,0.25"
 json_check "sim mesh collider contacts" "d['contacts'] > 2 and d['max_penetration'] < 1e-4 and d['warnings'] == 0"
 expect "sim no self-collision" 0 "$V" sim "$SRC/data/tomato.lpy" --duration 0.02 --stats --no-self-collision --no-ground
 json_check "sim no self-collision contacts" "d['contacts'] == 0"

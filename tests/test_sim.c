@@ -471,7 +471,8 @@ TEST(sim, self_collision_rest) {
     vd_sim_model* m = NULL;
     vd_error e = {0};
     REQUIRE(vd_sim_build(pm, &def, &m, &e) == VD_OK);
-    CHECK_INT(m->opt.self_collision, 1);
+    CHECK_INT(m->opt.self_collision, 0);
+    m->opt.self_collision = 1;
     m->opt.contacts = 1;
     vd_sim_data* d = vd_sim_data_create(m);
     REQUIRE(d);

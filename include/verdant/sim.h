@@ -152,7 +152,7 @@ typedef struct vd_sim_opt {
 // Defaults: dt 1e-3 s, iterations 1, solver direct, gravity (0, 0, -9.81) m/s^2,
 // air_density 1.226 kg/m^3, wind 0 m/s, gust_amplitude 0, gust_period 2 s, no wind series,
 // drag 1, stokes_viscosity 0 Pa s, damping 0 s, mass_damping 0 1/s, fracture 1, contacts 1,
-// friction 0.5, self_collision 1.
+// friction 0.5, self_collision 0 (off: it costs ~30 % on the tomato with a probe, docs/physics.md).
 vd_sim_opt vd_sim_opt_default(void);
 
 // rod segment flags

@@ -77,7 +77,7 @@ vd_sim_opt vd_sim_opt_default(void) {
   o.fracture = 1;
   o.contacts = 1;
   o.friction = 0.5;
-  o.self_collision = 1;
+  o.self_collision = 0;
   return o;
 }
 
