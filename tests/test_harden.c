@@ -250,7 +250,7 @@ TEST(harden, sim_retake_keeps_soft_plant_bounded) {
   for (int n = 0; n < 50; n++) vd_sim_step(m, d);
   CHECK(sim_finite(m, d));
   CHECK(vd_sim_max_displacement(m, d, NULL) < 1.0);  // the plant is 0.3 m tall
-  CHECK(d->warning[VD_SIM_WARN_SUBSTEP] > 0);
+  CHECK(d->nwarning > 0);  // the trouble is counted (stretched steps, retakes)
   CHECK(d->time > 0.25);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);
