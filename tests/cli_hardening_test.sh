@@ -35,7 +35,7 @@ expect() {
   # VD_TABLE=FILE: each case also becomes a row of the bad-input table (docs/reliability.md)
   if [ -n "${VD_TABLE:-}" ]; then
     local msg
-    msg=$(head -n 1 "$T/err" | sed -e "s#$T/##g" -e "s#$SRC/##g" -e 's/|/\\|/g' | cut -c 1-150)
+    msg=$(head -n 1 "$T/err" | sed -e "s#$T/##g" -e "s#$SRC/##g" -e 's/|/\\|/g' | cut -c 1-220)
     printf '| %s | %s | %s | %s |\n' "${name%%:*}" "${name#*: }" "$rc" "${msg:-(nothing on stderr)}" >>"$VD_TABLE"
   fi
   if [ "$rc" -eq 124 ]; then bad "$name (hang: killed after $TMO s)"; return; fi
