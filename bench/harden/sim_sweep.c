@@ -16,11 +16,12 @@
 
 #include "verdant/verdant.h"
 
-#define MAXV 16  // most values of one swept parameter
+#define MAXV 16 // most values of one swept parameter
 
 static const char* usage =
     "usage: verdant_bench_sweep [options]\n"
-    "  --quick              corners only: E 1e6,1e11 Pa; rho 100,1500 kg/m^3; dt 1e-4,1e-2 s; iterations 1,100\n"
+    "  --quick              corners only: E 1e6,1e11 Pa; rho 100,1500 kg/m^3; dt 1e-4,1e-2 s; "
+    "iterations 1,100\n"
     "  --plant LIST         plants, comma separated (arabidopsis,tomato,tree; default all)\n"
     "  --young LIST         Young's moduli (Pa), default 1e6,1e7,1e8,1e9,1e10,1e11\n"
     "  --density LIST       densities (kg/m^3), default 100,500,1000,1500\n"
@@ -29,7 +30,8 @@ static const char* usage =
     "  --solver LIST        direct, gs or direct,gs (default)\n"
     "  --steps N            steps per run (default 100)\n"
     "  --span T             at most T simulated seconds per run: steps = min(N, ceil(T / dt))\n"
-    "  --max-seconds S      stop a run after S wall seconds, checked between steps (outcome capped)\n"
+    "  --max-seconds S      stop a run after S wall seconds, checked between steps (outcome "
+    "capped)\n"
     "  --csv FILE           one row per run, flushed as each run ends\n"
     "  --append             add rows to FILE (header only when FILE is empty)\n";
 
@@ -64,8 +66,10 @@ static int parse_list(const char* s, double* v) {
     double x = strtod(s, &end);
     if (end == s || !(x > 0) || !isfinite(x)) return 0;
     v[n++] = x;
-    if (*end == ',') end++;
-    else if (*end) return 0;
+    if (*end == ',')
+      end++;
+    else if (*end)
+      return 0;
     s = end;
   }
   return *s ? 0 : n;
@@ -87,16 +91,17 @@ static int state_finite(const vd_sim_model* m, const vd_sim_data* d) {
 }
 
 typedef struct run_result {
-  int steps_done, nonfinite;  // steps taken, non-finite states seen
-  int failed, capped;         // 1 when a step failed; 1 when the wall-time cap stopped the run
-  int64_t warning[VD_SIM_WARN_COUNT];  // the library's warning counters at the end
-  int64_t warnings;                    // their sum
-  double max_disp, ke, seconds;        // largest displacement (m), kinetic energy (J), wall (s)
+  int steps_done, nonfinite; // steps taken, non-finite states seen
+  int failed, capped;        // 1 when a step failed; 1 when the wall-time cap stopped the run
+  int64_t warning[VD_SIM_WARN_COUNT]; // the library's warning counters at the end
+  int64_t warnings;                   // their sum
+  double max_disp, ke, seconds;       // largest displacement (m), kinetic energy (J), wall (s)
 } run_result;
 
 // outcomes, worst first; a run is counted under the first that applies
 enum { O_NONFINITE, O_FAILED, O_CAPPED, O_STRETCHED, O_RETAKEN, O_CLEAN, O_COUNT };
-static const char* outcome_name[O_COUNT] = {"NONFINITE", "failed", "capped", "stretched", "retaken", "clean"};
+static const char* outcome_name[O_COUNT] = {"NONFINITE", "failed",  "capped",
+                                            "stretched", "retaken", "clean"};
 
 // outcome of a run as `verdant sim` reports it (capped: stopped by --max-seconds, incomplete)
 static int outcome(const run_result* r) {
@@ -110,12 +115,13 @@ static int outcome(const run_result* r) {
 
 // one run: gravity, ground, wind 5 m/s along x with 50 % gusts of 0.5 s, `steps` steps, stopped
 // after `max_seconds` of wall time (0: no cap)
-static void run_one(const vd_model* pm, double sigma, double young, double rho, double dt, int iters,
-                    vd_sim_solver solver, int steps, double max_seconds, run_result* r) {
+static void run_one(const vd_model* pm, double sigma, double young, double rho, double dt,
+                    int iters, vd_sim_solver solver, int steps, double max_seconds, run_result* r) {
   memset(r, 0, sizeof *r);
   vd_sim_def def = vd_sim_def_default();
   def.segment_length = sigma;
-  for (int c = 0; c < VD_SIM_CLASS_COUNT; c++) def.material[c].young = young, def.material[c].density = rho;
+  for (int c = 0; c < VD_SIM_CLASS_COUNT; c++)
+    def.material[c].young = young, def.material[c].density = rho;
   vd_sim_model* m = NULL;
   vd_error e = {0};
   if (vd_sim_build(pm, &def, &m, &e)) {
@@ -130,7 +136,8 @@ static void run_one(const vd_model* pm, double sigma, double young, double rho, 
   m->opt.gust_amplitude = 0.5;
   m->opt.gust_period = 0.5;
   vd_sim_data* d = vd_sim_data_create(m);
-  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
+  vd_sim_collider g = {VD_SIM_PLANE,       {0, 0, 0},      vd_v3(0, 0, 0),
+                       vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   vd_sim_add_collider(d, &g);
   double t0 = now();
   // as the command does: stop at the first step that fails; the cap is checked between steps
@@ -157,22 +164,34 @@ int main(int argc, char** argv) {
   double span = 0, max_seconds = 0;
   const char* csv_path = NULL;
   const char* plants = NULL;
-  const char* lists[5] = {NULL, NULL, NULL, NULL, NULL};  // young, density, dt, iterations, solver
+  const char* lists[5] = {NULL, NULL, NULL, NULL, NULL}; // young, density, dt, iterations, solver
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     int more = i + 1 < argc;
-    if (!strcmp(a, "--quick")) quick = 1;
-    else if (!strcmp(a, "--append")) append = 1;
-    else if (!strcmp(a, "--steps") && more) steps = atoi(argv[++i]);
-    else if (!strcmp(a, "--span") && more) span = atof(argv[++i]);
-    else if (!strcmp(a, "--max-seconds") && more) max_seconds = atof(argv[++i]);
-    else if (!strcmp(a, "--csv") && more) csv_path = argv[++i];
-    else if (!strcmp(a, "--plant") && more) plants = argv[++i];
-    else if (!strcmp(a, "--young") && more) lists[0] = argv[++i];
-    else if (!strcmp(a, "--density") && more) lists[1] = argv[++i];
-    else if (!strcmp(a, "--dt") && more) lists[2] = argv[++i];
-    else if (!strcmp(a, "--iterations") && more) lists[3] = argv[++i];
-    else if (!strcmp(a, "--solver") && more) lists[4] = argv[++i];
+    if (!strcmp(a, "--quick"))
+      quick = 1;
+    else if (!strcmp(a, "--append"))
+      append = 1;
+    else if (!strcmp(a, "--steps") && more)
+      steps = atoi(argv[++i]);
+    else if (!strcmp(a, "--span") && more)
+      span = atof(argv[++i]);
+    else if (!strcmp(a, "--max-seconds") && more)
+      max_seconds = atof(argv[++i]);
+    else if (!strcmp(a, "--csv") && more)
+      csv_path = argv[++i];
+    else if (!strcmp(a, "--plant") && more)
+      plants = argv[++i];
+    else if (!strcmp(a, "--young") && more)
+      lists[0] = argv[++i];
+    else if (!strcmp(a, "--density") && more)
+      lists[1] = argv[++i];
+    else if (!strcmp(a, "--dt") && more)
+      lists[2] = argv[++i];
+    else if (!strcmp(a, "--iterations") && more)
+      lists[3] = argv[++i];
+    else if (!strcmp(a, "--solver") && more)
+      lists[4] = argv[++i];
     else {
       fputs(usage, stderr);
       return 2;
@@ -188,7 +207,8 @@ int main(int argc, char** argv) {
   // swept values: defaults (full grid or --quick corners), replaced by the lists given
   double val[4][MAXV];
   int nval[4];
-  static const double full[4][6] = {{1e6, 1e7, 1e8, 1e9, 1e10, 1e11}, {100, 500, 1000, 1500}, {1e-4, 1e-3, 1e-2}, {1, 10, 100}};
+  static const double full[4][6] = {
+      {1e6, 1e7, 1e8, 1e9, 1e10, 1e11}, {100, 500, 1000, 1500}, {1e-4, 1e-3, 1e-2}, {1, 10, 100}};
   static const int nfull[4] = {6, 4, 3, 3};
   static const double corner[4][2] = {{1e6, 1e11}, {100, 1500}, {1e-4, 1e-2}, {1, 100}};
   static const char* what[4] = {"--young", "--density", "--dt", "--iterations"};
@@ -196,12 +216,14 @@ int main(int argc, char** argv) {
     if (lists[p]) {
       nval[p] = parse_list(lists[p], val[p]);
       if (!nval[p]) {
-        fprintf(stderr, "%s: expected up to %d positive numbers separated by commas, got '%s'\n", what[p], MAXV, lists[p]);
+        fprintf(stderr, "%s: expected up to %d positive numbers separated by commas, got '%s'\n",
+                what[p], MAXV, lists[p]);
         return 2;
       }
     } else {
       nval[p] = quick ? 2 : nfull[p];
-      for (int k = 0; k < nval[p]; k++) val[p][k] = quick ? corner[p][k] : full[p][k];
+      for (int k = 0; k < nval[p]; k++)
+        val[p][k] = quick ? corner[p][k] : full[p][k];
     }
   }
   int use_solver[2] = {1, 1};
@@ -216,9 +238,11 @@ int main(int argc, char** argv) {
   int use_plant[3] = {1, 1, 1};
   if (plants) {
     int any = 0;
-    for (int p = 0; p < 3; p++) any += use_plant[p] = strstr(plants, names[p]) != NULL;
+    for (int p = 0; p < 3; p++)
+      any += use_plant[p] = strstr(plants, names[p]) != NULL;
     if (!any) {
-      fprintf(stderr, "--plant: expected arabidopsis, tomato or tree (comma separated), got '%s'\n", plants);
+      fprintf(stderr, "--plant: expected arabidopsis, tomato or tree (comma separated), got '%s'\n",
+              plants);
       return 2;
     }
   }
@@ -229,12 +253,15 @@ int main(int argc, char** argv) {
   }
   // header: run settings, outcome, one column per warning kind, then measures
   if (csv && ftell(csv) == 0) {
-    fprintf(csv, "plant,sigma_m,young_pa,density,dt_s,iterations,solver,steps_asked,steps,outcome,nonfinite_states");
-    for (int w = 0; w < VD_SIM_WARN_COUNT; w++) fprintf(csv, ",warn_%s", vd_sim_warning_name((vd_sim_warning)w));
+    fprintf(csv, "plant,sigma_m,young_pa,density,dt_s,iterations,solver,steps_asked,steps,outcome,"
+                 "nonfinite_states");
+    for (int w = 0; w < VD_SIM_WARN_COUNT; w++)
+      fprintf(csv, ",warn_%s", vd_sim_warning_name((vd_sim_warning)w));
     fprintf(csv, ",warnings,max_displacement_m,kinetic_energy_j,seconds\n");
     fflush(csv);
   }
-  int64_t runs = 0, nonfinite = 0, steps_all = 0, count[O_COUNT] = {0}, by_solver[2][O_COUNT] = {{0}};
+  int64_t runs = 0, nonfinite = 0, steps_all = 0, count[O_COUNT] = {0},
+          by_solver[2][O_COUNT] = {{0}};
   int64_t warn_all[VD_SIM_WARN_COUNT] = {0};
   double t_all = now();
   for (int p = 0; p < 3; p++) {
@@ -261,18 +288,22 @@ int main(int argc, char** argv) {
               nonfinite += r.nonfinite;
               steps_all += r.steps_done;
               count[o]++, by_solver[s][o]++;
-              for (int w = 0; w < VD_SIM_WARN_COUNT; w++) warn_all[w] += r.warning[w];
-              printf("%-12s E %-6.0e rho %-5.0f dt %-6.0e it %-3d %-6s  steps %3d/%-3d  %-9s  nonfinite %d  "
+              for (int w = 0; w < VD_SIM_WARN_COUNT; w++)
+                warn_all[w] += r.warning[w];
+              printf("%-12s E %-6.0e rho %-5.0f dt %-6.0e it %-3d %-6s  steps %3d/%-3d  %-9s  "
+                     "nonfinite %d  "
                      "retaken %4lld  stretched %3lld  max disp %.4g m  KE %.3g J  %.2f s\n",
-                     names[p], young, rho, dt, iters, s ? "gs" : "direct", r.steps_done, n, outcome_name[o],
-                     r.nonfinite, (long long)r.warning[VD_SIM_WARN_SUBSTEP],
+                     names[p], young, rho, dt, iters, s ? "gs" : "direct", r.steps_done, n,
+                     outcome_name[o], r.nonfinite, (long long)r.warning[VD_SIM_WARN_SUBSTEP],
                      (long long)r.warning[VD_SIM_WARN_STRETCHED], r.max_disp, r.ke, r.seconds);
               fflush(stdout);
               if (csv) {
-                fprintf(csv, "%s,%g,%g,%g,%g,%d,%s,%d,%d,%s,%d", names[p], sigma[p], young, rho, dt, iters,
-                        s ? "gs" : "direct", n, r.steps_done, outcome_name[o], r.nonfinite);
-                for (int w = 0; w < VD_SIM_WARN_COUNT; w++) fprintf(csv, ",%lld", (long long)r.warning[w]);
-                fprintf(csv, ",%lld,%.6g,%.6g,%.3f\n", (long long)r.warnings, r.max_disp, r.ke, r.seconds);
+                fprintf(csv, "%s,%g,%g,%g,%g,%d,%s,%d,%d,%s,%d", names[p], sigma[p], young, rho, dt,
+                        iters, s ? "gs" : "direct", n, r.steps_done, outcome_name[o], r.nonfinite);
+                for (int w = 0; w < VD_SIM_WARN_COUNT; w++)
+                  fprintf(csv, ",%lld", (long long)r.warning[w]);
+                fprintf(csv, ",%lld,%.6g,%.6g,%.3f\n", (long long)r.warnings, r.max_disp, r.ke,
+                        r.seconds);
                 fflush(csv);
               }
             }
@@ -280,7 +311,8 @@ int main(int argc, char** argv) {
   }
   printf("%lld runs, %lld steps in %.0f s: %lld non-finite states\n  outcomes:", (long long)runs,
          (long long)steps_all, now() - t_all, (long long)nonfinite);
-  for (int o = 0; o < O_COUNT; o++) printf(" %s %lld", outcome_name[o], (long long)count[o]);
+  for (int o = 0; o < O_COUNT; o++)
+    printf(" %s %lld", outcome_name[o], (long long)count[o]);
   printf("\n  warnings:");
   for (int w = 0; w < VD_SIM_WARN_COUNT; w++)
     printf(" %s %lld", vd_sim_warning_name((vd_sim_warning)w), (long long)warn_all[w]);
@@ -288,7 +320,8 @@ int main(int argc, char** argv) {
   for (int s = 0; s < 2; s++) {
     if (!use_solver[s]) continue;
     printf("  %-6s", s ? "gs" : "direct");
-    for (int o = 0; o < O_COUNT; o++) printf(" %s %lld", outcome_name[o], (long long)by_solver[s][o]);
+    for (int o = 0; o < O_COUNT; o++)
+      printf(" %s %lld", outcome_name[o], (long long)by_solver[s][o]);
     printf("\n");
   }
   if (csv) fclose(csv);
