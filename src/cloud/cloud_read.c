@@ -340,7 +340,7 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
       cs.record += type_size[ty];
       cs.n++;
     } else {
-      return fail(r, t.line, "unknown header line '%s'", tok[0]);
+      return fail(r, t.line, "unknown header line '%.40s'", tok[0]);
     }
   }
   if (binary < 0) return fail(r, t.line, "no format line");
@@ -419,7 +419,7 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
       else if (k == 2 && !strcmp(tok[1], "binary")) binary = 1;
       else return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, t.line, 0, "PCD DATA '%s' is not supported (ascii or binary)", k > 1 ? tok[1] : "");
     } else if (strcmp(key, "VERSION") != 0 && strcmp(key, "WIDTH") != 0 && strcmp(key, "HEIGHT") != 0 && strcmp(key, "VIEWPOINT") != 0) {
-      return fail(r, t.line, "unknown header line '%s'", key);
+      return fail(r, t.line, "unknown header line '%.40s'", key);
     }
   }
   if (cs.n < 1 || nsize != cs.n || ntype != cs.n || (ncount >= 0 && ncount != cs.n))
