@@ -233,3 +233,23 @@ TEST(regress, strings_built_in_a_loop) {
   // the same string again is found, not added
   CHECK_INT(LSYS("Axiom:\n  for i in range(5000):\n    nproduce A('x' + 'y', str(i % 7))\n"), VD_OK);
 }
+
+// ---------------------------------------------------------------------------------------------
+// cloud readers
+
+// F10 (fuzz_cloud, UBSan signed overflow): an XYZ cloud naming a label with a large id gave the
+// label its organ colour through id * 37 in int arithmetic
+TEST(regress, large_label_id_colour) {
+  static const char xyz[] = "# 2 : leaf\n# label 63661737 flower\n0 0 0 63661737 1\n";
+  vd_cloud c;
+  vd_error err = {0};
+  vd_status st = vd_cloud_parse(xyz, sizeof xyz - 1, VD_CLOUD_XYZ, "regress.xyz", &c, &err);
+  if (st == VD_OK) vd_cloud_free(&c);
+  // every id a label can have gets a colour (the sanitizer build checks the arithmetic)
+  static const int ids[] = {0, 6, 7, 65535, 63661737, 2147483647};
+  for (int k = 0; k < 6; k++) {
+    vd_label l;
+    vd_label_init(&l, ids[k], "flower");
+    for (int j = 0; j < 3; j++) CHECK(l.rgb[j] >= 0 && l.rgb[j] <= 1);
+  }
+}

@@ -244,7 +244,7 @@ static void label_rgb(const vd_label* l, float rgb[3]) {
     vd_plant_default_rgb(l->id, rgb);
     return;
   }
-  float f = 0.8f + 0.4f * (float)((l->id * 37) % 10) / 10.0f;
+  float f = 0.8f + 0.4f * (float)(((uint32_t)l->id * 37u) % 10u) / 10.0f;  // unsigned: any id
   for (int k = 0; k < 3; k++) {
     float c = organ_rgb[l->organ][k] * f;
     rgb[k] = c > 1 ? 1 : c;
