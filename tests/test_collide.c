@@ -525,6 +525,13 @@ static void make_soup(soup* s, vd_rng* r, int ncap, int nsph) {
 
 static soup sp; // big: static storage
 
+// is j in i's excluded row?
+static int pair_excluded(const vd_collide_exclusion* ex, int i, int j) {
+  for (int e = ex->start[i]; e < ex->start[i + 1]; e++)
+    if (ex->exclude[e] == j) return 1;
+  return 0;
+}
+
 TEST(collide, broad_phase_equals_brute_force) {
   vd_rng r;
   vd_rng_seed(&r, 21);
@@ -614,6 +621,28 @@ TEST(collide, broad_phase_equals_brute_force) {
   CHECK(full.n > 20 && full.n == reused.n &&
         memcmp(full.c, reused.c, (size_t)full.n * sizeof *full.c) == 0);
   CHECK(reused.ntested < pairs.n); // the current boxes cull most candidates first
+  // primitives' own margins: pair i, j within def.margin + margin[i] + margin[j], as brute force
+  static double own[580];
+  for (int i = 0; i < n; i++)
+    own[i] = i % 50 == 0 ? 0.05 : vd_rng_uniform(&r, 0, 0.001);
+  p.margin = own;
+  vd_contact_list wide;
+  CHECK_STATUS(vd_collide_self(&p, &def, &arena, &wide, &err), VD_OK, err);
+  int nw = 0, wmatch = 1;
+  for (int i = 0; i < n; i++)
+    for (int j = i + 1; j < n; j++) {
+      vd_contact c;
+      if (skip[i] || skip[j] || pair_excluded(&ex, i, j) ||
+          !vd_collide_pair(&p, i, j, def.margin + own[i] + own[j], &c))
+        continue;
+      wmatch &= nw < wide.n && wide.c[nw].a == i && wide.c[nw].b == j;
+      nw++;
+    }
+  CHECK_INT(wide.n, nw);
+  CHECK(wmatch && nw > full.n);
+  own[3] = -1;
+  CHECK_STATUS(vd_collide_self(&p, &def, &arena, &wide, &err), VD_ERR_ARG, err);
+  p.margin = NULL;
   // a bad pair list is refused
   int bad[2] = {3, 3};
   vd_pair_list bl = {1, bad};

@@ -527,3 +527,60 @@ TEST(sim, self_collision_fold) {
   vd_sim_model_destroy(m);
   vd_model_destroy(pm);
 }
+
+// a dense canopy: k x k parallel rods of length len along x, spacing apart in y and z
+static vd_model* comb(int k, double len, double apart, double r) {
+  vd_plant_spec* s = vd_plant_spec_create();
+  vd_segment_spec g = vd_segment_spec_default();
+  g.r0 = g.r1 = r, g.label = 1, g.up = vd_v3(0, 0, 1);
+  for (int i = 0; i < k * k; i++) {
+    double y = apart * (i % k), z = apart * (i / k);
+    int a = vd_plant_add_node(s, vd_v3(-0.01, y, z)), b = vd_plant_add_node(s, vd_v3(0, y, z));
+    int c = vd_plant_add_node(s, vd_v3(len, y, z));
+    g.node0 = a, g.node1 = b, g.parent = -1, g.instance = 2 * i + 1;
+    int s0 = vd_plant_add_segment(s, &g);
+    g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2 * i + 2;
+    vd_plant_add_segment(s, &g);
+  }
+  vd_plant_set_label(s, 1, "stem");
+  vd_model* m = NULL;
+  vd_error e = {0};
+  vd_plant_compile(s, &m, &e);
+  vd_plant_spec_destroy(s);
+  return m;
+}
+
+TEST(sim, self_collision_pairs_linear) {
+  // one node flung fast in a dense canopy widens its own search only: the broad phase's pairs
+  // per primitive stay bounded (a margin set by the fastest node for every primitive made the
+  // pairs, contacts and the memory holding them grow as the square of the plant)
+  int most[2] = {0, 0}, nprim[2] = {0, 0};
+  for (int size = 0; size < 2; size++) {
+    vd_model* pm = comb(size ? 8 : 4, 0.4, 0.012, 0.003);
+    REQUIRE(pm);
+    vd_sim_def def = cantilever_def(0.02, 5e7, 1000);
+    vd_sim_model* m = NULL;
+    vd_error e = {0};
+    REQUIRE(vd_sim_build(pm, &def, &m, &e) == VD_OK);
+    m->opt.self_collision = 1;
+    m->opt.contacts = 1;
+    vd_sim_data* d = vd_sim_data_create(m);
+    REQUIRE(d);
+    const sim_work* w = (const sim_work*)d->work;
+    nprim[size] = w->self.ncap + w->self.nsph;
+    for (int k = 0; k < 5; k++) {
+      // the last rod's tip at 40 m/s: 4 cm a step
+      d->node_vel[m->nnode - 1] = vd_v3(0, 0, 40);
+      vd_sim_step(m, d);
+      if (w->self.pairs.n > most[size]) most[size] = w->self.pairs.n;
+    }
+    CHECK_INT(d->warning[VD_SIM_WARN_ARENA], 0);
+    vd_sim_data_destroy(d);
+    vd_sim_model_destroy(m);
+    vd_model_destroy(pm);
+  }
+  // measured: 2811 pairs for 336 primitives, 13233 for 1344 (a global margin: 38824, 629920)
+  CHECK(nprim[1] >= 4 * nprim[0] - 8);
+  CHECK(most[1] < 12 * nprim[1]);               // pairs per primitive bounded
+  CHECK(most[1] < 6 * (most[0] > 0 ? most[0] : 1)); // 4x the rods, not 16x the pairs
+}

@@ -160,6 +160,11 @@ typedef struct vd_collide_prims {
   const double* sphere_radius;  // sphere radii (m) (nsphere x 1)
   const int* skip;              // Nullable: non-zero leaves a primitive out (a broken segment)
                                 // ((ncapsule + nsphere) x 1)
+  const double* margin;         // Nullable: extra margin of each primitive (m): pair i, j is
+                                // reported closer than def.margin + margin[i] + margin[j], a
+                                // collider contact closer than def.margin + margin[i]; boxes grow
+                                // by it (a fast primitive's own reach, not everyone's)
+                                // ((ncapsule + nsphere) x 1)
   const int* exclude_start;     // Nullable: row starts of the excluded-pair adjacency (CSR):
                                 // primitive i never meets exclude[exclude_start[i] ..
                                 // exclude_start[i+1]) ((ncapsule + nsphere + 1) x 1)
@@ -240,9 +245,10 @@ typedef struct vd_pair_list {
   int* pair; // primitive pairs (a < b), ascending by (a, b) (n x 2), in an arena
 } vd_pair_list;
 
-// The broad phase alone: pairs (not excluded, not skipped) whose boxes, grown by `grow` (m),
-// overlap. While no primitive moves more than (grow - margin) / 2, every contact within margin
-// is among them: build them every few steps into an arena kept until the next build.
+// The broad phase alone: pairs (not excluded, not skipped) whose boxes, grown by grow / 2 +
+// prims->margin[i] each (m), overlap. While no primitive moves more than (grow - margin) / 2 plus
+// the drop of its own margin since the build, every contact within margin is among them: build
+// them every few steps into an arena kept until the next build. The list takes 8 bytes a pair.
 vd_status vd_collide_self_pairs(const vd_collide_prims* prims, double grow, vd_arena* arena,
                                 vd_pair_list* out, vd_error* err);
 // The narrow phase over given pairs: their contacts within def.margin, sorted by (a, b).

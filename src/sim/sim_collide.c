@@ -533,6 +533,9 @@ static int cbuf_push(vd_arena* ar, cbuf* b, const vd_contact* c) {
   return 1;
 }
 
+// primitive i's own extra margin (m)
+static double prim_margin(const vd_collide_prims* P, int i) { return P->margin ? P->margin[i] : 0; }
+
 // bounding box of primitive i, grown by g on every side
 static void prim_bounds(const vd_collide_prims* P, int i, double g, vd_vec3* lo, vd_vec3* hi) {
   if (i < P->ncapsule) {
@@ -582,6 +585,10 @@ static vd_status check_prims(const vd_collide_prims* P, const vd_collide_def* de
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
                         "collide: the exclusion has %d rows for %d primitives", P->exclude_rows,
                         P->ncapsule + P->nsphere);
+  for (int i = 0; P->margin && i < P->ncapsule + P->nsphere; i++)
+    if (!(P->margin[i] >= 0 && isfinite(P->margin[i])))
+      return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: primitive %d: margin must be >= 0 m",
+                          i);
   if (def && !(def->margin >= 0 && isfinite(def->margin)))
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: margin must be >= 0 m");
   if (def && def->max_contacts < 0)
@@ -687,7 +694,7 @@ static vd_status broad_phase(const vd_collide_prims* P, double grow, vd_arena* a
   vd_vec3 cmin = vd_v3(HUGE_VAL, HUGE_VAL, HUGE_VAL), cmax = vd_scale(cmin, -1);
   for (int i = 0; i < n; i++) {
     if (P->skip && P->skip[i]) continue;
-    prim_bounds(P, i, 0.5 * grow, &lo[i], &hi[i]);
+    prim_bounds(P, i, 0.5 * grow + prim_margin(P, i), &lo[i], &hi[i]);
     vd_vec3 c = vd_scale(vd_add(lo[i], hi[i]), 0.5);
     cmin = vd_vmin(cmin, c), cmax = vd_vmax(cmax, c);
     key[m++].v = i;
@@ -725,16 +732,17 @@ static vd_status narrow_phase(const vd_collide_prims* P, const int* pair, int np
   for (int k = 0; k < npair; k++) {
     int a = pair[2 * k], b = pair[2 * k + 1];
     if (P->skip && (P->skip[a] || P->skip[b])) continue;
+    double ea = prim_margin(P, a), eb = prim_margin(P, b);
     if (boxes) {
       vd_vec3 la, ha, lb, hb;
-      prim_bounds(P, a, 0.5 * def->margin, &la, &ha);
-      prim_bounds(P, b, 0.5 * def->margin, &lb, &hb);
+      prim_bounds(P, a, 0.5 * def->margin + ea, &la, &ha);
+      prim_bounds(P, b, 0.5 * def->margin + eb, &lb, &hb);
       if (la.x > hb.x || lb.x > ha.x || la.y > hb.y || lb.y > ha.y || la.z > hb.z || lb.z > ha.z)
         continue;
     }
     out->ntested++;  // NOLINT(clang-analyzer-core.uninitialized.Assign): check_prims zeroes *out
     vd_contact c;
-    if (!vd_collide_pair(P, a, b, def->margin, &c)) continue;
+    if (!vd_collide_pair(P, a, b, def->margin + ea + eb, &c)) continue;
     if (buf.n >= def->max_contacts) {
       out->ndropped++;
       continue;
@@ -771,19 +779,27 @@ vd_status vd_collide_self_pairs(const vd_collide_prims* P, double grow, vd_arena
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "collide: grow must be >= 0 m");
   pbuf pairs;
   if ((st = broad_phase(P, grow, arena, &pairs, err))) return st;
-  // ascending (a, b)
+  // ascending (a, b): two stable counting sorts, by b then by a, back into the sweep's buffer
+  // (primitive indices are small integers; 8 bytes a pair of scratch, no 64-bit keys)
   if (pairs.n > 1) {
-    rkey* k = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *k);
-    rkey* tmp = vd_arena_alloc(arena, (size_t)pairs.n * sizeof *tmp);
-    int* sorted = vd_arena_alloc(arena, (size_t)pairs.n * 2 * sizeof *sorted);
-    if (!k || !tmp || !sorted)
+    int n = P->ncapsule + P->nsphere;
+    int* tmp = vd_arena_alloc(arena, (size_t)pairs.n * 2 * sizeof *tmp);
+    int* cnt = vd_arena_alloc(arena, ((size_t)n + 1) * sizeof *cnt);
+    if (!tmp || !cnt)
       return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
-    for (int i = 0; i < pairs.n; i++)
-      k[i].k = (uint64_t)(uint32_t)pairs.p[2 * i] << 32 | (uint32_t)pairs.p[2 * i + 1], k[i].v = i;
-    rkey* s = sort_keys(k, tmp, pairs.n);
-    for (int i = 0; i < pairs.n; i++)
-      sorted[2 * i] = pairs.p[2 * s[i].v], sorted[2 * i + 1] = pairs.p[2 * s[i].v + 1];
-    pairs.p = sorted;
+    for (int pass = 1; pass >= 0; pass--) {
+      const int* src = pass ? pairs.p : tmp;
+      int* dst = pass ? tmp : pairs.p;
+      memset(cnt, 0, ((size_t)n + 1) * sizeof *cnt);
+      for (int i = 0; i < pairs.n; i++)
+        cnt[src[2 * i + pass] + 1]++;
+      for (int v = 0; v < n; v++)
+        cnt[v + 1] += cnt[v];
+      for (int i = 0; i < pairs.n; i++) {
+        int o = cnt[src[2 * i + pass]]++;
+        dst[2 * o] = src[2 * i], dst[2 * o + 1] = src[2 * i + 1];
+      }
+    }
   }
   out->n = pairs.n;
   out->pair = pairs.p;
@@ -825,7 +841,7 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
   if (!plo || !phi)
     return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "collide: arena out of memory");
   for (int i = 0; i < n; i++)
-    prim_bounds(P, i, def.margin, &plo[i], &phi[i]);
+    prim_bounds(P, i, def.margin + prim_margin(P, i), &plo[i], &phi[i]);
   cbuf buf = {NULL, 0, 0};
   for (int k = 0; k < ncol; k++) {
     const vd_collider* c = &col[k];
@@ -855,7 +871,8 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
                lip = c->shape == VD_SHAPE_SDF ? 1.7320508075688772 : 1;
         double sd_mid = shape_sd(c, f_local(&f, vd_scale(vd_add(a0, a1), 0.5)), &nm);
         double slack = c->shape == VD_SHAPE_SDF ? 0.1 * c->sdf->cell : 0; // swept values' error
-        if (sd_mid - lip * half - (r0 > r1 ? r0 : r1) - slack >= def.margin) continue;
+        if (sd_mid - lip * half - (r0 > r1 ? r0 : r1) - slack >= def.margin + prim_margin(P, i))
+          continue;
         h = capsule_query(c, &f, a0, a1, r0, r1);
         ct.ta = h.t;
         ct.pa = vd_madd(vd_madd(a0, vd_sub(a1, a0), h.t), h.normal, -(r0 + h.t * (r1 - r0)));
@@ -865,7 +882,7 @@ vd_status vd_collide_colliders(const vd_collide_prims* P, const vd_collider* col
         h = sphere_query(c, &f, ci, ri);
         ct.pa = vd_madd(ci, h.normal, -ri);
       }
-      if (!(h.dist < def.margin)) continue;
+      if (!(h.dist < def.margin + prim_margin(P, i))) continue;
       ct.dist = h.dist;
       ct.normal = h.normal;
       ct.pb = h.point;

@@ -141,8 +141,12 @@ typedef struct sim_self {
   double* sph_pos;           // sphere centres, refreshed each step (m) (nsph x 3)
   double* sph_radius;        // sphere radii (m) (nsph)
   vd_collide_exclusion ex;   // neighbours and pairs touching in the modelled shape
-  // candidate pairs reused over steps (a Verlet list): valid while no node has moved more than
-  // (grow - margin) / 2 from pos_built and no joint has broken since
+  // each primitive's own margin: twice the step's largest displacement of its nodes, so one fast
+  // node widens its own search, not the whole plant's (a global margin made the pairs O(n^2))
+  double* margin;            // this step's (m) (ncap + nsph)
+  double* margin_built;      // at the last build (m) (ncap + nsph)
+  // candidate pairs reused over steps (a Verlet list): valid while no primitive has moved more
+  // than (grow - margin) / 2 + margin_built - margin from pos_built and no joint has broken since
   vd_arena pair_arena;       // holds pairs
   vd_pair_list pairs;        // broad-phase pairs of the last build
   vd_vec3* pos_built;        // node positions at that build (m) (nnode_all)
@@ -243,8 +247,9 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
 vd_status sim_self_init(const vd_sim_model* m, sim_self* s, vd_error* err);
 // Free them (a zeroed one is fine).
 void sim_self_free(sim_self* s);
-// Append the self-contacts within margin (m) at the current state to the nprev contacts in prev;
-// *out gets the joined list (in the arena). Returns the new count.
+// Append the self-contacts at the current state to the nprev contacts in prev: pairs closer than
+// margin (m) plus twice the step's displacement (from node_prev) of each one's nodes; *out gets
+// the joined list (in the arena). Returns the new count.
 int sim_self_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_contact* prev, int nprev,
                   sim_contact** out);
 // Project contacts: push penetrating rod elements out of the colliders (compliance 0).

@@ -44,6 +44,7 @@ static vd_collide_prims self_prims(const vd_sim_model* m, const vd_vec3* pos, co
   p.node_pos = &pos[0].x;
   p.capsule_node = s->cap_node, p.capsule_radius = s->cap_radius;
   p.sphere_pos = s->sph_pos, p.sphere_radius = s->sph_radius;
+  p.margin = s->margin;
   return p;
 }
 
@@ -54,7 +55,9 @@ vd_status sim_self_init(const vd_sim_model* m, sim_self* s, vd_error* err) {
   for (int i = 0; i < m->nnode; i++) nsp += m->node_sphere[i] > 0 && m->node_owner[i] >= 0;
   size_t I = sizeof(int), D = sizeof(double);
   size_t nca = nc ? (size_t)nc : 1, nsa = nsp ? (size_t)nsp : 1;
-  s->nbytes = (size_t)m->nnode_all * sizeof(vd_vec3) + nca * 3 * I + nca * 2 * D + nsa * I + nsa * 4 * D;
+  size_t npa = nca + nsa;
+  s->nbytes = (size_t)m->nnode_all * sizeof(vd_vec3) + nca * 3 * I + nca * 2 * D + nsa * I + nsa * 4 * D +
+              npa * 2 * D;
   s->block = vd_malloc(s->nbytes);
   if (!s->block) {
     s->nbytes = 0;
@@ -66,6 +69,8 @@ vd_status sim_self_init(const vd_sim_model* m, sim_self* s, vd_error* err) {
   s->cap_radius = dp, dp += nca * 2;
   s->sph_pos = dp, dp += nsa * 3;
   s->sph_radius = dp, dp += nsa;
+  s->margin = dp, dp += npa;
+  s->margin_built = dp, dp += npa;
   int* ip = (int*)dp;
   s->cap_node = ip, ip += nca * 2;
   s->cap_seg = ip, ip += nca;
@@ -83,8 +88,10 @@ vd_status sim_self_init(const vd_sim_model* m, sim_self* s, vd_error* err) {
       s->sph_radius[k] = m->node_sphere[i];
       k++;
     }
-  // exclusion: neighbours along the rods, then whatever touches in the modelled shape
+  // exclusion: neighbours along the rods, then whatever touches in the modelled shape (at rest:
+  // no margins of their own)
   self_fill(m, NULL, m->node_pos0, s);
+  memset(s->margin, 0, npa * D);
   vd_status st = vd_collide_exclusion_build(m->nnode_all, nc, s->cap_node, nsp, s->sph_node, SIM_SELF_HOPS,
                                             &s->ex, err);
   if (!st) {
@@ -108,36 +115,61 @@ int sim_self_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_cont
   vd_collide_prims_set_exclusion(&p, &s->ex);
   vd_collide_def def = vd_collide_def_default();
   def.margin = margin;
-  // broad phase again when a node may have moved past the growth of the boxes, or after a fracture
-  double lim = 0.5 * (s->grow - margin), lim2 = lim * lim;
-  int rebuild = !s->have_pairs || lim <= 0 || s->nevent_built != d->nevent;
-  for (int i = 0; i < m->nnode_all && !rebuild; i++) {
-    vd_vec3 e = vd_sub(d->node_pos[i], s->pos_built[i]);
-    rebuild = vd_dot(e, e) > lim2;
+  // each primitive's own margin: twice the step's largest displacement of its nodes (two
+  // elements closing at once each bring their own); and how far it moved since the build
+  int np = s->ncap + s->nsph;
+  const vd_vec3* start = w->node_prev;
+  double* moved = vd_arena_alloc(&d->arena, (size_t)np * sizeof *moved);
+  if (!moved) {
+    sim_warn(d, VD_SIM_WARN_ARENA);
+    return nprev;
   }
+  for (int k = 0; k < np; k++) {
+    int nd[2];
+    if (k < s->ncap)
+      nd[0] = s->cap_node[2 * k], nd[1] = s->cap_node[2 * k + 1];
+    else
+      nd[0] = nd[1] = s->sph_node[k - s->ncap];
+    double step2 = 0, built2 = 0;
+    for (int e = 0; e < 2; e++) {
+      vd_vec3 u = vd_sub(d->node_pos[nd[e]], start[nd[e]]), b = vd_sub(d->node_pos[nd[e]], s->pos_built[nd[e]]);
+      step2 = fmax(step2, vd_dot(u, u)), built2 = fmax(built2, vd_dot(b, b));
+    }
+    s->margin[k] = 2 * sqrt(step2);
+    moved[k] = sqrt(built2);
+  }
+  // broad phase again when a primitive may have moved past the growth of its box (its margin's
+  // drop since the build counts in its favour), or after a fracture
+  double lim = 0.5 * (s->grow - margin);
+  int rebuild = !s->have_pairs || lim <= 0 || s->nevent_built != d->nevent;
+  for (int k = 0; k < np && !rebuild; k++)
+    rebuild = moved[k] + s->margin[k] > lim + s->margin_built[k];
   vd_error err;
   if (rebuild) {
     vd_arena_reset(&s->pair_arena);
     s->grow = margin + SIM_SELF_GROW;
     s->have_pairs = 0;
     if (vd_collide_self_pairs(&p, s->grow, &s->pair_arena, &s->pairs, &err)) {
-      d->nwarning++;
+      sim_warn(d, VD_SIM_WARN_ARENA);
       return nprev;
     }
     memcpy(s->pos_built, d->node_pos, (size_t)m->nnode_all * sizeof(vd_vec3));
+    memcpy(s->margin_built, s->margin, (size_t)np * sizeof *s->margin);
     s->have_pairs = 1;
     s->nevent_built = d->nevent;
   }
   // narrow phase over the kept pairs
   vd_contact_list L;
   if (vd_collide_pairs(&p, &s->pairs, &def, &d->arena, &L, &err)) {
-    d->nwarning++;
+    sim_warn(d, VD_SIM_WARN_ARENA);
     return nprev;
   }
+  // contacts beyond the list's cap are a counted warning, never a silent drop
+  if (L.ndropped) sim_warn(d, VD_SIM_WARN_ARENA);
   if (!L.n) return nprev;
   sim_contact* c = vd_arena_alloc(&d->arena, (size_t)(nprev + L.n) * sizeof(sim_contact));
   if (!c) {
-    d->nwarning++;
+    sim_warn(d, VD_SIM_WARN_ARENA);
     return nprev;
   }
   if (nprev) memcpy(c, prev, (size_t)nprev * sizeof(sim_contact));

@@ -190,8 +190,8 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
         if (s > vmax) vmax = s;
       }
     if (d->ncollider) c.ncontact = sim_contacts_find(m, d, 2 * vmax + 0.005, &c.contacts);
-    // self-contacts: both elements move, so twice the margin
-    if (m->opt.self_collision) c.ncontact = sim_self_find(m, d, 4 * vmax + 0.002, c.contacts, c.ncontact, &c.contacts);
+    // self-contacts: each primitive reaches twice its own nodes' displacement (sim_self.c)
+    if (m->opt.self_collision) c.ncontact = sim_self_find(m, d, 0.002, c.contacts, c.ncontact, &c.contacts);
   }
   // constraints
   // statics needs the primal residual that only the direct solver keeps
