@@ -174,7 +174,7 @@ typedef struct vd_sim_model {
   // nodes (nnode_all; spare nodes after the first nnode)
   vd_vec3* node_pos0;     // modelled position (m)
   double* node_mass;      // lumped mass (kg)
-  double* node_radius;    // contact sphere radius (m)
+  double* node_radius;    // largest radius of its segments or its sphere (m), Stokes drag
   int* node_owner;        // segment that ends at the node, -1 for fixed root nodes and spares
   int* node_fixed;        // 1 when the node is kinematic
   double* node_sphere;    // drag sphere radius at the node, 0 if none (m)

@@ -988,7 +988,8 @@ static void case_contacts(vctx* v) {
     char name[64];
     snprintf(name, sizeof name, "no_penetration_%s", k == 0 ? "ground" : k == 1 ? "sphere" : k == 2 ? "box" : "mesh");
     check(v, name, "continuum", "deepest penetration (m)", maxpen, 0, 1e-4, 1,
-          "cantilever of capsules against a %s (signed distance), 1 s, h = 1 ms%s", what[k], touched ? "" : " [no contact]");
+          "cantilever of %s against a %s (signed distance), 1 s, h = 1 ms%s",
+          k ? "capsules" : "flat-ended cylinders", what[k], touched ? "" : " [no contact]");
     built_free(&b);
   }
   vd_sdf_destroy(sdf);
