@@ -161,6 +161,8 @@ typedef struct vd_solid {
   int prim;            // index of the primitive within its kind
   int label, instance; // semantic label and organ instance
   int slices, stacks;  // polygon sides (frustum, sphere longitudes) and sphere latitude bands
+  double cos_half;     // cos(pi / slices): inscribed over circumscribed radius of the polygon
+  double cos_stack;    // sphere: cos(pi / (2 stacks)), the latitude chords' inner reach
   int joined[2];       // solids of a generalised-cylinder tube sharing a ring with this one
                        // (parent side, child side), -1 when none
   vd_vec3 c;           // frustum start centre or sphere centre (m)

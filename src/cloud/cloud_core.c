@@ -1,6 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Cloud basics: settings with their defaults, the one-block point arrays, relabelling by
 // instance.
+#if defined(__linux__)
+#define _DEFAULT_SOURCE  // madvise
+#include <sys/mman.h>
+#endif
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,6 +49,19 @@ vd_cloud_def vd_cloud_def_default(void) {
 // bytes of the point block for n points: pos, normal, range (doubles), label, instance, view
 static size_t block_size(int64_t n) { return (size_t)n * (7 * sizeof(double) + 3 * sizeof(int)); }
 
+// ask for transparent huge pages over a large block: its first touch then faults once per 2 MiB
+// instead of once per 4 KiB (1M points: 68 MB, 17,000 faults). Advice only; nothing changes
+// where the kernel or the allocator says no.
+static void advise_huge(void* block, size_t nbytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  const uintptr_t huge = (uintptr_t)2 << 20;
+  uintptr_t a = ((uintptr_t)block + huge - 1) & ~(huge - 1), b = ((uintptr_t)block + nbytes) & ~(huge - 1);
+  if (b > a) (void)madvise((void*)a, (size_t)(b - a), MADV_HUGEPAGE);
+#else
+  (void)block, (void)nbytes;
+#endif
+}
+
 vd_status cloud_alloc(vd_cloud* c, int64_t n, const vd_label* labels, int nlabel, int zero,
                       vd_error* err) {
   if (!c) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "cloud: null output");
@@ -62,6 +80,7 @@ vd_status cloud_alloc(vd_cloud* c, int64_t n, const vd_label* labels, int nlabel
     return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory for %lld points",
                         (long long)n);
   }
+  if (nbytes >= (size_t)4 << 20) advise_huge(block, nbytes);
   if (nbytes && zero) memset(block, 0, nbytes);
   if (nlabel) memcpy(lt, labels, (size_t)nlabel * sizeof(vd_label));
   c->n = n;

@@ -123,6 +123,7 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
     s->len = vd_dot(vd_sub(c1, c0), axis);
     s->r0 = m->seg_radius[2 * i], s->r1 = m->seg_radius[2 * i + 1];
     s->slices = geom_seg_slices(m, md.slices, i);
+    s->cos_half = cos(VD_PI / s->slices);
     box_disc(s, c0, axis, s->r0, eps);
     box_disc(s, c1, axis, s->r1, eps);
   }
@@ -141,6 +142,8 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
     s->r0 = s->r1 = m->sphere_radius[i];
     s->slices = md.slices > 0 ? md.slices : m->sphere_slices[i];
     s->stacks = md.sphere_stacks > 0 ? md.sphere_stacks : (s->slices / 2 < 2 ? 2 : s->slices / 2);
+    s->cos_half = cos(VD_PI / s->slices);
+    s->cos_stack = cos(VD_PI / (2.0 * s->stacks));
     box_point(s, vd_sub(s->c, vd_v3(s->r0, s->r0, s->r0)), eps);
     box_point(s, vd_add(s->c, vd_v3(s->r0, s->r0, s->r0)), eps);
   }
@@ -206,7 +209,7 @@ static int in_frustum(const vd_solid* s, vd_vec3 p, double eps) {
   double rho2 = v.x * v.x + v.y * v.y;
   // outside the circumscribed circle, inside the inscribed one, else the polygon's side
   if (rho2 > (rz + eps) * (rz + eps)) return 0;
-  double half = VD_PI / s->slices, ri = rz * cos(half);
+  double half = VD_PI / s->slices, ri = rz * s->cos_half;
   if (rho2 <= ri * ri) return 1;
   int k = sector(v.y, v.x, s->slices);
   double tm = (2 * k + 1) * half;
@@ -220,8 +223,8 @@ static int in_sphere(const vd_solid* s, vd_vec3 p, double eps) {
   vd_vec3 v = vd_sub(p, s->c);
   double r = s->r0, d2 = vd_dot(v, v);
   if (d2 > (r + eps) * (r + eps)) return 0;
-  double half = VD_PI / s->slices, ch = cos(half);
-  double ri = r * ch * cos(VD_PI / (2.0 * s->stacks));
+  double half = VD_PI / s->slices, ch = s->cos_half;
+  double ri = r * ch * s->cos_stack;
   if (d2 <= ri * ri) return 1;
   int k = sector(v.y, v.x, s->slices);
   double tm = (2 * k + 1) * half;
