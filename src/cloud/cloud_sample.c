@@ -344,10 +344,16 @@ static vd_status build_candidates(sampler* s, vd_error* err) {
   return VD_OK;
 }
 
-// inside a candidate solid of a triangle
+// inside a candidate solid of a triangle. Nine tests in ten end at the solid's box: that test is
+// made here, inline, and the full one (which repeats it) only for points inside the box.
 static inline int inside_cand(const sampler* s, const stri* r, vd_vec3 p) {
-  for (int i = r->cand0; i < r->cand1; i++)
+  for (int i = r->cand0; i < r->cand1; i++) {
+    const vd_solid* sd = &s->so.solid[s->cand[i]];
+    if (p.x < sd->lo[0] || p.x > sd->hi[0] || p.y < sd->lo[1] || p.y > sd->hi[1] || p.z < sd->lo[2] ||
+        p.z > sd->hi[2])
+      continue;
     if (vd_solid_contains(&s->so, s->cand[i], p)) return 1;
+  }
   return 0;
 }
 
