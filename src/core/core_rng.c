@@ -61,29 +61,35 @@ void vd_rng_stream(vd_rng* r, uint64_t master, uint64_t index) {
   vd_rng_seed_array(r, key, 5);
 }
 
-static inline uint32_t next_u32(vd_rng* r) {
-  static const uint32_t mag01[2] = {0u, 0x9908b0dfu};
-  if (r->mti >= MT_N) {
-    int kk;
-    uint32_t y;
-    for (kk = 0; kk < MT_N - MT_M; kk++) {
-      y = (r->mt[kk] & 0x80000000u) | (r->mt[kk + 1] & 0x7fffffffu);
-      r->mt[kk] = r->mt[kk + MT_M] ^ (y >> 1) ^ mag01[y & 1u];
-    }
-    for (; kk < MT_N - 1; kk++) {
-      y = (r->mt[kk] & 0x80000000u) | (r->mt[kk + 1] & 0x7fffffffu);
-      r->mt[kk] = r->mt[kk + (MT_M - MT_N)] ^ (y >> 1) ^ mag01[y & 1u];
-    }
-    y = (r->mt[MT_N - 1] & 0x80000000u) | (r->mt[0] & 0x7fffffffu);
-    r->mt[MT_N - 1] = r->mt[MT_M - 1] ^ (y >> 1) ^ mag01[y & 1u];
-    r->mti = 0;
+// the next 624 words of the state at once (the matrix's lowest bit picks 0x9908b0df, branch-free)
+static void twist(vd_rng* r) {
+  uint32_t* mt = r->mt;
+  int kk;
+  uint32_t y;
+  for (kk = 0; kk < MT_N - MT_M; kk++) {
+    y = (mt[kk] & 0x80000000u) | (mt[kk + 1] & 0x7fffffffu);
+    mt[kk] = mt[kk + MT_M] ^ (y >> 1) ^ (-(y & 1u) & 0x9908b0dfu);
   }
-  uint32_t y = r->mt[r->mti++];
+  for (; kk < MT_N - 1; kk++) {
+    y = (mt[kk] & 0x80000000u) | (mt[kk + 1] & 0x7fffffffu);
+    mt[kk] = mt[kk + (MT_M - MT_N)] ^ (y >> 1) ^ (-(y & 1u) & 0x9908b0dfu);
+  }
+  y = (mt[MT_N - 1] & 0x80000000u) | (mt[0] & 0x7fffffffu);
+  mt[MT_N - 1] = mt[MT_M - 1] ^ (y >> 1) ^ (-(y & 1u) & 0x9908b0dfu);
+  r->mti = 0;
+}
+
+static inline uint32_t temper(uint32_t y) {
   y ^= (y >> 11);
   y ^= (y << 7) & 0x9d2c5680u;
   y ^= (y << 15) & 0xefc60000u;
   y ^= (y >> 18);
   return y;
+}
+
+static inline uint32_t next_u32(vd_rng* r) {
+  if (r->mti >= MT_N) twist(r);
+  return temper(r->mt[r->mti++]);
 }
 
 uint32_t vd_rng_u32(vd_rng* r) { return next_u32(r); }
@@ -94,9 +100,24 @@ double vd_rng_random(vd_rng* r) {
 }
 
 void vd_rng_fill(vd_rng* r, double* out, int n) {
-  for (int i = 0; i < n; i++) {
-    uint32_t a = next_u32(r) >> 5, b = next_u32(r) >> 6;
-    out[i] = (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+  int i = 0;
+  while (i < n) {
+    // whole pairs of words left in the state: one tight loop without the refill check
+    if (r->mti >= MT_N) twist(r);
+    int m = (MT_N - r->mti) / 2;
+    if (m > n - i) m = n - i;
+    const uint32_t* w = r->mt + r->mti;
+    for (int k = 0; k < m; k++) {
+      uint32_t a = temper(w[2 * k]) >> 5, b = temper(w[2 * k + 1]) >> 6;
+      out[i + k] = (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+    }
+    r->mti += 2 * m;
+    i += m;
+    // a pair straddling a refill
+    if (m == 0 && i < n) {
+      uint32_t a = next_u32(r) >> 5, b = next_u32(r) >> 6;
+      out[i++] = (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+    }
   }
 }
 
