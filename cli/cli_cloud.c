@@ -309,6 +309,7 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
              co->def.sensor == VD_SENSOR_UNIFORM ? "uniform" : co->def.sensor == VD_SENSOR_DISTANCE ? "distance" : "scan",
              co->labels_instance ? "instance" : "semantic");
     wd.comment = comment;
+    wd.threads = co->def.threads;
     int w = cli_watch(out);
     st = vd_cloud_write(&cloud, out, &wd, err);
     cli_unwatch(w);

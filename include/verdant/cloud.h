@@ -175,9 +175,11 @@ typedef struct vd_cloud_write_def {
                           // ("scalar_" for CloudCompare) (Nullable: none); default NULL
   const char* comment;    // one line recorded in the header where the format allows it
                           // (Nullable); default NULL
+  int threads;            // threads converting binary records, 0 = all cores; the bytes do not
+                          // depend on it; default 0
 } vd_cloud_write_def;
 
-// Defaults: format from the extension, binary, no property prefix, no comment.
+// Defaults: format from the extension, binary, no property prefix, no comment, all cores.
 vd_cloud_write_def vd_cloud_write_def_default(void);
 // Format for a path's extension (VD_CLOUD_AUTO when unknown).
 vd_cloud_format vd_cloud_format_of(const char* path);

@@ -5,6 +5,9 @@
 // and is written under a temporary name, renamed when complete.
 #include <math.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "cloud_internal.h"
 
@@ -15,6 +18,7 @@ vd_cloud_write_def vd_cloud_write_def_default(void) {
   def.ascii = 0;
   def.ply_prefix = NULL;
   def.comment = NULL;
+  def.threads = 0;
   return def;
 }
 
@@ -44,7 +48,7 @@ vd_cloud_format vd_cloud_format_of(const char* path) {
 
 typedef struct wbuf {
   FILE* fp;
-  unsigned char data[1 << 16];
+  unsigned char data[1 << 19];
   size_t n;
 } wbuf;
 
@@ -116,6 +120,26 @@ static void put_record(unsigned char* r, const vd_cloud* c, int64_t i, int views
   }
 }
 
+// the binary PLY/PCD records, a buffer at a time; large buffers are filled by several threads
+// (each record is converted alone, so the bytes do not depend on the thread count)
+static void write_records(FILE* fp, const vd_cloud* c, int views, wbuf* wb, int threads) {
+  int64_t rec = views ? 40 : 32, per = (int64_t)sizeof wb->data / rec;
+  int le = host_le();
+#ifdef _OPENMP
+  if (threads <= 0) threads = omp_get_max_threads();
+#else
+  (void)threads;
+#endif
+  for (int64_t a = 0; a < c->n; a += per) {
+    int64_t b = a + per < c->n ? a + per : c->n;
+    unsigned char* data = wb->data;
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && b - a >= 8192)
+    for (int64_t i = a; i < b; i++)
+      put_record(data + (i - a) * rec, c, i, views, le);
+    fwrite(data, (size_t)rec, (size_t)(b - a), fp);
+  }
+}
+
 // a string into a fixed field of cap bytes, cut, NUL-padded (the field is zeroed before)
 static void put_str(unsigned char* p, const char* str, size_t cap) {
   size_t n = strlen(str);
@@ -173,12 +197,7 @@ static void write_ply(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def
     }
     return;
   }
-  wb->fp = fp, wb->n = 0;
-  size_t rec = views ? 40 : 32;
-  int le = host_le();
-  for (int64_t i = 0; i < c->n; i++)
-    put_record(wb_take(wb, rec), c, i, views, le);
-  wb_flush(wb);
+  write_records(fp, c, views, wb, def->threads);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -205,12 +224,7 @@ static void write_pcd(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def
     }
     return;
   }
-  wb->fp = fp, wb->n = 0;
-  size_t rec = views ? 40 : 32;
-  int le = host_le();
-  for (int64_t i = 0; i < c->n; i++)
-    put_record(wb_take(wb, rec), c, i, views, le);
-  wb_flush(wb);
+  write_records(fp, c, views, wb, def->threads);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -389,7 +403,7 @@ vd_status vd_cloud_write(const vd_cloud* c, const char* path, const vd_cloud_wri
                             "PLY property prefix '%s': letters, digits and '_' only", def.ply_prefix);
     if (strlen(def.ply_prefix) > 32) return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "PLY property prefix too long");
   }
-  // a 64 KiB record buffer for the binary formats, then the file under a temporary name
+  // a 512 KiB record buffer for the binary formats, then the file under a temporary name
   wbuf* wb = vd_malloc(sizeof *wb);
   if (!wb) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory writing a cloud");
   vd_outfile f;
