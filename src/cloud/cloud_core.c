@@ -72,7 +72,7 @@ vd_status cloud_alloc(vd_cloud* c, int64_t n, const vd_label* labels, int nlabel
   if (nlabel < 0 || (nlabel > 0 && !labels))
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "cloud: bad label table");
   size_t nbytes = block_size(n);
-  char* block = nbytes ? vd_malloc(nbytes) : NULL;
+  char* block = nbytes ? (zero ? vd_calloc(1, nbytes) : vd_malloc(nbytes)) : NULL;
   vd_label* lt = nlabel ? vd_malloc((size_t)nlabel * sizeof(vd_label)) : NULL;
   if ((nbytes && !block) || (nlabel && !lt)) {
     vd_free(block, nbytes);
@@ -81,7 +81,6 @@ vd_status cloud_alloc(vd_cloud* c, int64_t n, const vd_label* labels, int nlabel
                         (long long)n);
   }
   if (nbytes >= (size_t)4 << 20) advise_huge(block, nbytes);
-  if (nbytes && zero) memset(block, 0, nbytes);
   if (nlabel) memcpy(lt, labels, (size_t)nlabel * sizeof(vd_label));
   c->n = n;
   c->nbytes = nbytes;

@@ -480,11 +480,14 @@ static inline vd_vec3 tri_normal(const stri* r, double wa, double wb, double wc)
   return vd_normalize(vd_cross(e1, e2));
 }
 
-static void store(vd_cloud* c, int64_t i, vd_vec3 p, vd_vec3 n, int label, int instance, int vi,
-                  double range) {
+// point i; view and range only with scanners (without, the block was allocated zeroed, and those
+// pages are never touched)
+static void store(vd_cloud* c, int64_t i, vd_vec3 p, vd_vec3 n, int label, int instance, int scanners,
+                  int vi, double range) {
   c->pos[3 * i] = p.x, c->pos[3 * i + 1] = p.y, c->pos[3 * i + 2] = p.z;
   c->normal[3 * i] = n.x, c->normal[3 * i + 1] = n.y, c->normal[3 * i + 2] = n.z;
-  c->label[i] = label, c->instance[i] = instance, c->view[i] = vi, c->range[i] = range;
+  c->label[i] = label, c->instance[i] = instance;
+  if (scanners) c->view[i] = vi, c->range[i] = range;
 }
 
 static vd_vec3 gauss3(ustream* u) {
@@ -576,7 +579,7 @@ static int sample_chunk(const sampler* s, int64_t c, counters* k) {
         }
       }
       double range = s->scanners ? vd_norm(vd_sub(p, w->pos)) : 0;
-      store(s->out, i, p, n, r->label, r->instance, s->scanners ? v : 0, range);
+      store(s->out, i, p, n, r->label, r->instance, s->scanners, v, range);
       break;
     }
   }
@@ -633,7 +636,7 @@ static void scan_chunk(const sampler* s, int64_t c, counters* k, unsigned char* 
         k->interior++;
       continue;
     }
-    store(s->out, g, p, n, r->label, r->instance, v, range);
+    store(s->out, g, p, n, r->label, r->instance, 1, v, range);
     keep[g] = 1;
   }
 }
@@ -734,7 +737,7 @@ vd_status vd_cloud_sample(const vd_model* m, const vd_data* d, const vd_cloud_de
   vd_cloud big;
   memset(&big, 0, sizeof big);
   unsigned char* keep = NULL;
-  if (!st) st = cloud_alloc(&big, total, m->labels, m->nlabel, 0, err);
+  if (!st) st = cloud_alloc(&big, total, m->labels, m->nlabel, !s.scanners, err);
   if (!st && def.sensor == VD_SENSOR_SCAN) {
     keep = vd_malloc((size_t)total);
     if (!keep) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory scanning");

@@ -37,6 +37,13 @@ void* vd_malloc(size_t size) {
 void* vd_calloc(size_t n, size_t size) {
   if (n == 0 || size == 0) return NULL;
   if (n > SIZE_MAX / size) return NULL;
+  if (alloc_fn == libc_realloc) {
+    // libc's calloc does not clear memory fresh from the system (it is zero already): a large
+    // block's pages are then touched only where they are written
+    void* p = calloc(n, size);
+    if (p) atomic_fetch_add(&alloc_bytes, (int64_t)(n * size));
+    return p;
+  }
   void* p = vd_malloc(n * size);
   if (p) memset(p, 0, n * size);
   return p;
