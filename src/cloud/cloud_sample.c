@@ -517,8 +517,12 @@ static int sample_chunk(const sampler* s, int64_t c, counters* k) {
       const stri* r = &s->tri[draw_tri(s, &u)];
       double r1 = uni(&u), r2 = uni(&u);
 #if defined(__GNUC__)
-      // the next draw's triangle is most likely this one (the alias table, 16 bytes a triangle,
-      // stays in cache; the triangles do not): start loading it
+      // the next draw's triangle is most likely this one: start loading it, and the alias
+      // column of the draw after (three uniforms a draw), which picks that one's triangle
+      if (u.i + 3 < 64) {
+        int nn = (int)(u.buf[u.i + 3] * s->mesh.ntri);
+        if (nn < s->mesh.ntri) __builtin_prefetch(&s->col[nn]);
+      }
       if (u.i < 64) {
         double x = u.buf[u.i] * s->mesh.ntri;
         int nx = (int)x;
