@@ -352,6 +352,24 @@ int cli_label_counts(const vd_cloud* c, int64_t* count) {
   for (int l = 0; l < c->nlabel; l++)
     ix[l] = (id_index){c->labels[l].id, l};
   qsort(ix, (size_t)c->nlabel, sizeof *ix, cmp_id);
+  // distinct ids over a short range: a direct table instead of a search per point
+  int lo = ix[0].id, span = ix[c->nlabel - 1].id - lo, distinct = 1;
+  for (int l = 1; l < c->nlabel; l++)
+    distinct &= ix[l].id != ix[l - 1].id;
+  int* at_id = distinct && span >= 0 && span < 1 << 16 ? vd_malloc(((size_t)span + 1) * sizeof(int)) : NULL;
+  if (at_id) {
+    for (int k = 0; k <= span; k++)
+      at_id[k] = -1;
+    for (int l = 0; l < c->nlabel; l++)
+      at_id[ix[l].id - lo] = ix[l].index;
+    for (int64_t i = 0; i < c->n; i++) {
+      int64_t k = (int64_t)c->label[i] - lo;
+      if (k >= 0 && k <= span && at_id[k] >= 0) count[at_id[k]]++;
+    }
+    vd_free(at_id, ((size_t)span + 1) * sizeof(int));
+    vd_free(ix, (size_t)c->nlabel * sizeof *ix);
+    return 1;
+  }
   for (int64_t i = 0; i < c->n; i++) {
     id_index key = {c->label[i], 0};
     const id_index* at = bsearch(&key, ix, (size_t)c->nlabel, sizeof *ix, cmp_id);
@@ -388,11 +406,16 @@ cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
   cJSON_AddNumberToObject(root, "instances", ninst);
   cJSON_AddNumberToObject(root, "views", c->nview);
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-  for (int k = 0; k < 3; k++) {
-    if (c->n) lo[k] = INFINITY, hi[k] = -INFINITY;
-    for (int64_t i = 0; i < c->n; i++)
-      lo[k] = fmin(lo[k], c->pos[3 * i + k]), hi[k] = fmax(hi[k], c->pos[3 * i + k]);
-  }
+  if (c->n)
+    for (int k = 0; k < 3; k++)
+      lo[k] = INFINITY, hi[k] = -INFINITY;
+  // one pass; for finite bounds the same as fmin and fmax (ties and NaN keep the bound)
+  for (int64_t i = 0; i < c->n; i++)
+    for (int k = 0; k < 3; k++) {
+      double x = c->pos[3 * i + k];
+      lo[k] = x < lo[k] ? x : lo[k];
+      hi[k] = x > hi[k] ? x : hi[k];
+    }
   cJSON_AddItemToObject(root, "bbox_min", vec_json(lo));
   cJSON_AddItemToObject(root, "bbox_max", vec_json(hi));
   cJSON_AddNumberToObject(root, "area", s->area);
