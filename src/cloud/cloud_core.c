@@ -55,8 +55,12 @@ static size_t block_size(int64_t n) { return (size_t)n * (7 * sizeof(double) + 3
 static void advise_huge(void* block, size_t nbytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   const uintptr_t huge = (uintptr_t)2 << 20;
-  uintptr_t a = ((uintptr_t)block + huge - 1) & ~(huge - 1), b = ((uintptr_t)block + nbytes) & ~(huge - 1);
-  if (b > a) (void)madvise((void*)a, (size_t)(b - a), MADV_HUGEPAGE);
+  // the whole huge pages inside the block, by offsets from its start (no integer-to-pointer cast)
+  uintptr_t start = (uintptr_t)block;
+  size_t head = (size_t)((huge - start % huge) % huge);
+  if (nbytes <= head) return;
+  size_t len = (nbytes - head) & ~(size_t)(huge - 1);
+  if (len) (void)madvise((char*)block + head, len, MADV_HUGEPAGE);
 #else
   (void)block, (void)nbytes;
 #endif
