@@ -11,13 +11,7 @@
 #include <time.h>
 
 #include "verdant/verdant.h"
-
-// CPU time of the process (s): on a shared machine, time spent descheduled is not counted
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "bench_util.h"
 
 // a machine-speed reference measured in the same run (the machine is shared): nanoseconds per
 // step of a dependent chain of floating-point adds through memory, best of 5
@@ -25,10 +19,10 @@ static double calibration_ns(void) {
   volatile double x = 0;
   double best = HUGE_VAL;
   for (int b = 0; b < 5; b++) {
-    double t0 = now();
+    double t0 = bench_cpu();
     for (int k = 0; k < 10000000; k++)
       x += 1e-9;
-    best = fmin(best, now() - t0);
+    best = fmin(best, bench_cpu() - t0);
   }
   return best / 1e7 * 1e9;
 }
@@ -140,12 +134,12 @@ int main(int argc, char** argv) {
       def.full = full;
       vd_error err = {0};
       vd_sdf* g = NULL;
-      double t0 = now();
+      double t0 = bench_cpu();
       if (vd_sdf_build(sm[m].v, sm[m].nv, sm[m].t, sm[m].nt, &def, &g, &err)) {
         fprintf(stderr, "sdf build failed: %s\n", err.msg);
         return 1;
       }
-      double t = now() - t0;
+      double t = bench_cpu() - t0;
       char d[64];
       snprintf(d, sizeof d, "%d tris, %dx%dx%d, %s", sm[m].nt, g->nx, g->ny, g->nz,
                full ? "full" : "band");
@@ -179,10 +173,10 @@ int main(int argc, char** argv) {
   for (int s = 0; s < 5; s++) {
     double best = HUGE_VAL;
     for (int batch = 0; batch < 5; batch++) {
-      double t0 = now();
+      double t0 = bench_cpu();
       for (int i = 0; i < NQ; i++)
         sink += vd_collide_point(&col[s], pa[i]).dist;
-      best = fmin(best, now() - t0);
+      best = fmin(best, bench_cpu() - t0);
     }
     row("point query", names[s], NQ, best, "queries/s");
   }
@@ -190,10 +184,10 @@ int main(int argc, char** argv) {
     int n = s == 4 ? NQ / 10 : NQ;
     double best = HUGE_VAL;
     for (int batch = 0; batch < 5; batch++) {
-      double t0 = now();
+      double t0 = bench_cpu();
       for (int i = 0; i < n; i++)
         sink += vd_collide_capsule(&col[s], pa[i], pb[i], 0.003, 0.002).dist;
-      best = fmin(best, now() - t0);
+      best = fmin(best, bench_cpu() - t0);
     }
     row("capsule (0.02 m) query", names[s], n, best, "queries/s");
   }
@@ -279,12 +273,12 @@ int main(int argc, char** argv) {
   int reps = 200;
   double t = HUGE_VAL, t0;
   for (int batch = 0; batch < 10; batch++) {
-    t0 = now();
+    t0 = bench_cpu();
     for (int r = 0; r < reps; r++) {
       vd_arena_reset(&arena);
       vd_collide_self(&P, &def, &arena, &L, &err);
     }
-    t = fmin(t, now() - t0);
+    t = fmin(t, bench_cpu() - t0);
   }
   char d[96];
   snprintf(d, sizeof d, "tomato %d caps + %d spheres", np, m->nsphere);
@@ -297,7 +291,7 @@ int main(int argc, char** argv) {
   vd_pair_list pairs;
   t = HUGE_VAL;
   for (int batch = 0; batch < 10; batch++) {
-    t0 = now();
+    t0 = bench_cpu();
     for (int r = 0; r < reps; r++) {
       if (r % 10 == 0) {
         vd_arena_reset(&keep);
@@ -306,7 +300,7 @@ int main(int argc, char** argv) {
       vd_arena_reset(&arena);
       vd_collide_pairs(&P, &pairs, &def, &arena, &L, &err);
     }
-    t = fmin(t, now() - t0);
+    t = fmin(t, bench_cpu() - t0);
   }
   row("self-collision, pairs reused", "broad phase every 10 steps", reps, t, "per s");
   printf("  %d candidate pairs (grow 0.01 m), %d contacts, %.1f us per step\n", pairs.n, L.n,
@@ -327,12 +321,12 @@ int main(int argc, char** argv) {
   g[4] = vd_collider_sdf(mp, grid);
   t = HUGE_VAL;
   for (int batch = 0; batch < 10; batch++) {
-    t0 = now();
+    t0 = bench_cpu();
     for (int r = 0; r < reps; r++) {
       vd_arena_reset(&arena);
       vd_collide_colliders(&P, g, 5, &def, &arena, &L, &err);
     }
-    t = fmin(t, now() - t0);
+    t = fmin(t, bench_cpu() - t0);
   }
   row("colliders (queries/s)", "tomato vs gripper (5 shapes)", reps, t, "per s");
   printf("  %d candidates, %d contacts, %.1f us per query\n", (int)L.ntested, L.n, 1e6 * t / reps);

@@ -10,12 +10,7 @@
 #include <unistd.h>
 
 #include "verdant/verdant.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "bench_util.h"
 
 typedef struct case_def {
   const char* name;
@@ -58,7 +53,7 @@ static double memcpy_seconds(size_t bytes, size_t chunk) {
   memset(b, 2, chunk);
   double best = 1e30;
   for (int r = 0; r < 3; r++) {
-    double t0 = now();
+    double t0 = bench_wall();
     size_t left = bytes;
     while (left) {
       size_t n = left < chunk ? left : chunk;
@@ -66,7 +61,7 @@ static double memcpy_seconds(size_t bytes, size_t chunk) {
       a[n / 2] ^= b[n / 3];  // keep the copies observable
       left -= n;
     }
-    double t = now() - t0;
+    double t = bench_wall() - t0;
     if (t < best) best = t;
   }
   free(a);
@@ -112,9 +107,9 @@ int main(int argc, char** argv) {
       def.progress = count_cb;
       def.progress_user = &a;
       vd_lstring s = vd_lstring_empty();
-      double t0 = now();
+      double t0 = bench_wall();
       vd_status st = vd_lsys_derive(ls, &def, &s, &err);
-      double td = now() - t0;
+      double td = bench_wall() - t0;
       if (st) {
         fprintf(stderr, "%s: %s\n", cases[c].name, err.msg);
         return 1;
@@ -127,9 +122,9 @@ int main(int argc, char** argv) {
       // turtle on the final string
       vd_plant_spec* plant = vd_plant_spec_create();
       vd_turtle_def td_def = vd_turtle_def_default();
-      double t1 = now();
+      double t1 = bench_wall();
       st = vd_turtle_run(ls, &s, &td_def, plant, &err);
-      double tt = now() - t1;
+      double tt = bench_wall() - t1;
       int nseg = plant ? plant->nseg : 0;
       double mps = (double)a.total / td;
       printf("%-24s %12lld %12lld %9.4f %14.0f %10.4f %9.2f %12.0f\n", cases[c].name, (long long)s.n,

@@ -30,13 +30,7 @@
 
 #include "mj_trap.h"
 #include "verdant/verdant.h"
-
-// CPU time of the process (s): on a shared machine, time spent descheduled is not counted
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "bench_util.h"
 
 // a machine-speed reference measured in the same run (the machine is shared): nanoseconds per
 // step of a dependent chain of floating-point adds through memory, best of 5
@@ -44,10 +38,10 @@ static double calibration_ns(void) {
   volatile double x = 0;
   double best = HUGE_VAL;
   for (int b = 0; b < 5; b++) {
-    double t0 = now();
+    double t0 = bench_cpu();
     for (int k = 0; k < 10000000; k++)
       x += 1e-9;
-    best = fmin(best, now() - t0);
+    best = fmin(best, bench_cpu() - t0);
   }
   return best / 1e7 * 1e9;
 }
@@ -237,7 +231,7 @@ static statics chain_statics(const beam* b, int N, int root2, int selfweight) {
   double l = b->L / N;
   if (VD_MJ_TRY(&trap)) {
     int steps = 0;
-    double t0 = now();
+    double t0 = bench_cpu();
     for (; steps < 60000; steps++) {
       if (!selfweight) apply_tip_load(M, d, l, b->P);
       mj_step(M, d);
@@ -248,7 +242,7 @@ static statics chain_statics(const beam* b, int N, int root2, int selfweight) {
         if (v < 1e-12) break;
       }
     }
-    out.steps_s = steps / (now() - t0);
+    out.steps_s = steps / (bench_cpu() - t0);
     out.settle_s = steps * dt;
     mj_forward(M, d);
     double tip[3];
@@ -300,11 +294,11 @@ static double steps_per_second(const mjModel* M, mjData* d, double min_s) {
   double rate = 0;
   if (VD_MJ_TRY(&trap)) {
     int steps = 0;
-    double t0 = now(), t = 0;
+    double t0 = bench_cpu(), t = 0;
     do {
       mj_step(M, d);
       steps++;
-      t = now() - t0;
+      t = bench_cpu() - t0;
     } while (t < min_s || steps < 3);
     rate = steps / t;
     vd_mj_trap_end(&trap);
@@ -513,23 +507,6 @@ static mjModel* plant_model(void* user, double dt, char* msg, int cap) {
   return M;
 }
 
-// the bundled plant path grown with seed 0 and compiled; NULL on failure
-static vd_model* grow(const char* path) {
-  vd_lsystem* ls = NULL;
-  vd_error err = {0};
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_model* m = NULL;
-  vd_lsys_def def = vd_lsys_def_default();
-  if (vd_lsys_load(path, &ls, &err) || vd_lsys_grow(ls, &def, NULL, s, &err) ||
-      vd_plant_compile(s, &m, &err)) {
-    char buf[1200];
-    fprintf(stderr, "%s\n", vd_error_format(&err, buf, sizeof buf));
-  }
-  vd_lsys_destroy(ls);
-  vd_plant_spec_destroy(s);
-  return m;
-}
-
 // ---------------------------------------------------------------------------------------------
 // the self-test of the error trap (registered in CTest)
 
@@ -731,7 +708,7 @@ int main(int argc, char** argv) {
     for (char* name = strtok(list, ","); name; name = strtok(NULL, ",")) {
       char path[4096];
       snprintf(path, sizeof path, "%s/data/%s.lpy", VD_SOURCE_DIR, name);
-      vd_model* m = grow(path);
+      vd_model* m = bench_grow(path);
       if (!m) continue;
       char xml_path[4200];
       if (xml_dir) snprintf(xml_path, sizeof xml_path, "%s/%s_chain.xml", xml_dir, name);

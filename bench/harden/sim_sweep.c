@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include "verdant/verdant.h"
+#include "../bench_util.h"
 
 #define MAXV 16 // most values of one swept parameter
 
@@ -34,29 +35,6 @@ static const char* usage =
     "capped)\n"
     "  --csv FILE           one row per run, flushed as each run ends\n"
     "  --append             add rows to FILE (header only when FILE is empty)\n";
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static vd_model* grow(const char* path) {
-  vd_error e = {0};
-  vd_lsystem* ls = NULL;
-  if (vd_lsys_load(path, &ls, &e)) {
-    fprintf(stderr, "%s: %s\n", path, e.msg);
-    return NULL;
-  }
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_lsys_def def = vd_lsys_def_default();
-  vd_model* m = NULL;
-  if (!vd_lsys_grow(ls, &def, NULL, s, &e)) vd_plant_compile(s, &m, &e);
-  if (!m) fprintf(stderr, "%s: %s\n", path, e.msg);
-  vd_plant_spec_destroy(s);
-  vd_lsys_destroy(ls);
-  return m;
-}
 
 // parse a comma-separated list of positive numbers into v; returns the count, 0 when malformed
 static int parse_list(const char* s, double* v) {
@@ -139,10 +117,10 @@ static void run_one(const vd_model* pm, double sigma, double young, double rho, 
   vd_sim_collider g = {VD_SIM_PLANE,       {0, 0, 0},      vd_v3(0, 0, 0),
                        vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   vd_sim_add_collider(d, &g);
-  double t0 = now();
+  double t0 = bench_wall();
   // as the command does: stop at the first step that fails; the cap is checked between steps
   for (int k = 0; k < steps && !r->failed; k++) {
-    if (max_seconds > 0 && now() - t0 > max_seconds) {
+    if (max_seconds > 0 && bench_wall() - t0 > max_seconds) {
       r->capped = 1;
       break;
     }
@@ -150,7 +128,7 @@ static void run_one(const vd_model* pm, double sigma, double young, double rho, 
     if (!state_finite(m, d)) r->nonfinite++;
     r->steps_done += !r->failed;
   }
-  r->seconds = now() - t0;
+  r->seconds = bench_wall() - t0;
   r->warnings = d->nwarning;
   memcpy(r->warning, d->warning, sizeof r->warning);
   r->max_disp = vd_sim_max_displacement(m, d, NULL);
@@ -263,12 +241,12 @@ int main(int argc, char** argv) {
   int64_t runs = 0, nonfinite = 0, steps_all = 0, count[O_COUNT] = {0},
           by_solver[2][O_COUNT] = {{0}};
   int64_t warn_all[VD_SIM_WARN_COUNT] = {0};
-  double t_all = now();
+  double t_all = bench_wall();
   for (int p = 0; p < 3; p++) {
     if (!use_plant[p]) continue;
     char path[4096];
     snprintf(path, sizeof path, "%s/data/%s.lpy", VD_SOURCE_DIR, names[p]);
-    vd_model* pm = grow(path);
+    vd_model* pm = bench_grow(path);
     if (!pm) return 1;
     for (int a = 0; a < nval[0]; a++)
       for (int b = 0; b < nval[1]; b++)
@@ -310,7 +288,7 @@ int main(int argc, char** argv) {
     vd_model_destroy(pm);
   }
   printf("%lld runs, %lld steps in %.0f s: %lld non-finite states\n  outcomes:", (long long)runs,
-         (long long)steps_all, now() - t_all, (long long)nonfinite);
+         (long long)steps_all, bench_wall() - t_all, (long long)nonfinite);
   for (int o = 0; o < O_COUNT; o++)
     printf(" %s %lld", outcome_name[o], (long long)count[o]);
   printf("\n  warnings:");

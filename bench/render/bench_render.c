@@ -11,12 +11,7 @@
 #include <time.h>
 
 #include "verdant/verdant.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../bench_util.h"
 
 typedef struct bench_case {
   const char* name;
@@ -38,13 +33,13 @@ static vd_renderer* make(const bench_case* c, const vd_model* m, int plant, doub
     fprintf(stderr, "%s: %s\n", c->name, err.msg);
     return NULL;
   }
-  double t = now();
+  double t = bench_wall();
   if (plant && vd_render_add_plant(r, m, NULL, NULL, &err)) {
     fprintf(stderr, "%s: %s\n", c->name, err.msg);
     vd_render_destroy(r);
     return NULL;
   }
-  *setup_s = now() - t;
+  *setup_s = bench_wall() - t;
   return r;
 }
 
@@ -69,12 +64,12 @@ static int run_case(const bench_case* c, const vd_model* m, int frames, double* 
   for (int i = 0; i <= frames && ok; i++) {
     vd_camera cam = vd_camera_preset(VD_CAMERA_ORBIT, -1.0 + 0.02 * i, 0.35, lo, hi, 640, 480);
     for (int k = 0; k < 2 && ok; k++) {
-      double a = now();
+      double a = bench_wall();
       if (vd_render_draw(k ? p : r, &cam, c->layers, &f, &err)) {
         fprintf(stderr, "%s: %s\n", c->name, err.msg);
         ok = 0;
       }
-      double t = now() - a;
+      double t = bench_wall() - a;
       if (i > 0) sum[k] += t, fast[k] = t < fast[k] ? t : fast[k]; // frame 0 warms up
     }
   }

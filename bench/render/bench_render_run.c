@@ -14,12 +14,7 @@
 #include <unistd.h>
 
 #include "verdant/verdant.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "../bench_util.h"
 
 // little-endian writers for frames.bin (docs/formats.md)
 static void put_u32(FILE* f, uint32_t v) {
@@ -130,9 +125,9 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 3; k++) {
     vd_render_def d = vd_render_def_default();
     vd_renderer* r;
-    double t = now();
+    double t = bench_wall();
     if (vd_render_create(&d, &r, &err)) return fail("renderer", &err);
-    create += (now() - t) / 3;
+    create += (bench_wall() - t) / 3;
     vd_render_destroy(r);
   }
   FILE* csv = fopen(csv_path, "w");
@@ -180,23 +175,23 @@ int main(int argc, char** argv) {
     vd_frame out;
     for (int k = 0; k <= nframe; k++) {
       int fk = k == 0 ? 0 : k - 1; // a warm-up frame first
-      double t0 = now();
+      double t0 = bench_wall();
       if (vd_sim_frames_load(fr, fk, sm, sd, &err)) return fail("load", &err);
-      double t1 = now();
+      double t1 = bench_wall();
       vd_sim_to_plant(sm, sd, pm, pd);
-      double t2 = now();
+      double t2 = bench_wall();
       if (bc->color_by == VD_COLOR_STRESS) vd_sim_plant_stress(sm, sd, pm, stress);
-      double t3 = now();
+      double t3 = bench_wall();
       vd_render_clear(r);
       vd_render_shape sh = {
           VD_RENDER_SPHERE, {0.04, 0, 0}, probe_at[fk], vd_quat_identity(), {0.55f, 0.62f, 0.75f}};
       if (vd_render_add_plant(r, pm, pd, &st, &err) || vd_render_add_shape(r, &sh, &err))
         return fail("scene", &err);
-      double t4 = now();
+      double t4 = bench_wall();
       if (vd_render_draw(r, &cam, bc->layers, &out, &err)) return fail("draw", &err);
-      double t5 = now();
+      double t5 = bench_wall();
       if (vd_render_draw(p, &cam, bc->layers, &out, &err)) return fail("peer", &err);
-      double t6 = now();
+      double t6 = bench_wall();
       if (k == 0) continue;
       tm.load += (t1 - t0) / nframe, tm.plant += (t2 - t1) / nframe,
           tm.stress += (t3 - t2) / nframe;

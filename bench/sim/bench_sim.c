@@ -12,34 +12,7 @@
 #include <time.h>
 
 #include "verdant/verdant.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double cpu(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static vd_model* grow(const char* path) {
-  vd_error e = {0};
-  vd_lsystem* ls = NULL;
-  if (vd_lsys_load(path, &ls, &e)) {
-    fprintf(stderr, "%s: %s\n", path, e.msg);
-    return NULL;
-  }
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_lsys_def def = vd_lsys_def_default();
-  vd_model* m = NULL;
-  if (!vd_lsys_grow(ls, &def, NULL, s, &e)) vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
-  vd_lsys_destroy(ls);
-  return m;
-}
+#include "../bench_util.h"
 
 // a plant run: sag-free plant, ground, a probe sweeping through the crown; self: self-collision
 static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_solver solver, int iters, double secs,
@@ -64,12 +37,12 @@ static void plant_run(FILE* csv, const char* name, const vd_model* pm, vd_sim_so
   vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.5, 0, 0.6 * top), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   int id = vd_sim_add_collider(d, &p);
   int steps = (int)(secs / m->opt.dt + 0.5);
-  double w0 = now(), c0 = cpu();
+  double w0 = bench_wall(), c0 = bench_cpu();
   for (int k = 0; k < steps; k++) {
     vd_sim_set_collider_pose(m, d, id, vd_v3(0.5 - 1.0 * k / steps, 0, 0.6 * top), vd_quat_identity());
     vd_sim_step(m, d);
   }
-  double wall = now() - w0, ct = cpu() - c0;
+  double wall = bench_wall() - w0, ct = bench_cpu() - c0;
   int dyn = 0;
   for (int t = 0; t < m->nseg; t++) dyn += !(m->seg_flags[t] & VD_SIM_FIXED);
   double sps = steps / ct;
@@ -121,7 +94,7 @@ static void solver_run(FILE* csv, const char* name, double young, double rho, vd
   m->opt.solver = solver;
   m->opt.iterations = iters;
   // damped dynamics for 3 s
-  double c0 = cpu();
+  double c0 = bench_cpu();
   int steps = 3000;
   s = vd_sim_settle_def_default();
   s.extra_damping = 10;
@@ -130,7 +103,7 @@ static void solver_run(FILE* csv, const char* name, double young, double rho, vd
   int n = 0;
   vd_sim_settle(m, d, &s, NULL, &n);
   steps = n;
-  double ct = cpu() - c0;
+  double ct = bench_cpu() - c0;
   double sag = -d->node_pos[m->main_tip].z, err = (sag - ref) / ref;
   printf("%-22s %-6s %4d it  sag %.5f m (static %.5f m, error %+8.3f %%)  %7.2f us/step\n", name,
          solver == VD_SIM_GS ? "gs" : "direct", iters, sag, ref, 100 * err, 1e6 * ct / steps);
@@ -147,9 +120,9 @@ static double calibration_ns(void) {
   volatile double x = 0;
   double best = HUGE_VAL;
   for (int b = 0; b < 5; b++) {
-    double t0 = now();
+    double t0 = bench_wall();
     for (int k = 0; k < 10000000; k++) x += 1e-9;
-    best = fmin(best, now() - t0);
+    best = fmin(best, bench_wall() - t0);
   }
   return best / 1e7 * 1e9;
 }
@@ -198,9 +171,9 @@ static void cantilever_run(FILE* csv, int n, double ref) {
   vd_sim_data* d = vd_sim_data_create(m);
   m->opt.gravity = vd_v3(0, 0, -9.81);
   int steps = 2000;
-  double c0 = cpu();
+  double c0 = bench_cpu();
   for (int k = 0; k < steps; k++) vd_sim_step(m, d);
-  double ct = cpu() - c0;
+  double ct = bench_cpu() - c0;
   printf("cantilever N = %3d  %9.0f steps/s  %7.2f x real time  tip-load error %+.2e\n", n, steps / ct,
          steps / ct * m->opt.dt, err);
   fprintf(csv, "cantilever,N%d,direct,1,%d,%d,%.6f,,%.1f,%.3f,%.4f,,%.6g\n", n, n, steps, ct, steps / ct,
@@ -231,9 +204,9 @@ int main(int argc, char** argv) {
                "us_per_segment_step,settled_sag_m,sag_error_rel\n");
   char path[1024];
   snprintf(path, sizeof path, "%s/data/tomato.lpy", VD_SOURCE_DIR);
-  vd_model* tomato = grow(path);
+  vd_model* tomato = bench_grow(path);
   snprintf(path, sizeof path, "%s/data/tree.lpy", VD_SOURCE_DIR);
-  vd_model* tree = grow(path);
+  vd_model* tree = bench_grow(path);
   if (!tomato || !tree) return 1;
   double cal = calibration_ns();
   printf("== machine: %.3f ns per dependent floating-point add (compare runs with it)\n", cal);
