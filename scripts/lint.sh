@@ -3,6 +3,8 @@
 # Static analysis (`make lint`): clang-tidy with the checks of .clang-tidy and cppcheck over every
 # .c in src/ and cli/, with the compile flags of the CMake build (compile_commands.json of a
 # configure-only build in build-lint/). Any finding fails the run (exit 1); a missing tool exits 2.
+# `scripts/lint.sh FILE.c ...` checks only the files named (a quick check before a commit);
+# `scripts/lint.sh --changed` the .c files of src/ and cli/ that differ from main.
 # Needs the Debian packages clang-tidy and cppcheck. docs/reliability.md, "Static analysis".
 set -u
 cd "$(dirname "$0")/.."
@@ -17,7 +19,21 @@ done
 if [ ! -f "$out/compile_commands.json" ] || [ CMakeLists.txt -nt "$out/compile_commands.json" ]; then
   cmake -S . -B "$out" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null || exit 2
 fi
-mapfile -t files < <(find src cli -name '*.c' | sort)
+if [ "${1:-}" = "--changed" ]; then
+  mapfile -t files < <({ git diff --name-only main -- src cli; git ls-files --others --exclude-standard src cli; } |
+    grep '\.c$' | sort -u | while read -r f; do [ -f "$f" ] && echo "$f"; done)
+  [ ${#files[@]} -gt 0 ] || { echo "lint: no changed .c files" >&2; exit 0; }
+elif [ $# -gt 0 ]; then
+  files=("$@")
+else
+  mapfile -t files < <(find src cli -name '*.c' | sort)
+fi
+filters=()
+if [ $# -gt 0 ]; then
+  for f in "${files[@]}"; do filters+=(--file-filter="$f" --file-filter="$root/$f"); done
+else
+  filters=(--file-filter="src/*" --file-filter="cli/*" --file-filter="$root/src/*" --file-filter="$root/cli/*")
+fi
 start=$(date +%s)
 fail=0
 
@@ -34,8 +50,7 @@ printf '%s\n' "${files[@]}" |
 # whose offsets are aligned for their types.
 echo "lint: $(cppcheck --version) on src/ and cli/" >&2
 mkdir -p "$out/cppcheck"
-cppcheck --project="$out/compile_commands.json" --file-filter="src/*" --file-filter="cli/*" \
-  --file-filter="$root/src/*" --file-filter="$root/cli/*" \
+cppcheck --project="$out/compile_commands.json" "${filters[@]}" \
   --cppcheck-build-dir="$out/cppcheck" --enable=warning,performance,portability --std=c11 --inline-suppr \
   --suppress=invalidPointerCast --error-exitcode=1 -j "$jobs" --quiet --template='{file}:{line}:{column}: {severity}: {message} [{id}]' ||
   fail=1
