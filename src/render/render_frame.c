@@ -406,12 +406,9 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   if (!vd_render_bounds(r, &lo, &hi)) lo = hi = cam->lookat;
   vd_vec3 ctr = vd_scale(vd_add(lo, hi), 0.5);
   double reach = fmax(0.5 * vd_norm(vd_sub(hi, lo)), 0.05);
-  jmp_buf jb;
-  jmp_buf* prev = mjguard_push(&jb);
-  if (setjmp(jb)) {
-    mjguard_pop(prev);
-    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "MuJoCo: %s", mjguard_message());
-  }
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap))
+    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "MuJoCo: %s", trap.error);
   st = fill_scene(r, err);
   if (!st) {
     mjvScene* scn = &r->scn;
@@ -446,7 +443,7 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
     }
     mjr_finish();
   }
-  mjguard_pop(prev);
+  vd_mj_trap_end(&trap);
   if (st) return st;
   out->width = w;
   out->height = h;

@@ -6,6 +6,7 @@
 #include <mujoco/mujoco.h>
 #include <setjmp.h>
 
+#include "mjtrap/mjtrap.h"
 #include "verdant/geom.h"
 #include "verdant/render.h"
 
@@ -43,18 +44,6 @@ typedef struct gl_tris {
 unsigned gl_list(gl_ctx* g, const gl_tris* t);
 // Delete a display list (0 is fine).
 void gl_list_free(gl_ctx* g, unsigned list);
-
-// ---------------------------------------------------------------------------------------------
-// MuJoCo guard (render_mujoco.c): MuJoCo errors longjmp back to the innermost guard of the thread
-
-// Install the MuJoCo error and warning hooks (once per process).
-void mjguard_install(void);
-// Push a jump target for MuJoCo errors on this thread; returns the previous one.
-jmp_buf* mjguard_push(jmp_buf* jb);
-// Restore the previous jump target.
-void mjguard_pop(jmp_buf* prev);
-// The message of the last MuJoCo error on this thread.
-const char* mjguard_message(void);
 
 // ---------------------------------------------------------------------------------------------
 // the renderer
