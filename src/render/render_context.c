@@ -185,6 +185,8 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
     if (r->con.currentBuffer != mjFB_OFFSCREEN)
       st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
                         "no OpenGL context: MuJoCo has no offscreen buffer");
+    else
+      render_measure_font(r);
   }
   vd_mj_trap_end(&trap);
   return st;

@@ -84,6 +84,8 @@ struct vd_renderer {
   mjvCamera mjcam;
   mjVFS* vfs;      // stage file system (owned)
   int nmodel_geom; // geoms mjv_updateScene adds for the model
+  int digit_base;  // font: lowest ink row of '0' above the bottom of its cell (pixels)
+  int dot_size;    // font: side of the decimal point we draw (pixels)
   // what is drawn
   item* items; // scene items (nitem)
   int nitem, cap_item;
@@ -115,6 +117,8 @@ void render_items_free(vd_renderer* r);
 // Rebuild the splat lists of the clouds for a camera at eye looking along fwd with axes right/up.
 vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double fwd[3],
                                const double right[3], const double up[3], vd_error* err);
+// Measure the font's digit baseline and stroke (once, after the MuJoCo context is made).
+void render_measure_font(vd_renderer* r);
 // Colour map from t in [0, 1] (viridis) into rgb.
 void render_colormap(double t, float rgb[3]);
 
