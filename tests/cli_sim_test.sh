@@ -34,6 +34,9 @@ expect "sim unknown option" 2 "$V" sim "$T/p.lpy" --stats --bogus
 expect "sim bad dt" 2 "$V" sim "$T/p.lpy" --stats --dt -1
 expect_err "bad dt named" "--dt"
 expect "sim bad solver" 2 "$V" sim "$T/p.lpy" --stats --solver magic
+expect "sim bad bend measure" 2 "$V" sim "$T/p.lpy" --stats --bend-measure darboux
+expect_err "bad bend measure named" "--bend-measure"
+expect "sim quat bend measure" 0 "$V" sim "$T/p.lpy" --stats --bend-measure quat --duration 0.01
 expect "sim bad class" 2 "$V" sim "$T/p.lpy" --stats --young bark=1e9
 expect_err "bad class named" "unknown class 'bark'"
 expect "sim bad young" 2 "$V" sim "$T/p.lpy" --stats --young -5
