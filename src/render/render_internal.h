@@ -42,6 +42,9 @@ typedef struct gl_tris {
 
 // Compile a display list of triangles; returns its name, 0 on failure.
 unsigned gl_list(gl_ctx* g, const gl_tris* t);
+// Offset the depth of filled polygons by factor x their depth slope + units x the depth
+// resolution (glPolygonOffset); 0, 0 turns the offset off.
+void gl_polygon_offset(gl_ctx* g, float factor, float units);
 // Delete a display list (0 is fine).
 void gl_list_free(gl_ctx* g, unsigned list);
 
