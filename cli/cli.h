@@ -88,6 +88,16 @@ double cli_now(void);
 // Does path end with ext (case-insensitive, ext with the dot)?
 int cli_has_ext(const char* path, const char* ext);
 
+// Inputs and outputs (cli_paths.c). Is a the same file as b (both exist, same device and inode)?
+int cli_same_file(const char* a, const char* b);
+// No output may replace an input: when one of the nout outputs is one of the nin inputs (NULL
+// entries skipped) print which and return EXIT_USAGE, else 0.
+int cli_check_outputs(const char* cmd, const char* const* out, int nout, const char* const* in, int nin);
+// Does the folder dir hold the file path (path's parent folder is dir, by inode)?
+int cli_in_folder(const char* dir, const char* path);
+
+// The files of a plant output: path, and for .obj its material library (.mtl); returns the count.
+int cli_plant_files(const char* path, char files[2][4200]);
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
 
@@ -188,8 +198,11 @@ typedef struct cli_render_opts {
 
 // The camera of the options: the explicit pose, or the preset fitted to the box lo..hi.
 vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi);
-// Write a frame: OUT.png, and with depth or masks OUT.depth.png, OUT.label.png, OUT.instance.png
-// and the sidecar OUT.json naming them (every file atomic).
+// The files of a frame: OUT.png, and with depth or masks OUT.depth.png, OUT.label.png,
+// OUT.instance.png and the sidecar OUT.png.json naming them (named after the whole image name, so
+// it never takes the name of a plant file OUT.json). Fills path[0..n) and returns n.
+int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]);
+// Write a frame's files (cli_frame_files; every file atomic).
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err);
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);

@@ -319,7 +319,7 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
     cJSON_AddNumberToObject(e, "azimuth", az);
     cJSON_AddNumberToObject(e, "elevation", el);
     static const char* roles[5][2] = {{"color", "png"}, {"depth", "depth.png"}, {"label", "label.png"},
-                                      {"instance", "instance.png"}, {"camera", "json"}};
+                                      {"instance", "instance.png"}, {"camera", "png.json"}};
     for (int k = 0; k < 5; k++) {
       snprintf(path, sizeof path, "%s.%s", base, roles[k][1]);
       cJSON_AddStringToObject(e, roles[k][0], path);
@@ -707,6 +707,15 @@ int cli_dataset(int argc, char** argv) {
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
   if (image_size_given && !ds.images) return cli_usage_error("dataset", "--image-size goes with --images N");
+  // no output may replace an input: the dataset writes manifest.json and item_* in DIR
+  const char* ins[2] = {po.path, co.scanners_file};
+  for (int k = 0; k < 2; k++) {
+    const char* base = ins[k] ? strrchr(ins[k], '/') : NULL;
+    base = base ? base + 1 : ins[k];
+    if (ins[k] && cli_in_folder(ds.dir, ins[k]) && (!strcmp(base, "manifest.json") || !strncmp(base, "item_", 5)))
+      return cli_usage_error("dataset", "the input '%s' lies in the dataset folder '%s' under a name the dataset "
+                             "writes (manifest.json, item_*); move it or choose another folder", ins[k], ds.dir);
+  }
   ds.master = po.seed;
   ds.instance_labels = co.labels_instance;
   ds.progress = po.progress;

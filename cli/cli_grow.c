@@ -124,6 +124,12 @@ int cli_grow(int argc, char** argv) {
   if (!out && !stats) return cli_usage_error("grow", "nothing to do: give -o OUT and/or --stats");
   if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
     return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
+  if (out) {
+    char files[2][4200];
+    int nf = cli_plant_files(out, files);
+    const char* outs[2] = {files[0], files[1]};
+    if (cli_check_outputs("grow", outs, nf, (const char* const[]){po.path}, 1)) return EXIT_USAGE;
+  }
   vd_error err = {0};
   vd_plant_spec* plant;
   cli_grow_info info;

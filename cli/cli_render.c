@@ -22,7 +22,7 @@ static const char* render_help =
     "\n"
     "options:\n"
     "  -o, --output OUT.png  colour image; the other files take its name: OUT.depth.png,\n"
-    "                        OUT.label.png, OUT.instance.png, OUT.json\n"
+    "                        OUT.label.png, OUT.instance.png, OUT.png.json\n"
     "      --camera VIEW     front | side | top | orbit[:AZ[:EL]] (degrees, orbit alone is\n"
     "                        orbit:-60:20), fitted to the plant; default orbit\n"
     "      --eye X,Y,Z       explicit camera position (m); with --lookat, replaces --camera\n"
@@ -35,9 +35,9 @@ static const char* render_help =
     "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the data's\n"
     "                        (for a run: 0 to the largest value of the whole run)\n"
     "      --depth           also write OUT.depth.png (16-bit grey, millimetres along the optical\n"
-    "                        axis, 0 = nothing) and OUT.json (intrinsics, pose)\n"
+    "                        axis, 0 = nothing) and OUT.png.json (intrinsics, pose)\n"
     "      --masks           also write OUT.label.png and OUT.instance.png (16-bit ids, 0 =\n"
-    "                        background, exact: no anti-aliasing) and OUT.json\n"
+    "                        background, exact: no anti-aliasing) and OUT.png.json\n"
     "      --supersample K   colour anti-aliasing, K x K samples per pixel (1..4, default 2)\n"
     "      --point-size M    splat half-size of cloud points (m, default 0.4% of the cloud)\n"
     "      --robot FILE.xml  draw a robot from its MJCF (with its own world) beside the plant\n"
@@ -259,12 +259,21 @@ vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi) {
   return cam;
 }
 
+int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]) {
+  int n = 0;
+  snprintf(path[n++], 4200, "%s", out);
+  if (depth) sibling(out, "depth.png", path[n++], 4200);
+  if (masks) sibling(out, "label.png", path[n++], 4200), sibling(out, "instance.png", path[n++], 4200);
+  if (depth || masks) snprintf(path[n++], 4200, "%s.json", out);
+  return n;
+}
+
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err) {
   char p_depth[4200], p_label[4200], p_inst[4200], p_json[4200];
   sibling(out, "depth.png", p_depth, sizeof p_depth);
   sibling(out, "label.png", p_label, sizeof p_label);
   sibling(out, "instance.png", p_inst, sizeof p_inst);
-  sibling(out, "json", p_json, sizeof p_json);
+  snprintf(p_json, sizeof p_json, "%s.json", out);
   // an interrupt removes the temporary files of these outputs
   int watch[5] = {cli_watch(out), cli_watch(p_depth), cli_watch(p_label), cli_watch(p_inst), cli_watch(p_json)};
   // colour, then depth and masks, then the sidecar naming them
@@ -318,6 +327,15 @@ int cli_render(int argc, char** argv) {
     return cli_usage_error(
         "render",
         "--time, --mp4 and --fps apply to simulation runs (a folder of 'verdant sim -o')");
+  {
+    // no output may replace an input (the plant file, the robot)
+    char files[5][4200];
+    const char* outs[5];
+    int nout = cli_frame_files(o.out, o.depth, o.masks, files);
+    for (int k = 0; k < nout; k++) outs[k] = files[k];
+    const char* ins[2] = {o.po.path, o.def.robot_mjcf};
+    if (cli_check_outputs("render", outs, nout, ins, 2)) return EXIT_USAGE;
+  }
   // point clouds in any format the cloud module reads; everything else is a plant
   int is_cloud = cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") ||
                  cli_has_ext(o.po.path, ".xyz") || cli_has_ext(o.po.path, ".csv") ||

@@ -225,7 +225,7 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
       cJSON_AddStringToObject(e, "instance", name);
     }
     if (o->depth || o->masks)
-      snprintf(name, sizeof name, "frame_%05d.json", k), cJSON_AddStringToObject(e, "camera", name);
+      snprintf(name, sizeof name, "frame_%05d.png.json", k), cJSON_AddStringToObject(e, "camera", name);
     cJSON_AddItemToArray(frames, e);
   }
   char* text = cJSON_Print(root);
@@ -277,6 +277,23 @@ int cli_render_run(const cli_render_opts* o) {
   if (o->po.steps >= 0 || o->po.seed || o->po.nset || o->po.nlabel)
     return cli_usage_error(
         cmd, "-n, --seed, --set and --label apply to .lpy plants; a run holds its plant");
+  {
+    // no output may replace a file of the run or the robot
+    static const char* run_files[] = {"rod.json", "plant_initial.json", "frames.bin", "frames.jsonl",
+                                      "colliders.jsonl", "plant.json", "events.csv"};
+    char ipath[8][4200], opath[7][4200];
+    const char* ins[8];
+    const char* outs[7];
+    int nin = 0, nout = 0;
+    for (size_t k = 0; k < sizeof run_files / sizeof *run_files; k++, nin++)
+      snprintf(ipath[nin], sizeof ipath[nin], "%s/%s", o->po.path, run_files[k]), ins[nin] = ipath[nin];
+    ins[nin++] = o->def.robot_mjcf;
+    if (single) nout = cli_frame_files(o->out, o->depth, o->masks, opath);
+    if (folder) snprintf(opath[nout++], sizeof opath[0], "%s/frames.json", folder);
+    if (o->mp4) snprintf(opath[nout++], sizeof opath[0], "%s", o->mp4);
+    for (int k = 0; k < nout; k++) outs[k] = opath[k];
+    if (cli_check_outputs(cmd, outs, nout, ins, nin)) return EXIT_USAGE;
+  }
   const char* mp4 = o->mp4;
   if (mp4 && !on_path("ffmpeg")) {
     fprintf(stderr,

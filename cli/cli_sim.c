@@ -724,6 +724,24 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
   return EXIT_OK;
 }
 
+// no output may replace an input (the plant, the wind series, collider meshes)
+static int check_clash(const sim_opts* o) {
+  static const char* run_files[] = {"frames.bin", "frames.jsonl", "colliders.jsonl", "rod.json",
+                                    "plant_initial.json", "events.csv", "plant.json"};
+  char opath[9][4200];
+  const char* outs[9];
+  const char* ins[10] = {o->po.path, o->wind_file};
+  int nout = 0, nin = 2;
+  for (int k = 0; k < o->nmesh; k++) ins[nin++] = o->mesh_path[k];
+  int dn = o->out ? (int)strlen(o->out) : 0;
+  while (dn > 1 && o->out[dn - 1] == '/') dn--;
+  for (size_t k = 0; o->out && k < sizeof run_files / sizeof *run_files; k++)
+    snprintf(opath[nout++], sizeof opath[0], "%.*s/%s", dn, o->out, run_files[k]);
+  if (o->final) nout += cli_plant_files(o->final, opath + nout);
+  for (int k = 0; k < nout; k++) outs[k] = opath[k];
+  return cli_check_outputs("sim", outs, nout, ins, nin);
+}
+
 int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
@@ -745,6 +763,7 @@ int cli_sim(int argc, char** argv) {
   if (rc) return rc;
   if (!o.po.path) return cli_usage_error("sim", "missing PLANT (an .lpy or plant .json file)");
   if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
+  if (check_clash(&o)) return EXIT_USAGE;
   if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
   if (!o.frames) o.frames = "bin";
   // the run's steps, counted (a time sum stalls once time + dt == time): at most --max-steps

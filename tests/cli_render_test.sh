@@ -44,7 +44,7 @@ fi
 
 # the tomato with masks and depth: five files, masks 16-bit, sidecar names them
 expect "render tomato" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/tomato.png" --masks --depth --size 320x240
-for f in tomato.png tomato.label.png tomato.instance.png tomato.depth.png tomato.json; do
+for f in tomato.png tomato.label.png tomato.instance.png tomato.depth.png tomato.png.json; do
   if [ -s "$T/$f" ]; then ok "wrote $f"; else bad "wrote $f"; fi
 done
 if python3 - "$T" <<'PY'
@@ -78,7 +78,7 @@ def png(path):
         rows.append(line); prev = line
     vals = [v for r in rows for v in (struct.unpack(">%dH" % (len(r) // 2), r) if bits == 16 else r)]
     return w, h, bits, ch, vals
-meta = json.load(open(f"{d}/tomato.json"))
+meta = json.load(open(f"{d}/tomato.png.json"))
 assert meta["version"] == 1 and meta["width"] == 320 and meta["height"] == 240
 assert abs(meta["intrinsics"]["cx"] - 159.5) < 1e-9
 names = {l["id"]: l["name"] for l in meta["labels"]}

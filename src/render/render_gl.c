@@ -43,6 +43,10 @@ struct gl_api {
   void (*Color3fv)(const GLfloat*);
   const GLubyte* (*GetString)(GLenum);
   GLenum (*GetErrorGL)(void);
+  // the shadow map's depth bias
+  void (*Enable)(GLenum);
+  void (*Disable)(GLenum);
+  void (*PolygonOffset)(GLfloat, GLfloat);
 };
 
 // a symbol of libEGL
@@ -206,6 +210,9 @@ vd_status gl_create(gl_ctx* g, vd_error* err) {
   GLFN(Color3fv, "glColor3fv");
   GLFN(GetString, "glGetString");
   GLFN(GetErrorGL, "glGetError");
+  GLFN(Enable, "glEnable");
+  GLFN(Disable, "glDisable");
+  GLFN(PolygonOffset, "glPolygonOffset");
 #undef GLFN
   const char* ver = (const char*)a->GetString(GL_VERSION);
   const char* ren = (const char*)a->GetString(GL_RENDERER);
@@ -265,4 +272,14 @@ unsigned gl_list(gl_ctx* g, const gl_tris* t) {
 
 void gl_list_free(gl_ctx* g, unsigned list) {
   if (list && g->api) g->api->DeleteLists(list, 1);
+}
+
+void gl_polygon_offset(gl_ctx* g, float factor, float units) {
+  gl_api* a = g->api;
+  if (factor == 0 && units == 0) {
+    a->Disable(GL_POLYGON_OFFSET_FILL);
+    return;
+  }
+  a->PolygonOffset(factor, units);
+  a->Enable(GL_POLYGON_OFFSET_FILL);
 }
