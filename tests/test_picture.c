@@ -189,3 +189,38 @@ TEST(picture, no_shadow_acne) {
   free(label);
   vd_model_destroy(m);
 }
+
+// ---------------------------------------------------------------------------------------------
+// the sidecar
+
+TEST(picture, sidecar_names_opengl) {
+  // which OpenGL drew an image: a GPU and Mesa's llvmpipe differ in the last bits of a picture
+  vd_render_def d = vdt_small_def(32, 24);
+  vd_renderer* r = vdt_renderer(&d);
+  if (!r) return;
+  const vd_render_gl* gl = vd_render_gl_info(r);
+  CHECK(gl->vendor[0] && gl->renderer[0] && gl->version[0]);
+  CHECK(strstr(vd_render_info(r), gl->renderer) != NULL);
+  CHECK(gl->software == (strstr(gl->renderer, "llvmpipe") || strstr(gl->renderer, "softpipe") ||
+                         strstr(gl->renderer, "swrast") || strstr(gl->renderer, "Software")));
+  vd_camera c = {{0, -2, 0.5}, {0, 0, 0.5}, {0, 0, 1}, 0.8, 0.1, 10};
+  vd_frame f;
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK(f.gl == gl);
+  char path[512];
+  snprintf(path, sizeof path, "%s/gl.json", vdt_tmpdir());
+  CHECK_STATUS(vd_render_write_json(&f, NULL, path, &err), VD_OK, err);
+  char* text = NULL;
+  size_t len = 0;
+  CHECK_STATUS(vd_file_read(path, &text, &len, &err), VD_OK, err);
+  if (text) {
+    char want[300];
+    snprintf(want, sizeof want, "\"renderer\":\t\"%s\"", gl->renderer);
+    CHECK(strstr(text, "\"opengl\":") != NULL);
+    CHECK(strstr(text, want) != NULL);
+    CHECK(strstr(text, gl->software ? "\"software\":\ttrue" : "\"software\":\tfalse") != NULL);
+    vd_free(text, len + 1);
+  }
+  vd_render_destroy(r);
+}

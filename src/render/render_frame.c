@@ -477,5 +477,6 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   out->legend = r->legend;
   out->range_min = r->range_min;
   out->range_max = r->range_max;
+  out->gl = &r->gl.id;
   return VD_OK;
 }

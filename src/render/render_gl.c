@@ -116,6 +116,7 @@ static int try_display(gl_ctx* g, EGLDisplay dpy, const char* platform, char* tr
   }
   g->dpy = dpy;
   snprintf(g->info, sizeof g->info, "EGL %d.%d (%s)", maj, min, platform);
+  snprintf(g->id.platform, sizeof g->id.platform, "%s", platform);
   return 1;
 }
 
@@ -216,9 +217,15 @@ vd_status gl_create(gl_ctx* g, vd_error* err) {
 #undef GLFN
   const char* ver = (const char*)a->GetString(GL_VERSION);
   const char* ren = (const char*)a->GetString(GL_RENDERER);
+  const char* ven = (const char*)a->GetString(GL_VENDOR);
+  snprintf(g->id.version, sizeof g->id.version, "%s", ver ? ver : "?");
+  snprintf(g->id.renderer, sizeof g->id.renderer, "%s", ren ? ren : "?");
+  snprintf(g->id.vendor, sizeof g->id.vendor, "%s", ven ? ven : "?");
+  // Mesa's software rasterisers name themselves in GL_RENDERER
+  g->id.software = strstr(g->id.renderer, "llvmpipe") || strstr(g->id.renderer, "softpipe") ||
+                   strstr(g->id.renderer, "swrast") || strstr(g->id.renderer, "Software");
   size_t len = strlen(g->info);
-  snprintf(g->info + len, sizeof g->info - len, ", OpenGL %s, %s", ver ? ver : "?",
-           ren ? ren : "?");
+  snprintf(g->info + len, sizeof g->info - len, ", OpenGL %s, %s", g->id.version, g->id.renderer);
   return VD_OK;
 }
 

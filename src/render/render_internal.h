@@ -21,6 +21,7 @@ typedef struct gl_ctx {
   void* ctx;      // EGLContext
   void* surf;     // EGLSurface (1x1 pbuffer) or NULL when surfaceless
   char info[256]; // "EGL 1.5 (surfaceless), GL 4.5 ..., llvmpipe ..."
+  vd_render_gl id; // which OpenGL implementation this is (platform, vendor, renderer)
 } gl_ctx;
 
 // Create a compatibility-profile context with depth and stencil and make it current.
