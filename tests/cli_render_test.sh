@@ -101,6 +101,18 @@ w, h, bits, ch, rgb = png(f"{d}/tomato.png")
 assert (w, h, bits, ch) == (320, 240, 8, 3)
 PY
 then ok "masks, depth and sidecar agree"; else bad "masks, depth and sidecar agree"; fi
+# the sidecar names the OpenGL that drew the picture, as --info does (GPU or llvmpipe)
+expect "render with info" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/info.png" --depth --size 64x48 --info
+if python3 - "$T/info.png.json" "$T/err" <<'PY'
+import json, sys
+gl = json.load(open(sys.argv[1]))["opengl"]
+info = open(sys.argv[2]).read()
+assert gl["vendor"] and gl["renderer"] and gl["version"] and "?" not in (gl["vendor"], gl["renderer"])
+assert gl["renderer"] in info and gl["version"] in info, (gl, info)
+assert gl["egl_platform"] in ("surfaceless", "device", "default display")
+assert gl["software"] == any(s in gl["renderer"] for s in ("llvmpipe", "softpipe", "swrast", "Software"))
+PY
+then ok "sidecar names the OpenGL renderer"; else bad "sidecar names the OpenGL renderer"; fi
 
 # same seed, same bytes; presets and explicit poses; other colourings
 expect "render again" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/again.png" --masks --depth --size 320x240

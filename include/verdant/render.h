@@ -122,8 +122,21 @@ void vd_render_destroy(vd_renderer* r);
 // Let go of the renderer's OpenGL context on this thread, so that another thread may use the
 // renderer next (a pool of renderers shared by worker threads, one thread at a time).
 void vd_render_release(vd_renderer* r);
+// The OpenGL implementation a renderer draws with: pictures from a GPU and from Mesa's software
+// rasteriser can differ in their last bits, so sidecars record it.
+typedef struct vd_render_gl {
+  char platform[32];  // EGL display used: "surfaceless" (Mesa), "device" (a GPU driver's EGL)
+                      // or "default display"
+  char vendor[128];   // GL_VENDOR: "Mesa", "NVIDIA Corporation", ...
+  char renderer[128]; // GL_RENDERER: "llvmpipe (LLVM 15.0.6, 256 bits)", a GPU's name, ...
+  char version[128];  // GL_VERSION
+  int software;       // 1: a software rasteriser (llvmpipe, softpipe, swrast), 0: hardware
+} vd_render_gl;
+
 // Text describing the OpenGL context ("EGL 1.5 surfaceless, Mesa llvmpipe ..."), for logs.
 const char* vd_render_info(const vd_renderer* r);
+// The OpenGL implementation of the renderer (valid while it lives).
+const vd_render_gl* vd_render_gl_info(const vd_renderer* r);
 // Set the robot's joint positions (MuJoCo qpos, nq values) for the next frames.
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err);
 
@@ -228,6 +241,7 @@ typedef struct vd_frame {
   int nlegend;              // labels present, by id, with names and label colours (the mask key)
   const vd_legend_entry* legend; // (nlegend)
   double range_min, range_max;   // colour scale of stress (Pa) or displacement (m)
+  const vd_render_gl* gl;        // Nullable: the OpenGL implementation that drew it
 } vd_frame;
 
 // Render the scene from camera c; layers is a mask of VD_LAYER_*.
@@ -240,8 +254,9 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* c, unsigned layers, vd
 // Write one layer as PNG: colour RGB 8-bit; depth 16-bit grey in millimetres (0 = nothing,
 // saturating at 65535); label or instance 16-bit grey ids.
 vd_status vd_render_write_png(const vd_frame* f, unsigned layer, const char* path, vd_error* err);
-// Write the sidecar JSON: format version, intrinsics, pose, depth scale, legend, files named in
-// files (Nullable; NULL-terminated pairs "role", "path").
+// Write the sidecar JSON: format version, intrinsics, pose, depth scale, legend, the OpenGL
+// implementation that drew it, files named in files (Nullable; NULL-terminated pairs "role",
+// "path").
 vd_status vd_render_write_json(const vd_frame* f, const char* const* files, const char* path,
                                vd_error* err);
 // Read a PNG (grey or RGB, 8 or 16 bits; alpha dropped) into *pix (w x h x channels values, row 0

@@ -237,6 +237,15 @@ vd_status vd_render_write_json(const vd_frame* f, const char* const* files, cons
     cJSON_AddItemToArray(leg, e);
   }
   cJSON_AddNumberToObject(root, "robot_label", VD_RENDER_ROBOT_LABEL);
+  if (f->gl) {
+    // which OpenGL drew it: a GPU's and Mesa's software pictures differ in their last bits
+    cJSON* gl = cJSON_AddObjectToObject(root, "opengl");
+    cJSON_AddStringToObject(gl, "vendor", f->gl->vendor);
+    cJSON_AddStringToObject(gl, "renderer", f->gl->renderer);
+    cJSON_AddStringToObject(gl, "version", f->gl->version);
+    cJSON_AddStringToObject(gl, "egl_platform", f->gl->platform);
+    cJSON_AddBoolToObject(gl, "software", f->gl->software);
+  }
   cJSON* fl = cJSON_AddObjectToObject(root, "files");
   for (int i = 0; files && files[i] && files[i + 1]; i += 2)
     cJSON_AddStringToObject(fl, files[i], files[i + 1]);
