@@ -122,6 +122,8 @@ typedef struct vd_plant_spec {
 vd_plant_spec* vd_plant_spec_create(void);
 // Free a spec (NULL is fine).
 void vd_plant_spec_destroy(vd_plant_spec* s);
+// Deep copy of a spec (every element and the label table); NULL when out of memory.
+vd_plant_spec* vd_plant_spec_copy(const vd_plant_spec* s);
 // Remove every element, keeping the memory.
 void vd_plant_spec_clear(vd_plant_spec* s);
 // Segment with defaults: nodes -1, radii 0.1 m, up +X, parent -1, label 0, instance 0,
