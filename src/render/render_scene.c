@@ -246,8 +246,9 @@ static int cmp_label(const void* a, const void* b) {
   return (x->id > y->id) - (x->id < y->id);
 }
 
-// label id in a table sorted by id, or NULL
-static const vd_label* find_label(const vd_label* l, int n, int id) {
+// label id in a table sorted by id; an unnamed entry of the default colour (*spare) when the
+// table lacks it
+static const vd_label* find_label(const vd_label* l, int n, int id, vd_label* spare) {
   int lo = 0, hi = n;
   while (lo < hi) {
     int mid = (lo + hi) / 2;
@@ -256,7 +257,9 @@ static const vd_label* find_label(const vd_label* l, int n, int id) {
     else
       hi = mid;
   }
-  return lo < n && l[lo].id == id ? &l[lo] : NULL;
+  if (lo < n && l[lo].id == id) return &l[lo];
+  vd_label_init(spare, id, "");
+  return spare;
 }
 
 // the label table of what is added, coloured by the palette: the table given (Nullable, any
@@ -283,10 +286,7 @@ static vd_status palette_table(const vd_label* tab, int ntab, const int* ids, in
   qsort(l, (size_t)k, sizeof *l, cmp_label);
   int known = k;
   for (int j = 0; j < nid; j++)
-    if (!find_label(l, known, ids[j])) {
-      vd_label_init(&l[k], ids[j], "");
-      k++;
-    }
+    if (find_label(l, known, ids[j], &l[k]) == &l[k]) k++;
   qsort(l, (size_t)k, sizeof *l, cmp_label);
   vd_render_label_colors(l, k, palette, rgb);
   for (int i = 0; i < k; i++)
@@ -354,7 +354,8 @@ static vd_status add_triangles(vd_renderer* r, const vd_mesh* mesh, const unsign
     it->kind = ITEM_PLANT;
     it->label = label;
     it->instance = inst;
-    const vd_label* l = find_label(lab, nlab, label);
+    vd_label spare;
+    const vd_label* l = find_label(lab, nlab, label, &spare);
     if (s->color_by == VD_COLOR_LABEL)
       memcpy(it->rgba, l->rgb, sizeof l->rgb);
     else if (s->color_by == VD_COLOR_INSTANCE)
@@ -422,7 +423,7 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
   md.slices = s.slices;
   if ((st = vd_geom_tessellate(m, d, &md, &mesh, err))) return st;
   // scratch: per-primitive values, per-triangle colours and open-surface flags
-  size_t nt = (size_t)mesh.ntri, nval = (size_t)(m->nseg + m->nsphere + m->nmesh + 1);
+  size_t nt = (size_t)mesh.ntri, nval = (size_t)m->nseg + (size_t)m->nsphere + (size_t)m->nmesh + 1;
   int value_mode = s.color_by == VD_COLOR_STRESS || s.color_by == VD_COLOR_DISPLACEMENT;
   double* val = vd_malloc(sizeof(double) * nval);
   float* tri_rgb = value_mode ? vd_malloc(sizeof(float) * 3 * (nt + 1)) : NULL;
@@ -680,7 +681,8 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
     it->cloud = r->ncloud - 1;
     it->start = g0;
     it->count = g1 - g0;
-    const vd_label* l = find_label(lab, nlab, label);
+    vd_label spare;
+    const vd_label* l = find_label(lab, nlab, label, &spare);
     if (s.color_by == VD_COLOR_INSTANCE)
       instance_rgb(inst, it->rgba);
     else
