@@ -196,6 +196,8 @@ typedef struct cli_render_opts {
   double fps;               // --fps of the MP4 (0: the run's frame rate)
 } cli_render_opts;
 
+// --palette NAME (distinct, natural); 1 on success.
+int cli_parse_palette(const char* s, vd_palette* out);
 // The camera of the options: the explicit pose, or the preset fitted to the box lo..hi.
 vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi);
 // The files of a frame: OUT.png, and with depth or masks OUT.depth.png, OUT.label.png,

@@ -32,6 +32,9 @@ static const char* render_help =
     "      --size WxH        image size in pixels (default 640x480)\n"
     "      --color-by WHAT   label | instance | stress | displacement (default label); stress\n"
     "                        needs a simulation run, a plant at rest has zero displacement\n"
+    "      --palette P       label colours: distinct (default: every label its own colour, organ-\n"
+    "                        like where it can) or natural (the label table's organ colours, in\n"
+    "                        which labels of one organ look alike)\n"
     "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the data's\n"
     "                        (for a run: 0 to the largest value of the whole run)\n"
     "      --depth           also write OUT.depth.png (16-bit grey, millimetres along the optical\n"
@@ -55,6 +58,16 @@ static const char* render_help =
     "  each segment, 4 |M| / (pi r^3), from its curvature (grey where there is none: leaf\n"
     "  blades, fruits). The camera and the colour scale stay fixed over the whole run, and\n"
     "  probes and other colliders are drawn (label 65535 in the masks, as robots).\n";
+
+int cli_parse_palette(const char* s, vd_palette* out) {
+  if (!strcmp(s, "distinct"))
+    *out = VD_PALETTE_DISTINCT;
+  else if (!strcmp(s, "natural"))
+    *out = VD_PALETTE_NATURAL;
+  else
+    return 0;
+  return 1;
+}
 
 // three comma-separated numbers
 static int parse_vec(const char* s, vd_vec3* v) {
@@ -130,7 +143,8 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
     static const char* with_value[] = {"-o",         "--output",      "--camera",     "--eye",
                                        "--lookat",   "--up",          "--fov",        "--size",
                                        "--color-by", "--supersample", "--point-size", "--robot",
-                                       "--time",     "--mp4",         "--fps",        "--range"};
+                                       "--time",     "--mp4",         "--fps",        "--range",
+                                       "--palette"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
       if (!strcmp(a, with_value[k])) {
         if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
@@ -172,6 +186,9 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       else
         return cli_usage_error(
             "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
+    } else if (!strcmp(a, "--palette")) {
+      if (!cli_parse_palette(val, &o->style.palette))
+        return cli_usage_error("render", "--palette expects distinct or natural, got '%s'", val);
     } else if (!strcmp(a, "--range")) {
       char* end;
       errno = 0;

@@ -81,6 +81,7 @@ static void copy_state(const vd_model* m, const vd_data* src, vd_data* dst) {
   memcpy(dst->sphere_pos, src->sphere_pos, sizeof(double) * 3 * (size_t)m->nsphere);
   memcpy(dst->vert_pos, src->vert_pos, sizeof(double) * 3 * (size_t)m->nvert);
   memcpy(dst->seg_broken, src->seg_broken, sizeof(int) * (size_t)m->nseg);
+  memcpy(dst->seg_cut, src->seg_cut, sizeof(double) * 7 * (size_t)m->nseg);
 }
 
 // ---------------------------------------------------------------------------------------------

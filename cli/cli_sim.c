@@ -940,8 +940,9 @@ int cli_sim(int argc, char** argv) {
     }
     if (!st && o.out) st = write_events(d, plant, o.out, &err);
     if (!st && (o.out || o.final)) {
-      vd_sim_to_spec(m, d, spec);
-      if (o.out) {
+      st = vd_sim_to_spec(m, d, spec);
+      if (st) vd_error_set(&err, st, "", 0, 0, "out of memory writing the final plant");
+      if (!st && o.out) {
         char path[4096];
         snprintf(path, sizeof path, "%s/plant.json", o.out);
         st = cli_write_plant(spec, path, 0, &err);

@@ -127,6 +127,21 @@ done
 expect "explicit pose" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/pose.png" --eye 1.5,-1.5,1.2 --lookat 0,0,0.6 --fov 40 --size 160x120
 expect "color by instance" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/inst.png" --color-by instance --size 160x120
 expect "color by displacement" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/disp.png" --color-by displacement --size 160x120
+# label colours: distinct by default, the label table's with --palette natural (sidecar says which)
+expect "palette natural" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/nat.png" --palette natural --masks --size 64x48
+expect "palette bad" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --palette pastel
+expect "grow for palette" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/labels.json"
+if python3 - "$T/tomato.png.json" "$T/nat.png.json" "$T/labels.json" <<'PY'
+import json, sys
+dist, nat, plant = (json.load(open(p)) for p in sys.argv[1:])
+assert dist["palette"] == "distinct" and nat["palette"] == "natural"
+table = {l["id"]: l["rgb"] for l in plant["labels"]}
+for l in nat["labels"]:
+    assert all(abs(a - b) < 1e-6 for a, b in zip(l["rgb"], table[l["id"]])), (l, table[l["id"]])
+rgb = [tuple(round(c, 3) for c in l["rgb"]) for l in dist["labels"]]
+assert len(set(rgb)) == len(rgb), rgb
+PY
+then ok "palettes in the sidecar"; else bad "palettes in the sidecar"; fi
 expect "plant file" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/tomato.json"
 expect "render plant file" 0 "$V" render "$T/tomato.json" -o "$T/fromjson.png" --size 160x120
 

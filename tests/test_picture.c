@@ -24,6 +24,45 @@ static int ink(const vd_frame* f, int x, int y) {
   return lum(f, x, y) < 215 && mx - mn < 40;
 }
 
+// CIE L*a*b* (D65) of an sRGB colour in [0, 1]
+static void srgb_lab(const double c[3], double lab[3]) {
+  double l[3];
+  for (int k = 0; k < 3; k++)
+    l[k] = c[k] <= 0.04045 ? c[k] / 12.92 : pow((c[k] + 0.055) / 1.055, 2.4);
+  double X = (0.4124 * l[0] + 0.3576 * l[1] + 0.1805 * l[2]) / 0.95047;
+  double Y = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+  double Z = (0.0193 * l[0] + 0.1192 * l[1] + 0.9505 * l[2]) / 1.08883;
+  double f[3] = {X, Y, Z};
+  for (int k = 0; k < 3; k++)
+    f[k] = f[k] > 0.008856 ? cbrt(f[k]) : 7.787 * f[k] + 16.0 / 116;
+  lab[0] = 116 * f[1] - 16, lab[1] = 500 * (f[0] - f[1]), lab[2] = 200 * (f[1] - f[2]);
+}
+
+// CIE76 colour difference of two sRGB colours
+static double delta_e(const double a[3], const double b[3]) {
+  double x[3], y[3];
+  srgb_lab(a, x);
+  srgb_lab(b, y);
+  return sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
+              (x[2] - y[2]) * (x[2] - y[2]));
+}
+
+// smallest colour difference between two labels of a table in a palette
+static double palette_min_delta(const char* const* names, int n, vd_palette p) {
+  vd_label lab[16];
+  float rgb[16][3];
+  for (int i = 0; i < n; i++)
+    vd_label_init(&lab[i], i + 1, names[i]);
+  vd_render_label_colors(lab, n, p, rgb);
+  double best = 1e9;
+  for (int i = 0; i < n; i++)
+    for (int j = i + 1; j < n; j++) {
+      double a[3] = {rgb[i][0], rgb[i][1], rgb[i][2]}, b[3] = {rgb[j][0], rgb[j][1], rgb[j][2]};
+      best = fmin(best, delta_e(a, b));
+    }
+  return best;
+}
+
 // ---------------------------------------------------------------------------------------------
 // the legend
 
@@ -223,4 +262,72 @@ TEST(picture, sidecar_names_opengl) {
     vd_free(text, len + 1);
   }
   vd_render_destroy(r);
+}
+
+// ---------------------------------------------------------------------------------------------
+// label colours
+
+TEST(picture, palette_tells_classes_apart) {
+  // the bundled plants' label tables: labels of one organ kind (trunk and branch; leaf,
+  // peduncle and pedicel) had near-identical colours (CIE76 5.2 for trunk/branch, 11.6 for
+  // leaf/peduncle); the default palette keeps every pair at least 25 apart
+  static const char* tomato[] = {"stem", "leaf", "peduncle", "pedicel", "fruit", "flower"};
+  static const char* tree[] = {"trunk", "branch", "leaf", "root"};
+  static const char* arabidopsis[] = {"internode", "leaf", "flower", "silique"};
+  static const char* many[] = {"stem", "branch", "twig", "leaf", "leaflet", "petiole", "flower",
+                               "petal", "fruit", "berry", "pedicel", "peduncle", "root", "a",
+                               "b"};
+  CHECK(palette_min_delta(tomato, 6, VD_PALETTE_DISTINCT) >= 25);
+  CHECK(palette_min_delta(tree, 4, VD_PALETTE_DISTINCT) >= 25);
+  CHECK(palette_min_delta(arabidopsis, 4, VD_PALETTE_DISTINCT) >= 25);
+  CHECK(palette_min_delta(many, 15, VD_PALETTE_DISTINCT) >= 25);
+  // the natural palette is the label table's (organ colours), kept as an option
+  CHECK(palette_min_delta(tree, 4, VD_PALETTE_NATURAL) < 10);
+  // organ-like where it can: leaf green, fruit red (green and red channels dominate)
+  vd_label lab[6];
+  float rgb[6][3];
+  for (int i = 0; i < 6; i++)
+    vd_label_init(&lab[i], i + 1, tomato[i]);
+  vd_render_label_colors(lab, 6, VD_PALETTE_DISTINCT, rgb);
+  CHECK(rgb[1][1] > rgb[1][0] && rgb[1][1] > rgb[1][2]);
+  CHECK(rgb[4][0] > rgb[4][1] && rgb[4][0] > rgb[4][2]);
+
+  // in a picture of the tomato, the mean colours of the labels' pixels stay apart too
+  vd_render_def d = vdt_small_def(480, 360);
+  vd_renderer* r = vdt_renderer(&d);
+  if (!r) return;
+  vd_model* m = vdt_tomato(2);
+  REQUIRE(m);
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+  vd_vec3 lo, hi;
+  vd_render_bounds(r, &lo, &hi);
+  vd_camera c = vd_camera_preset(VD_CAMERA_FRONT, 0, 0, lo, hi, d.width, d.height);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR | VD_LAYER_LABEL, &f, &err), VD_OK, err);
+  CHECK(f.palette == VD_PALETTE_DISTINCT);
+  double sum[8][3] = {{0}};
+  int count[8] = {0};
+  for (int i = 0; f.label && i < f.width * f.height; i++) {
+    int l = f.label[i];
+    if (l < 1 || l > 6) continue;
+    count[l]++;
+    for (int k = 0; k < 3; k++)
+      sum[l][k] += f.rgb[3 * i + k] / 255.0;
+  }
+  int pairs = 0;
+  for (int a = 1; a <= 6; a++)
+    for (int b = a + 1; b <= 6; b++) {
+      if (count[a] < 20 || count[b] < 20) continue;
+      double ca[3], cb[3];
+      for (int k = 0; k < 3; k++)
+        ca[k] = sum[a][k] / count[a], cb[k] = sum[b][k] / count[b];
+      double de = delta_e(ca, cb);
+      if (de < 15) fprintf(stderr, "  labels %d and %d: colour difference %.1f\n", a, b, de);
+      CHECK(de >= 15);
+      pairs++;
+    }
+  CHECK(pairs >= 6);
+  vd_render_destroy(r);
+  vd_model_destroy(m);
 }

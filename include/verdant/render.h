@@ -151,9 +151,25 @@ typedef enum vd_color_by {
   VD_COLOR_DISPLACEMENT, // a colour scale of the distance from the rest shape (m)
 } vd_color_by;
 
+// Colours of labels (colour by label, and the legend).
+typedef enum vd_palette {
+  VD_PALETTE_DISTINCT = 0, // every label its own colour, at least 29 CIE76 units apart in L*a*b*
+                           // for 15 labels, organ-like where it can (leaf green, fruit red, stem
+                           // brown, flower yellow; a second stem or leaf label gets another)
+  VD_PALETTE_NATURAL,      // the label table's colours (by organ kind: labels of one organ, such
+                           // as trunk and branch or peduncle and pedicel, look alike)
+} vd_palette;
+
+// Colours of a label table (sorted by id, as a model's) in a palette into rgb (nlabel x 3): the
+// distinct palette hands its colours out in id order, each label taking the first free colour its
+// organ prefers, then the first free one; beyond 15 labels, hues by the golden ratio.
+void vd_render_label_colors(const vd_label* labels, int nlabel, vd_palette palette,
+                            float (*rgb)[3]);
+
 // Look of one plant or cloud.
 typedef struct vd_render_style {
   vd_color_by color_by;     // default VD_COLOR_LABEL
+  vd_palette palette;       // label colours; default VD_PALETTE_DISTINCT
   const double* seg_stress; // Nullable: stress per segment (Pa) (nseg), needed by VD_COLOR_STRESS;
                             // NaN: no value (drawn grey), infinite: refused
   double range_min;         // colour scale minimum (Pa or m); with range_max <= range_min the
@@ -163,8 +179,8 @@ typedef struct vd_render_style {
                             // frame); NULL: the model's rest shape; default NULL
 } vd_render_style;
 
-// Defaults: colour by label, no stress, automatic range, slices 0, displacement from the rest
-// shape (ref NULL).
+// Defaults: colour by label in the distinct palette, no stress, automatic range, slices 0,
+// displacement from the rest shape (ref NULL).
 vd_render_style vd_render_style_default(void);
 
 // Remove every plant and cloud added since the last clear.
@@ -238,6 +254,7 @@ typedef struct vd_frame {
   vd_intrinsics K;          // camera intrinsics and pose
   vd_camera camera;         // the camera drawn from
   vd_color_by color_by;     // colouring of the first plant or cloud
+  vd_palette palette;       // its label colours
   int nlegend;              // labels present, by id, with names and label colours (the mask key)
   const vd_legend_entry* legend; // (nlegend)
   double range_min, range_max;   // colour scale of stress (Pa) or displacement (m)

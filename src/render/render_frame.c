@@ -473,6 +473,7 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   out->K = vd_camera_intrinsics(cam, w, h);
   out->camera = *cam;
   out->color_by = r->color_by;
+  out->palette = r->palette;
   out->nlegend = r->nlegend;
   out->legend = r->legend;
   out->range_min = r->range_min;

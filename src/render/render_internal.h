@@ -100,6 +100,7 @@ struct vd_renderer {
   vd_legend_entry* legend; // labels in use, sorted by id (nlegend)
   int nlegend, cap_legend;
   vd_color_by color_by;        // colouring of the first plant or cloud
+  vd_palette palette;          // its label colours
   int nadded;                  // plants and clouds added
   double range_min, range_max; // colour scale of the last value-coloured plant
   vd_vec3 lo, hi;              // bounds of everything added

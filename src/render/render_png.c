@@ -222,6 +222,7 @@ vd_status vd_render_write_json(const vd_frame* f, const char* const* files, cons
   cJSON_AddNumberToObject(root, "depth_scale", 0.001);
   cJSON_AddStringToObject(root, "depth_unit", "mm, 0 = no surface");
   cJSON_AddStringToObject(root, "color_by", color_by_name(f->color_by));
+  cJSON_AddStringToObject(root, "palette", f->palette == VD_PALETTE_NATURAL ? "natural" : "distinct");
   if (f->color_by == VD_COLOR_STRESS || f->color_by == VD_COLOR_DISPLACEMENT) {
     double rg[2] = {f->range_min, f->range_max};
     cJSON_AddItemToObject(root, "range", cJSON_CreateDoubleArray(rg, 2));
