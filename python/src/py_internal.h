@@ -131,10 +131,15 @@ extern PyTypeObject* vdpy_plant_class;
 extern PyTypeObject* vdpy_mesh_class;
 extern PyTypeObject* vdpy_cloud_class;
 
+// The plant model of a Sim and its plant state at the Sim's current rod state (the Sim's own
+// buffer, valid until the next call).
+const vd_data* vdpy_sim_plant_state(PyObject* sim, const vd_model** plant);
+
 // Module functions.
 PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_load(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_cloud(PyObject* self, PyObject* args, PyObject* kw);
+PyObject* vdpy_read_png(PyObject* self, PyObject* args, PyObject* kw);
 
 // A new Plant owning spec (taken) with its model compiled; NULL with an exception set (spec
 // freed).

@@ -215,6 +215,9 @@ static PyMethodDef methods[] = {
      "load(path, *, labels=None, seed=0) -> Plant: read a plant JSON file."},
     {"read_cloud", (PyCFunction)(void (*)(void))vdpy_read_cloud, METH_VARARGS | METH_KEYWORDS,
      "read_cloud(path) -> Cloud: read a cloud file written by verdant (.ply .pcd .xyz .csv .las)."},
+    {"read_png", (PyCFunction)(void (*)(void))vdpy_read_png, METH_VARARGS | METH_KEYWORDS,
+     "read_png(path) -> numpy array: a PNG as written by verdant render (H x W x 3 uint8 colour,\n"
+     "H x W uint16 depth in mm or label/instance ids)."},
     {"_register", (PyCFunction)(void (*)(void))mod_register, METH_VARARGS | METH_KEYWORDS,
      "_register(plant=, mesh=, cloud=): Python subclasses the extension returns."},
     {"alloc_bytes", mod_alloc_bytes, METH_NOARGS,
@@ -234,8 +237,9 @@ PyMODINIT_FUNC PyInit__verdant(void) {
   import_array();
   PyObject* mod = PyModule_Create(&module);
   if (!mod) return NULL;
-  PyTypeObject* types[] = {&vdpy_plant_type, &vdpy_mesh_type, &vdpy_cloud_type};
-  const char* names[] = {"Plant", "Mesh", "Cloud"};
+  PyTypeObject* types[] = {&vdpy_plant_type, &vdpy_mesh_type, &vdpy_cloud_type, &vdpy_sim_type,
+                           &vdpy_renderer_type};
+  const char* names[] = {"Plant", "Mesh", "Cloud", "Sim", "Renderer"};
   for (int k = 0; k < (int)(sizeof types / sizeof types[0]); k++)
     if (PyType_Ready(types[k]) < 0 || PyModule_AddObjectRef(mod, names[k], (PyObject*)types[k]) < 0)
       goto fail;

@@ -28,7 +28,7 @@ def test_docs_tour_runs(tmp_path):
     blocks = re.findall(r"```python\n(.*?)```", text, re.S)
     assert len(blocks) >= 3
     env = {}
-    os.chdir(SRC)
+    os.chdir(tmp_path)  # files the tour writes land here; its data/ paths point into the source
     try:
         for b in blocks:
             if "import open3d" in b:
@@ -39,7 +39,7 @@ def test_docs_tour_runs(tmp_path):
                 b = b.replace("o3d.visualization.draw_geometries", "(lambda g: g)")
             if "bad.lpy" in b:
                 continue  # an illustration of errors
-            b = b.replace('"tomato.', f'"{tmp_path}/tomato.')
+            b = b.replace('"data/', f'"{SRC}/data/')
             exec(compile(b, "docs/python.md", "exec"), env)
     finally:
         os.chdir(os.path.dirname(__file__))

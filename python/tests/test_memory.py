@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Reference counts and memory stay flat over 10,000 calls of each kind (success and failure)."""
 import gc
+import os
 import sys
 
 import numpy as np
@@ -10,6 +11,8 @@ import verdant
 from test_plant import TINY
 
 N = 10000
+# under the sanitizers (make test SANITIZE=1) freed memory sits in quarantine: RSS is not checked
+RSS_LIMIT = float("inf") if os.environ.get("VERDANT_SANITIZE") else 4096
 
 
 def rss_kib():
@@ -49,7 +52,7 @@ def test_grow_cloud_arrays_flat():
 
     grown, rss, objs = run(once)
     assert grown == 0, f"library memory grew by {grown} bytes"
-    assert rss < 4096, f"RSS grew by {rss} KiB over {N} calls"
+    assert rss < RSS_LIMIT, f"RSS grew by {rss} KiB over {N} calls"
     assert abs(objs) < 50, f"{objs} more live objects"
     assert sys.getrefcount(plant) == refs
 
@@ -69,7 +72,7 @@ def test_errors_flat(tmp_path):
                 raise AssertionError("no error")
 
     grown, rss, objs = run(once, N // 4)
-    assert grown == 0 and rss < 4096 and abs(objs) < 50, (grown, rss, objs)
+    assert grown == 0 and rss < RSS_LIMIT and abs(objs) < 50, (grown, rss, objs)
 
 
 def test_library_memory_returns_to_zero():

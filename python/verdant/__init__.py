@@ -40,12 +40,14 @@ from ._verdant import (  # noqa: F401  (the exception classes are part of the AP
     UnsupportedError,
     WrongTypeError,
     alloc_bytes,
+    read_png,
 )
 
 __version__ = _verdant.version
 
 __all__ = [
-    "grow", "load", "read_cloud", "Plant", "Mesh", "Cloud",
+    "grow", "load", "read_cloud", "read_png", "render", "Plant", "Mesh", "Cloud", "Sim",
+    "Renderer",
     "Error", "ParseError", "UnsupportedError", "UndefinedNameError", "WrongTypeError",
     "BadValueError", "ModelAssertionError", "LimitError", "FileError", "FormatError",
     "OutOfMemoryError", "ArgumentError",
@@ -189,6 +191,116 @@ class Cloud(_verdant.Cloud):
 
     def __repr__(self):
         return f"<verdant.Cloud {len(self)} points, labels {self.labels}>"
+
+
+class Sim(_verdant.Sim):
+    """Sim(plant, **options): the plant as Cosserat rods (XPBD with the exact tree solver), in SI
+    units; the options of `verdant sim` (docs/physics.md):
+
+    build: segment_length (m, 0.02), clamp_length (m, 0.01), clamp_roots, leaf_graphs,
+        sag_free (the modelled shape is the equilibrium under gravity), stake (m, 0: none),
+        max_segments; materials: young (Pa), density (kg/m^3), poisson, break_force (N),
+        break_moment (N m), break_strain ((cs, cb)): a number for every class or
+        {class: value} with classes green, wood, pedicel, leaf, fruit, flower, root;
+        float('inf') disables a threshold.
+    run (also set() between steps): dt (s, 1e-3), iterations, solver ('direct' or 'gs'),
+        gravity (m/s^2), wind (m/s), gust ((amplitude, period s)), wind_series (rows t, vx, vy,
+        vz), drag, stokes (Pa s), damping (s), mass_damping (1/s), fracture, contacts,
+        friction, self_collision.
+    ground: height of the ground plane (m, default 0), None for none.
+
+    step(n) and settle() release the GIL, so threads step their own Sims side by side. Between
+    steps: add_collider / add_mesh_collider / move_collider, apply_force (a node or an organ
+    name), add_tie / move_tie, node_force and seg_torque (writable views). The state arrays
+    (node_pos, node_vel, seg_quat, seg_broken, ...) are views of the state: they change with
+    every step. stress is computed on access (Pa per rod segment); events lists fractures;
+    stats is `verdant sim --stats`; plant() the deformed plant (`--final`).
+    """
+
+    __slots__ = ()
+
+    def cloud(self, **options):
+        """A labelled point cloud of the deformed plant: plant().cloud(**options)."""
+        return self.plant().cloud(**options)
+
+    def save(self, path, ascii=False):
+        """Write the deformed plant (.json, .obj, .ply): plant().save(path)."""
+        self.plant().save(path, ascii=ascii)
+
+    def __repr__(self):
+        return (f"<verdant.Sim t={self.time:.4g} s, {len(self.node_pos)} nodes, "
+                f"{len(self.seg_quat)} rod segments, {len(self.colliders)} colliders>")
+
+
+class Renderer(_verdant.Renderer):
+    """Renderer(*, size=(640, 480), supersample=2, shadows=True, floor=True, sky=True,
+    background=None, legend=True, robot=None, max_geoms=20000): an offscreen renderer (EGL and
+    MuJoCo's renderer, headless; software rendering without a GPU). Its settings are fixed;
+    draw(objects, ...) makes one picture (see verdant.render). Creating one costs 0.2-0.4 s with
+    software rendering, so keep it for many pictures; it is used by one thread at a time and may
+    be handed between threads. Raises UnsupportedError where no OpenGL context can be made."""
+
+    __slots__ = ()
+
+    def __repr__(self):
+        w, h = self.size
+        return f"<verdant.Renderer {w}x{h}: {self.info}>"
+
+
+_local = __import__("threading").local()
+
+
+def _geoms_needed(objects):
+    need = 16
+    for o in objects:
+        if isinstance(o, _verdant.Cloud):
+            need += len(o)
+        elif isinstance(o, _verdant.Sim):
+            need += o.initial_plant._geometry["instances"] + len(o.colliders)
+        elif isinstance(o, _verdant.Plant):
+            need += o._geometry["instances"]
+    return need
+
+
+def render(objects, *, camera="orbit", azimuth=-60, elevation=20, eye=None, lookat=None,
+           up=None, fov=45, size=(640, 480), masks=True, depth=True, color_by="label",
+           range=None, point_size=None, supersample=2, shadows=True, floor=True, sky=True,
+           legend=True, robot=None, robot_qpos=None, renderer=None):
+    """Draw a Plant, a Sim (its current state, with its colliders) or a Cloud, or a list of
+    them, headless, as `verdant render` does. Returns a dict of numpy arrays:
+
+    rgb: H x W x 3 uint8 colour (with a legend unless legend=False);
+    depth: H x W float32, metres along the optical axis, 0 where nothing (depth=True);
+    label, instance: H x W int32 masks, 0 = background, exact (masks=True);
+    K: 3 x 3 intrinsics (OpenCV: u = fx X/Z + cx, v = fy Y/Z + cy, pixel centres at integers);
+    pose: 4 x 4 camera-to-world (columns: camera X right, Y down, Z forward; then the centre);
+    intrinsics, camera (eye, lookat, up, fovy rad, znear, zfar), legend, and range (stress or
+    displacement colour scale).
+
+    camera: 'front', 'side', 'top' or 'orbit' (azimuth, elevation in degrees) fitted to the
+    scene; or eye and lookat (m) with up and fov (degrees). color_by: 'label', 'instance',
+    'stress' (a Sim), 'displacement'; range (min, max) of its scale (Pa or m). point_size:
+    splat half-size of cloud points (m). robot: an MJCF file drawn at its reference pose or at
+    robot_qpos. A renderer with these settings is kept per thread and reused (renderer= gives
+    your own). Raises UnsupportedError where no OpenGL context can be made.
+    """
+    objs = list(objects) if isinstance(objects, (list, tuple)) else [objects]
+    if renderer is None:
+        key = (tuple(size), supersample, bool(shadows), bool(floor), bool(sky), bool(legend),
+               None if robot is None else str(robot))
+        cache = getattr(_local, "renderers", None)
+        if cache is None:
+            cache = _local.renderers = {}
+        need = _geoms_needed(objs)
+        renderer = cache.get(key)
+        if renderer is None or renderer.max_geoms < need:
+            cache.pop(key, None)
+            renderer = Renderer(size=size, supersample=supersample, shadows=shadows, floor=floor,
+                                sky=sky, legend=legend, robot=robot, max_geoms=max(need, 20000))
+            cache[key] = renderer
+    return renderer.draw(objs, camera=camera, azimuth=azimuth, elevation=elevation, eye=eye,
+                         lookat=lookat, up=up, fov=fov, color_by=color_by, range=range,
+                         point_size=point_size, depth=depth, masks=masks, robot_qpos=robot_qpos)
 
 
 _verdant._register(plant=Plant, mesh=Mesh, cloud=Cloud)
