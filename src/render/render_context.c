@@ -270,6 +270,10 @@ const char* vd_render_info(const vd_renderer* r) {
   return r->gl.info;
 }
 
+const vd_render_gl* vd_render_gl_info(const vd_renderer* r) {
+  return &r->gl.id;
+}
+
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err) {
   if (!r->def.robot_mjcf)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the renderer has no robot");

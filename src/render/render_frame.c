@@ -253,6 +253,15 @@ static void draw_legend(vd_renderer* r, int w, int h, int k) {
 // ---------------------------------------------------------------------------------------------
 // drawing
 
+// shadow map: the half-width of the key light's view, a multiple of the bounding sphere's radius;
+// the depth offset, in depth slopes per texel and in steps of the depth buffer. A texel's depth
+// varies by tan(angle of incidence) texels across it and a fragment sits up to sqrt(2)/2 of a
+// texel from the texel centre, so a slope factor of 2 keeps a lit face clear of its own shadow
+// up to the incidence where the light grazes it (docs/render.md)
+#define SHADOW_CLIP 1.02
+#define SHADOW_SLOPE_BIAS 2.0f
+#define SHADOW_UNIT_BIAS 4.0f
+
 // set every light: a light at the camera (with the ambient term) and the key light
 static void set_lights(vd_renderer* r, const vd_camera* c, vd_vec3 ctr, double reach) {
   mjvScene* scn = &r->scn;
@@ -414,7 +423,9 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
     mjvScene* scn = &r->scn;
     set_lights(r, cam, ctr, reach);
     set_camera(r, cam);
-    r->con.shadowClip = (float)(1.5 * reach);
+    // the key light's shadow map covers the bounding sphere of what is drawn (the light looks at
+    // its centre), no more: every texel spent where shadows can fall
+    r->con.shadowClip = (float)(SHADOW_CLIP * reach);
     scn->flags[mjRND_CULL_FACE] = 1;
     scn->flags[mjRND_REFLECTION] = 0;
     mjr_setBuffer(mjFB_OFFSCREEN, &r->con);
@@ -425,7 +436,14 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
       scn->flags[mjRND_SKYBOX] = 1;
       set_lists(r, 1);
       mjrRect vp = {0, 0, w * k, h * k};
+      // depth bias of the shadow map (shadow acne, docs/render.md): MuJoCo 2.2.2 keeps the
+      // back faces (as seen from the light) and compares without a bias, so a lit face
+      // shadows itself wherever a texel's depth slope exceeds the thickness behind it; the
+      // offset applies to every pass of this draw alike, so the lit and the shadow passes
+      // still meet depth for depth
+      gl_polygon_offset(&r->gl, SHADOW_SLOPE_BIAS, SHADOW_UNIT_BIAS);
       mjr_render(vp, scn, &r->con);
+      gl_polygon_offset(&r->gl, 0, 0);
       if (r->def.legend && r->nadded) draw_legend(r, w * k, h * k, k);
       mjr_readPixels(r->big, NULL, vp, &r->con);
       downsample(r->big, r->rgb, w, h, k);
@@ -455,9 +473,11 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   out->K = vd_camera_intrinsics(cam, w, h);
   out->camera = *cam;
   out->color_by = r->color_by;
+  out->palette = r->palette;
   out->nlegend = r->nlegend;
   out->legend = r->legend;
   out->range_min = r->range_min;
   out->range_max = r->range_max;
+  out->gl = &r->gl.id;
   return VD_OK;
 }

@@ -21,6 +21,7 @@ typedef struct gl_ctx {
   void* ctx;      // EGLContext
   void* surf;     // EGLSurface (1x1 pbuffer) or NULL when surfaceless
   char info[256]; // "EGL 1.5 (surfaceless), GL 4.5 ..., llvmpipe ..."
+  vd_render_gl id; // which OpenGL implementation this is (platform, vendor, renderer)
 } gl_ctx;
 
 // Create a compatibility-profile context with depth and stencil and make it current.
@@ -42,6 +43,9 @@ typedef struct gl_tris {
 
 // Compile a display list of triangles; returns its name, 0 on failure.
 unsigned gl_list(gl_ctx* g, const gl_tris* t);
+// Offset the depth of filled polygons by factor x their depth slope + units x the depth
+// resolution (glPolygonOffset); 0, 0 turns the offset off.
+void gl_polygon_offset(gl_ctx* g, float factor, float units);
 // Delete a display list (0 is fine).
 void gl_list_free(gl_ctx* g, unsigned list);
 
@@ -96,6 +100,7 @@ struct vd_renderer {
   vd_legend_entry* legend; // labels in use, sorted by id (nlegend)
   int nlegend, cap_legend;
   vd_color_by color_by;        // colouring of the first plant or cloud
+  vd_palette palette;          // its label colours
   int nadded;                  // plants and clouds added
   double range_min, range_max; // colour scale of the last value-coloured plant
   vd_vec3 lo, hi;              // bounds of everything added
