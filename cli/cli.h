@@ -194,6 +194,7 @@ typedef struct cli_render_opts {
   int has_time;             // --time given
   double time;              // --time (s)
   double fps;               // --fps of the MP4 (0: the run's frame rate)
+  int disp_from_first;      // --displacement-from first (runs): from frame 0, not the model
 } cli_render_opts;
 
 // --palette NAME (distinct, natural); 1 on success.

@@ -35,8 +35,10 @@ static const char* render_help =
     "      --palette P       label colours: distinct (default: every label its own colour, organ-\n"
     "                        like where it can) or natural (the label table's organ colours, in\n"
     "                        which labels of one organ look alike)\n"
-    "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the data's\n"
-    "                        (for a run: 0 to the largest value of the whole run)\n"
+    "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the values\n"
+    "                        of the plant still attached (a fallen fruit or broken branch lies\n"
+    "                        beyond the scale, in its end colour); for a run: 0 to the largest\n"
+    "                        such value of the whole run\n"
     "      --depth           also write OUT.depth.png (16-bit grey, millimetres along the optical\n"
     "                        axis, 0 = nothing) and OUT.png.json (intrinsics, pose)\n"
     "      --masks           also write OUT.label.png and OUT.instance.png (16-bit ids, 0 =\n"
@@ -54,10 +56,13 @@ static const char* render_help =
     "      --mp4 OUT.mp4     every frame as an H.264 video (needs Debian's ffmpeg; skipped\n"
     "                        with a message when it is not installed)\n"
     "      --fps N           frame rate of the video (default: the run's, from its frame times)\n"
-    "  Displacement is measured from the first frame; stress is the largest bending stress of\n"
-    "  each segment, 4 |M| / (pi r^3), from its curvature (grey where there is none: leaf\n"
-    "  blades, fruits). The camera and the colour scale stay fixed over the whole run, and\n"
-    "  probes and other colliders are drawn (label 65535 in the masks, as robots).\n";
+    "      --displacement-from model|first\n"
+    "                        displacement from the plant as modelled (default: a settled run\n"
+    "                        shows its sag) or from the run's first frame (the timed motion)\n"
+    "  Stress is the largest bending stress of each segment, 4 |M| / (pi r^3), from its\n"
+    "  curvature (grey where there is none: leaf blades, fruits). The camera and the colour\n"
+    "  scale stay fixed over the whole run, and probes and other colliders are drawn (label\n"
+    "  65535 in the masks, as robots).\n";
 
 int cli_parse_palette(const char* s, vd_palette* out) {
   if (!strcmp(s, "distinct"))
@@ -144,7 +149,7 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
                                        "--lookat",   "--up",          "--fov",        "--size",
                                        "--color-by", "--supersample", "--point-size", "--robot",
                                        "--time",     "--mp4",         "--fps",        "--range",
-                                       "--palette"};
+                                       "--palette",  "--displacement-from"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
       if (!strcmp(a, with_value[k])) {
         if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
@@ -186,6 +191,11 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       else
         return cli_usage_error(
             "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
+    } else if (!strcmp(a, "--displacement-from")) {
+      if (strcmp(val, "model") != 0 && strcmp(val, "first") != 0)
+        return cli_usage_error("render", "--displacement-from expects model or first, got '%s'",
+                               val);
+      o->disp_from_first = !strcmp(val, "first");
     } else if (!strcmp(a, "--palette")) {
       if (!cli_parse_palette(val, &o->style.palette))
         return cli_usage_error("render", "--palette expects distinct or natural, got '%s'", val);
@@ -340,10 +350,9 @@ int cli_render(int argc, char** argv) {
   if (!o.out) return cli_usage_error("render", "missing -o OUT.png");
   if (!cli_has_ext(o.out, ".png"))
     return cli_usage_error("render", "output '%s' must end in .png", o.out);
-  if (o.has_time || o.mp4 || o.fps > 0)
-    return cli_usage_error(
-        "render",
-        "--time, --mp4 and --fps apply to simulation runs (a folder of 'verdant sim -o')");
+  if (o.has_time || o.mp4 || o.fps > 0 || o.disp_from_first)
+    return cli_usage_error("render", "--time, --mp4, --fps and --displacement-from first apply to "
+                                     "simulation runs (a folder of 'verdant sim -o')");
   {
     // no output may replace an input (the plant file, the robot)
     char files[5][4200];

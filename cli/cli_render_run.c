@@ -60,20 +60,6 @@ static void box_frame(box* b, const vd_model* m, const vd_data* d, const vd_sim_
   }
 }
 
-// largest distance of the state's points from the reference's (m)
-static double max_moved(const vd_model* m, const vd_data* d, const vd_data* ref) {
-  double best = 0;
-  const double* a[3] = {d->node_pos, d->sphere_pos, d->vert_pos};
-  const double* b[3] = {ref->node_pos, ref->sphere_pos, ref->vert_pos};
-  int n[3] = {m->nnode, m->nsphere, m->nvert};
-  for (int k = 0; k < 3; k++)
-    for (int i = 0; i < 3 * n[k]; i += 3) {
-      double dx = a[k][i] - b[k][i], dy = a[k][i + 1] - b[k][i + 1], dz = a[k][i + 2] - b[k][i + 2];
-      best = fmax(best, sqrt(dx * dx + dy * dy + dz * dz));
-    }
-  return best;
-}
-
 // copy a plant state (same model)
 static void copy_state(const vd_model* m, const vd_data* src, vd_data* dst) {
   memcpy(dst->node_pos, src->node_pos, sizeof(double) * 3 * (size_t)m->nnode);
@@ -329,6 +315,10 @@ int cli_render_run(const cli_render_opts* o) {
     goto fail;
   }
   box bx = {vd_v3(0, 0, 0), vd_v3(0, 0, 0), 0, o->def.floor};
+  // displacement from the plant as modelled (its rest shape: a settled run shows its sag), or
+  // from the first frame (--displacement-from first: the motion of the timed run only)
+  style.ref = o->disp_from_first ? ref : NULL;
+  style.seg_stress = stress;
   double vmax = 0;
   for (int k = 0; k < run.nframe; k++) {
     if ((st = cli_run_load(&run, k, &err))) goto fail;
@@ -336,17 +326,16 @@ int cli_render_run(const cli_render_opts* o) {
     const vd_sim_collider* col;
     int ncol = cli_run_colliders(&run, k, &col);
     box_frame(&bx, pm, run.pstate, col, ncol);
-    if (style.color_by == VD_COLOR_DISPLACEMENT) vmax = fmax(vmax, max_moved(pm, run.pstate, ref));
-    if (style.color_by == VD_COLOR_STRESS) {
-      vd_sim_plant_stress(run.sim, run.state, pm, stress);
-      for (int j = 0; j < pm->nseg; j++)
-        if (isfinite(stress[j])) vmax = fmax(vmax, stress[j]);
+    // the scale of the plant still attached in this frame (a fallen fruit lies beyond it)
+    if (value) {
+      double lo, hi;
+      if (style.color_by == VD_COLOR_STRESS) vd_sim_plant_stress(run.sim, run.state, pm, stress);
+      if ((st = vd_render_value_range(pm, run.pstate, &style, &lo, &hi, &err))) goto fail;
+      vmax = fmax(vmax, hi);
     }
   }
   if (value && !(style.range_max > style.range_min) && vmax > 0)
     style.range_min = 0, style.range_max = vmax;
-  style.ref = ref;
-  style.seg_stress = stress;
   // the renderer, with room for every organ instance and collider
   vd_render_def def = o->def;
   if (pm->ninstance + VD_SIM_MAX_COLLIDERS + 16 > def.max_geoms)

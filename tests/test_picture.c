@@ -331,3 +331,78 @@ TEST(picture, palette_tells_classes_apart) {
   vd_render_destroy(r);
   vd_model_destroy(m);
 }
+
+// ---------------------------------------------------------------------------------------------
+// colour scales
+
+TEST(picture, scale_follows_the_attached_plant) {
+  // the tomato moved 3 cm, one fruit fallen 1 m below its calyx and a branch broken off and
+  // dropped 0.5 m: the automatic scale is the plant's 3 cm (was 1 m), and the parts that came off
+  // are drawn in the scale's end colour
+  vd_model* m = vdt_tomato(1);
+  REQUIRE(m);
+  vd_data* d = vd_data_create(m);
+  REQUIRE(d);
+  for (int i = 0; i < 3 * m->nnode; i += 3)
+    d->node_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nsphere; i += 3)
+    d->sphere_pos[i] += 0.03;
+  for (int i = 0; i < 3 * m->nvert; i += 3)
+    d->vert_pos[i] += 0.03;
+  vd_render_style s = vd_render_style_default();
+  s.color_by = VD_COLOR_DISPLACEMENT;
+  double lo, hi;
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_value_range(m, d, &s, &lo, &hi, &err), VD_OK, err);
+  CHECK_NEAR(lo, 0.03, 1e-9);
+  CHECK_NEAR(hi, 0.03, 1e-9);
+  // a fruit falls: its sphere leaves its attachment node
+  int fruit = -1;
+  for (int k = 0; k < m->nsphere && fruit < 0; k++)
+    if (m->sphere_node[k] >= 0 || m->sphere_parent[k] >= 0) fruit = k;
+  REQUIRE(fruit >= 0);
+  d->sphere_pos[3 * fruit + 2] -= 1.0;
+  CHECK_STATUS(vd_render_value_range(m, d, &s, &lo, &hi, &err), VD_OK, err);
+  CHECK_NEAR(hi, 0.03, 1e-9);
+  // a branch breaks off: a segment with children, marked broken, its subtree dropped 0.5 m
+  int cut = -1;
+  for (int j = 0; j < m->nseg && cut < 0; j++)
+    if (m->seg_parent[j] >= 0 && m->seg_parent[m->seg_parent[j]] >= 0)
+      for (int c = 0; c < m->nseg; c++)
+        if (m->seg_parent[c] == j) cut = j;
+  REQUIRE(cut >= 0);
+  d->seg_broken[cut] = 1;
+  for (int j = 0; j < m->nseg; j++) {
+    int a = j;
+    while (a >= 0 && a != cut)
+      a = m->seg_parent[a];
+    if (a == cut) d->node_pos[3 * m->seg_node[2 * j + 1] + 2] -= 0.5;
+  }
+  CHECK_STATUS(vd_render_value_range(m, d, &s, &lo, &hi, &err), VD_OK, err);
+  CHECK_NEAR(hi, 0.03, 1e-9);
+  // a fixed range is the caller's; the plant renderer takes the attached scale too
+  vd_render_def def = vdt_small_def(64, 48);
+  vd_renderer* r = vdt_renderer(&def);
+  if (r) {
+    CHECK_STATUS(vd_render_add_plant(r, m, d, &s, &err), VD_OK, err);
+    vd_vec3 blo, bhi;
+    vd_render_bounds(r, &blo, &bhi);
+    vd_camera c = vd_camera_preset(VD_CAMERA_FRONT, 0, 0, blo, bhi, 64, 48);
+    vd_frame f;
+    CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+    CHECK_NEAR(f.range_max, 0.03, 1e-9);
+    vd_render_destroy(r);
+  }
+  // stress: the same rule
+  s.color_by = VD_COLOR_STRESS;
+  double* stress = malloc(sizeof(double) * (size_t)m->nseg);
+  REQUIRE(stress);
+  for (int j = 0; j < m->nseg; j++)
+    stress[j] = j == cut ? 1e9 : 1e6;
+  s.seg_stress = stress;
+  CHECK_STATUS(vd_render_value_range(m, d, &s, &lo, &hi, &err), VD_OK, err);
+  CHECK_NEAR(hi, 1e6, 1e-3);
+  free(stress);
+  vd_data_destroy(d);
+  vd_model_destroy(m);
+}

@@ -173,7 +173,8 @@ typedef struct vd_render_style {
   const double* seg_stress; // Nullable: stress per segment (Pa) (nseg), needed by VD_COLOR_STRESS;
                             // NaN: no value (drawn grey), infinite: refused
   double range_min;         // colour scale minimum (Pa or m); with range_max <= range_min the
-  double range_max;         // scale spans the data; default 0, 0
+  double range_max;         // scale spans the attached plant's values (vd_render_value_range);
+                            // default 0, 0
   int slices;               // tessellation sides (>= 3), or 0 for each primitive's own; default 0
   const vd_data* ref;       // Nullable: state displacement is measured from (a run's first
                             // frame); NULL: the model's rest shape; default NULL
@@ -188,6 +189,15 @@ void vd_render_clear(vd_renderer* r);
 // Add plant model m in state d (Nullable: its rest shape) with style s (Nullable: defaults).
 vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* d,
                               const vd_render_style* s, vd_error* err);
+
+// The colour scale vd_render_add_plant gives plant m in state d (Nullable: at rest) under style
+// (Nullable: defaults) when the style fixes none: the smallest and largest stress (Pa) or
+// displacement (m) of the primitives still joined to the root (a segment that broke and what
+// lies beyond it, a fruit that left its attachment node are left out and drawn in the end
+// colour; all primitives when none is left); 0, 0 for other colourings or no values. A caller
+// drawing many states (the frames of a run) takes the union for one scale.
+vd_status vd_render_value_range(const vd_model* m, const vd_data* d, const vd_render_style* style,
+                                double* lo, double* hi, vd_error* err);
 
 // A point cloud to splat: arrays owned by the caller.
 typedef struct vd_points {

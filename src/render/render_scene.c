@@ -220,6 +220,87 @@ static void prim_values(const vd_model* m, const vd_data* d, const vd_render_sty
   }
 }
 
+// 1 for each primitive still joined to the plant's root, 0 for parts that came off (att:
+// nseg + nsphere + nmesh; stack: nseg scratch). A broken segment and everything beyond it are
+// off; so is a sphere or mesh whose parent is off, or a sphere that moved away from its
+// attachment node or its parent's end (a fruit fallen at its calyx: the joint is not one of the
+// plant's segments)
+static void prim_attached(const vd_model* m, const vd_data* d, unsigned char* att, int* stack) {
+  int ns = m->nseg;
+  memset(att, 0, (size_t)ns); // 0 unknown, 1 attached, 2 off
+  for (int i = 0; i < ns; i++) {
+    // walk up to a known segment or the root, then set the path from the top down
+    int n = 0, j = i, state = 1;
+    while (j >= 0 && !att[j] && n < ns) {
+      if (d && d->seg_broken[j]) {
+        att[j] = 2;
+        break;
+      }
+      stack[n++] = j;
+      j = m->seg_parent[j];
+    }
+    if (j >= 0 && att[j]) state = att[j];
+    while (n > 0)
+      att[stack[--n]] = (unsigned char)state;
+  }
+  for (int i = 0; i < ns; i++)
+    att[i] = att[i] == 1;
+  unsigned char* sph = att + ns;
+  unsigned char* msh = sph + m->nsphere;
+  for (int k = 0; k < m->nsphere; k++) {
+    // its attachment node, or the end of its parent segment
+    int par = m->sphere_parent[k], node = m->sphere_node[k];
+    if (node < 0 && par >= 0) node = m->seg_node[2 * par + 1];
+    sph[k] = par < 0 || att[par];
+    if (sph[k] && d && node >= 0) {
+      // still as near its node as at rest, give or take its radius
+      double rest = moved(m->sphere_pos0 + 3 * k, m->node_pos0 + 3 * node);
+      double now = moved(d->sphere_pos + 3 * k, d->node_pos + 3 * node);
+      sph[k] = now <= rest + m->sphere_radius[k] + 1e-3;
+    }
+  }
+  for (int k = 0; k < m->nmesh; k++)
+    msh[k] = m->mesh_parent[k] < 0 || att[m->mesh_parent[k]];
+}
+
+// colour scale of values (nseg + nsphere + nmesh; NaN: none) over the attached primitives (the
+// whole plant when none of them has a value); 0, 0 when nothing has one
+static void value_range(const vd_model* m, const double* val, const unsigned char* att, double* lo,
+                        double* hi) {
+  int n = m->nseg + m->nsphere + m->nmesh;
+  for (int pass = 0; pass < 2; pass++) {
+    *lo = INFINITY, *hi = -INFINITY;
+    for (int i = 0; i < n; i++)
+      if (isfinite(val[i]) && (pass || att[i])) *lo = fmin(*lo, val[i]), *hi = fmax(*hi, val[i]);
+    if (*hi >= *lo) return;
+  }
+  *lo = *hi = 0;
+}
+
+vd_status vd_render_value_range(const vd_model* m, const vd_data* d, const vd_render_style* style,
+                                double* lo, double* hi, vd_error* err) {
+  *lo = *hi = 0;
+  vd_render_style s = style ? *style : vd_render_style_default();
+  vd_status st = check_style(&s, m->nseg, err);
+  if (st) return st;
+  if (s.color_by != VD_COLOR_STRESS && s.color_by != VD_COLOR_DISPLACEMENT) return VD_OK;
+  size_t n = (size_t)m->nseg + (size_t)m->nsphere + (size_t)m->nmesh + 1;
+  double* val = vd_malloc(sizeof(double) * n);
+  unsigned char* att = vd_malloc(n);
+  int* stack = vd_malloc(sizeof(int) * ((size_t)m->nseg + 1));
+  if (val && att && stack) {
+    prim_values(m, d, &s, val, val + m->nseg, val + m->nseg + m->nsphere);
+    prim_attached(m, d, att, stack);
+    value_range(m, val, att, lo, hi);
+  } else {
+    st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  vd_free(val, sizeof(double) * n);
+  vd_free(att, n);
+  vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
+  return st;
+}
+
 // half thickness given to open surfaces (leaves) drawn from both sides (m): the two faces lie
 // apart, so neither shadows nor depth-tests the other (real leaves are 0.1-0.5 mm thick)
 #define LEAF_HALF_THICKNESS 1e-4
@@ -438,11 +519,21 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
   double lo = s.range_min, hi = s.range_max;
   if (value_mode) {
     prim_values(m, d, &s, vseg, vsph, vmsh);
+    // without a fixed range, the scale spans the plant still attached: a fruit that fell or a
+    // branch that broke off lies beyond it (in the end colour) instead of washing out the plant
     if (!(hi > lo)) {
-      lo = INFINITY, hi = -INFINITY;
-      for (int i = 0; i < m->nseg + m->nsphere + m->nmesh; i++)
-        if (isfinite(val[i])) lo = fmin(lo, val[i]), hi = fmax(hi, val[i]);
-      if (!(hi >= lo)) lo = hi = 0;
+      unsigned char* att = vd_malloc(nval);
+      int* stack = vd_malloc(sizeof(int) * ((size_t)m->nseg + 1));
+      if (!att || !stack) {
+        vd_free(att, nval);
+        vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
+        st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+        goto done;
+      }
+      prim_attached(m, d, att, stack);
+      value_range(m, val, att, &lo, &hi);
+      vd_free(att, nval);
+      vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
     }
     r->range_min = lo;
     r->range_max = hi;
