@@ -98,6 +98,27 @@ int cli_in_folder(const char* dir, const char* path);
 
 // The files of a plant output: path, and for .obj its material library (.mtl); returns the count.
 int cli_plant_files(const char* path, char files[2][4200]);
+// A command's outputs, written together or not at all.
+typedef struct cli_outset {
+  int n, cap;            // outputs
+  char** path;           // the outputs (n)
+  char** backup;         // where the file an output replaces waits, NULL or "" when none (n)
+  unsigned char* fresh;  // 1 when the output did not exist before (n)
+  unsigned char* stale;  // 1 for a file this run does not write, removed when the set completes (n)
+  int slot;              // entry in the signal handler's table, -1 none
+} cli_outset;
+// Before writing: every output must be writable (not a folder, in a folder that exists and takes
+// files: else VD_ERR_IO naming it, nothing touched); the files they replace are kept aside.
+// stale (Nullable, n entries): outputs of an earlier run this one does not write (frames.bin of a
+// run now writing frames.jsonl), removed when the set completes.
+vd_status cli_outset_begin(cli_outset* s, const char* const* paths, int n, const unsigned char* stale,
+                           vd_error* err);
+// After writing: ok drops the kept files; else every output is removed and the files they
+// replaced are put back. Ends the set (cli_outset_begin failed: nothing to end).
+void cli_outset_end(cli_outset* s, int ok);
+// For the signal handler: put back every set in progress (async-signal-safe).
+void cli_outsets_rollback(void);
+
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
 

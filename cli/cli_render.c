@@ -302,10 +302,17 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
   sibling(out, "label.png", p_label, sizeof p_label);
   sibling(out, "instance.png", p_inst, sizeof p_inst);
   snprintf(p_json, sizeof p_json, "%s.json", out);
-  // an interrupt removes the temporary files of these outputs
+  // the files appear together or not at all; an interrupt removes their temporary files
+  char set_path[5][4200];
+  const char* set_out[5];
+  int nset = cli_frame_files(out, depth, masks, set_path);
+  for (int k = 0; k < nset; k++) set_out[k] = set_path[k];
+  cli_outset set;
+  vd_status st = cli_outset_begin(&set, set_out, nset, NULL, err);
+  if (st) return st;
   int watch[5] = {cli_watch(out), cli_watch(p_depth), cli_watch(p_label), cli_watch(p_inst), cli_watch(p_json)};
   // colour, then depth and masks, then the sidecar naming them
-  vd_status st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
+  st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
   if (!st && depth) st = vd_render_write_png(f, VD_LAYER_DEPTH, p_depth, err);
   if (!st && masks) st = vd_render_write_png(f, VD_LAYER_LABEL, p_label, err);
   if (!st && masks) st = vd_render_write_png(f, VD_LAYER_INSTANCE, p_inst, err);
@@ -322,6 +329,7 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
     st = vd_render_write_json(f, files, p_json, err);
   }
   for (int k = 0; k < 5; k++) cli_unwatch(watch[k]);
+  cli_outset_end(&set, st == VD_OK);
   return st;
 }
 

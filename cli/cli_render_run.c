@@ -234,6 +234,39 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
 // ---------------------------------------------------------------------------------------------
 // the command
 
+// the set of every file the command writes: one frame (and its siblings) or every frame of the
+// folder and its index, the video
+static vd_status begin_outputs(const cli_render_opts* o, const cli_run* run, const char* folder, const char* mp4,
+                               int single, cli_outset* set, vd_error* err) {
+  int per = 1 + (o->depth || o->masks) + o->depth + 2 * o->masks;
+  int cap = (folder ? run->nframe * per + 1 : 0) + (single ? per : 0) + 1, n = 0;
+  char** path = vd_calloc((size_t)cap, sizeof(char*));
+  if (!path) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_status st = VD_OK;
+  char files[5][4200];
+  for (int k = 0; !st && folder && k <= run->nframe; k++) {
+    int nf = 1;
+    if (k < run->nframe) {
+      char png[4200];
+      snprintf(png, sizeof png, "%s/frame_%05d.png", folder, k);
+      nf = cli_frame_files(png, o->depth, o->masks, files);
+    } else {
+      snprintf(files[0], sizeof files[0], "%s/frames.json", folder);
+    }
+    for (int i = 0; i < nf && !st; i++)
+      if (!(path[n++] = vd_strdup(files[i]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  int nf = !st && single ? cli_frame_files(o->out, o->depth, o->masks, files) : 0;
+  if (!st && mp4) snprintf(files[nf++], sizeof files[0], "%s", mp4);
+  for (int i = 0; i < nf && !st; i++)
+    if (!(path[n++] = vd_strdup(files[i]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (!st) st = cli_outset_begin(set, (const char* const*)path, n, NULL, err);
+  for (int i = 0; i < n; i++)
+    if (path[i]) vd_free(path[i], strlen(path[i]) + 1);
+  vd_free(path, (size_t)cap * sizeof(char*));
+  return st;
+}
+
 // the colliders of a frame as solids (planes are the floor's business)
 static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int ncol,
                                vd_error* err) {
@@ -301,6 +334,8 @@ int cli_render_run(const cli_render_opts* o) {
   memset(&vid, 0, sizeof vid);
   int progress = o->po.progress;
   int writing = 0; // the failure, if any, is in writing the outputs
+  int made_dir = 0, has_set = 0;
+  cli_outset set;
   if ((st = cli_run_open(o->po.path, &run, &err))) return cli_report(cmd, &err, st);
   const vd_model* pm = run.plant;
   int want = o->has_time ? vd_sim_frames_nearest(run.frames, o->time) : run.nframe - 1;
@@ -358,11 +393,16 @@ int cli_render_run(const cli_render_opts* o) {
     cam = cli_render_camera(o, lo, hi);
   }
   writing = 1;
-  if (folder && mkdir(folder, 0777) != 0 && errno != EEXIST) {
+  if (folder && mkdir(folder, 0777) == 0)
+    made_dir = 1;
+  else if (folder && errno != EEXIST) {
     st = vd_error_set(&err, VD_ERR_IO, folder, 0, 0, "cannot create the folder: %s",
                       strerror(errno));
     goto fail;
   }
+  // every file of the command appears together or not at all
+  if ((st = begin_outputs(o, &run, folder, mp4, single, &set, &err))) goto fail;
+  has_set = 1;
   // frames: one, or every one into the folder and the video
   unsigned layers = VD_LAYER_COLOR | (o->depth ? VD_LAYER_DEPTH : 0) |
                     (o->masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
@@ -415,6 +455,8 @@ fail:
   if (writing) code = EXIT_FAIL;
 done:
   if (vid.pid) video_finish(&vid, mp4, 0, NULL);
+  if (has_set) cli_outset_end(&set, code == EXIT_OK);
+  if (made_dir && code != EXIT_OK) rmdir(folder);  // only when empty
   vd_render_destroy(r);
   vd_free(stress, sizeof(double) * (size_t)(pm->nseg ? pm->nseg : 1));
   vd_data_destroy(ref);

@@ -48,5 +48,56 @@ if cmp -s ds/item_000000.json tom.keep; then ok "dataset input untouched"; else 
 cp tom.json ds/plant.json
 expect "dataset beside its input" 0 "$V" dataset ds/plant.json --count 1 -N 100 -o ds
 
+# --- a command's outputs appear together or not at all (issue 12, item 3) ---
+# an output that cannot be written (a folder in its place) stops the command before anything
+mkdir out.obj
+expect "grow .obj onto a folder" 1 "$V" grow tom.json -o out.obj
+expect_err "the folder is named" "out.obj: cannot write: it is a folder"
+if [ ! -e out.mtl ]; then ok "no .mtl without its .obj"; else bad "no .mtl without its .obj"; fi
+rmdir out.obj && mkdir out.mtl
+expect "grow .obj with a folder for its .mtl" 1 "$V" grow tom.json -o out.obj
+if [ ! -e out.obj ]; then ok "no .obj without its .mtl"; else bad "no .obj without its .mtl"; fi
+rmdir out.mtl
+mkdir r.label.png
+expect "render with a folder for its mask" 1 "$V" render tom.json -o r.png --masks --depth --size 64x48
+if ls r.png r.depth.png r.instance.png r.png.json 2>/dev/null; then bad "no image without its masks"; else ok "no image without its masks"; fi
+expect "grow into a missing folder" 1 "$V" grow tom.json -o nowhere/t.obj
+# a run that fails half way (unstable) takes back every file it wrote: a new folder goes, an
+# earlier run in the folder comes back as it was
+A="$SRC/data/arabidopsis.lpy"
+UNSTABLE=(--young 1e6 --density 100 --dt 0.01 --duration 0.5 --wind 5,0,0 --gust 0.5,0.5 --self-collision)
+expect "unstable run into a new folder" 1 "$V" sim "$A" -o newrun "${UNSTABLE[@]}"
+if [ ! -e newrun ]; then ok "no run folder after a failed run"; else bad "no run folder after a failed run ($(ls newrun))"; fi
+expect "a run" 0 "$V" sim "$A" -o oldrun --duration 0.01 --final oldrun.obj
+md5sum oldrun/* oldrun.obj oldrun.mtl >before.md5
+expect "unstable run over it" 1 "$V" sim "$A" -o oldrun --final oldrun.obj "${UNSTABLE[@]}"
+if md5sum -c --quiet before.md5 && [ "$(ls oldrun | wc -l)" -eq 6 ]; then ok "the earlier run kept"; else bad "the earlier run kept"; fi
+# a run with other frames removes the earlier run's frames with the rest of its files
+expect "a run with JSON Lines frames" 0 "$V" sim "$A" -o oldrun --duration 0.01 --frames jsonl
+if [ -s oldrun/frames.jsonl ] && [ ! -e oldrun/frames.bin ]; then ok "no stale frames.bin"; else bad "no stale frames.bin"; fi
+if ls oldrun/*.bak.* oldrun/*.tmp.* 2>/dev/null; then bad "nothing kept aside"; else ok "nothing kept aside"; fi
+# a full disk half way through a run's files: the earlier run comes back (hard links take no room)
+if mkdir full && mount -t tmpfs -o size=1m tmpfs full 2>/dev/null; then
+  trap 'umount "$T/full" 2>/dev/null; rm -rf "$T"' EXIT
+  expect "a small run on a small disk" 0 "$V" sim "$A" -o full/run --duration 0.01
+  md5sum full/run/* >full.md5
+  expect "a run too large for the disk" 1 "$V" sim "$A" -o full/run --duration 2 --fps 1000
+  if md5sum -c --quiet full.md5 && [ "$(ls full/run | wc -l)" -eq 6 ]; then ok "disk full: earlier run kept"; else bad "disk full: earlier run kept"; fi
+  expect "a dataset too large for the disk" 1 "$V" dataset "$A" --count 20 -N 50000 -o full/ds
+  if ls full/ds/*.tmp.* full/ds/*.bak.* 2>/dev/null; then bad "disk full: no partial item"; else ok "disk full: no partial item"; fi
+  for r in full/ds/item_*.json; do
+    [ -e "$r" ] || continue
+    c="${r%.json}.ply"
+    if [ -s "$c" ]; then ok "item $(basename "$r") whole"; else bad "item $(basename "$r") whole"; fi
+  done
+  for c in full/ds/item_*.ply; do
+    [ -e "$c" ] || continue
+    if [ -e "${c%.ply}.json" ]; then ok "cloud $(basename "$c") has its record"; else bad "cloud $(basename "$c") has its record"; fi
+  done
+  umount full
+else
+  echo "skip full-disk cases (mounting a tmpfs is not permitted here)"
+fi
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
