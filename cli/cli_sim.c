@@ -77,7 +77,10 @@ static const char* sim_help_output =
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
-    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n";
+    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n"
+    "      --profile           time each stage of the steps and the frame output; --stats then\n"
+    "                          has stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
+    "                          project, velocity, fracture, frames)\n";
 
 // a closed triangle mesh from a Wavefront OBJ file: "v x y z" and "f i j k ..." lines (1-based
 // or negative indices, "i/t/n" forms, polygons split in fans); other lines are skipped
@@ -234,7 +237,7 @@ typedef struct sim_opts {
   const char* out;
   double duration;
   int duration_set;
-  int settle, statics, stats;
+  int settle, statics, stats, profile;
   double ke_tol;
   const char* frames;
   double fps;
@@ -502,7 +505,7 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
 // the summary
 
 static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant, double wall, int64_t steps,
-                       int settled, int settle_steps) {
+                       int settled, int settle_steps, double frames_s) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return 0;
   int node;
@@ -546,6 +549,12 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON* wk = cJSON_AddObjectToObject(root, "warning_counts");
   for (int k = 0; k < VD_SIM_WARN_COUNT; k++)
     cJSON_AddNumberToObject(wk, vd_sim_warning_name((vd_sim_warning)k), (double)d->warning[k]);
+  if (d->profile) {
+    cJSON* sg = cJSON_AddObjectToObject(root, "stage_seconds");
+    for (int k = 0; k < VD_SIM_STAGE_COUNT; k++)
+      cJSON_AddNumberToObject(sg, vd_sim_stage_name((vd_sim_stage)k), d->stage_seconds[k]);
+    cJSON_AddNumberToObject(sg, "frames", frames_s);
+  }
   char* text = cJSON_Print(root);
   cJSON_Delete(root);
   if (!text) return 0;
@@ -718,6 +727,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      o->profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error(cmd, "unknown option '%s'", a);
     } else if (!o->po.path) {
@@ -821,6 +832,7 @@ int cli_sim(int argc, char** argv) {
     m->opt.wind_series = wind;
     m->opt.nwind = nwind;
     d = vd_sim_data_create(m);
+    if (d) d->profile = o.profile;
     if (!d) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   // organs to pull, colliders
@@ -904,6 +916,7 @@ int cli_sim(int argc, char** argv) {
     double start = d->time, total = o.duration, next_frame = start;
     double ramp = o.ramp_set ? o.ramp : total;
     int show = o.po.progress && total / m->opt.dt > 2000;
+    double frames_s = 0;
     if (out.frames_open) frames_write(&out, m, d), next_frame += 1.0 / o.fps;
     for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
       double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
@@ -922,7 +935,9 @@ int cli_sim(int argc, char** argv) {
       }
       st = vd_sim_step(m, d);
       if (out.frames_open && d->time >= next_frame - 1e-12) {
+        double tf = o.profile ? cli_now() : 0;
         if (frames_write(&out, m, d)) break;  // reported by the commit below
+        if (o.profile) frames_s += cli_now() - tf;
         next_frame += 1.0 / o.fps;
       }
       if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);
@@ -996,7 +1011,7 @@ int cli_sim(int argc, char** argv) {
       code = EXIT_FAIL;
       goto done;
     }
-    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps)) code = EXIT_FAIL;
+    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps, frames_s)) code = EXIT_FAIL;
   }
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);

@@ -112,6 +112,7 @@ void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d) {
   d->max_penetration = 0;
   d->nwarning = 0;
   memset(d->warning, 0, sizeof d->warning);
+  memset(d->stage_seconds, 0, sizeof d->stage_seconds);
 }
 
 void vd_sim_data_destroy(vd_sim_data* d) {

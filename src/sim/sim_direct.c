@@ -179,6 +179,7 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     g[0] += cc.x / at, g[1] += cc.y / at, g[2] += cc.z / at;
     (void)lam;
   }
+  sim_stage(d, VD_SIM_STAGE_EVAL, ctx->tstage);
   // forward elimination: children before parents; h and s end up holding inverses. The
   // Jacobians are used block by block: J_c = [[a, b], [0, g]], J_p = [[-a, 0], [0, -g]].
   for (int oi = 0; oi < nseg; oi++) {
@@ -277,6 +278,7 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
       mv6(hs, ng, w->dy + 6 * pb);
     }
   }
+  sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
   // back substitution: parents before children
   for (int oi = nseg - 1; oi >= 0; oi--) {
     int t = m->seg_order[oi];
@@ -356,6 +358,7 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     double* lam = w->tie_lambda + 3 * k;
     lam[0] = -cc.x / at, lam[1] = -cc.y / at, lam[2] = -cc.z / at;
   }
+  sim_stage(d, VD_SIM_STAGE_SOLVE, ctx->tstage);
   return 1;
 }
 
@@ -365,6 +368,7 @@ int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   for (int it = 0; it < iters; it++) {
     if (!iterate(m, d, w, c)) return 0;
     if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact);
+    sim_stage(d, VD_SIM_STAGE_PROJECT, c->tstage);
   }
   return 1;
 }

@@ -212,7 +212,20 @@ typedef struct sim_step_ctx {
   struct sim_contact* contacts;  // contact candidates of this step
   int ncontact;                  // their count
   int last;                      // 1: the smallest substep, an overstretched state is kept
+  double* tstage;                // running timestamp of the stage profile (sim_stage)
 } sim_step_ctx;
+
+// Monotonic clock (s) for the stage profile.
+double sim_clock(void);
+// While d->profile is on: add the time since *t to stage s and set *t to now.
+static inline void sim_stage(vd_sim_data* d, vd_sim_stage s, double* t) {
+  if (!d->profile) return;
+  double now = sim_clock();
+  d->stage_seconds[s] += now - *t;
+  *t = now;
+}
+// The start of a timed span (0 when not profiling).
+static inline double sim_stage_start(const vd_sim_data* d) { return d->profile ? sim_clock() : 0.0; }
 
 // Count one numerical warning of kind k (vd_sim_warning) in d->warning and d->nwarning.
 static inline void sim_warn(vd_sim_data* d, int k) {

@@ -134,12 +134,16 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   sim_step_ctx c = *cin;
   double h = c.h;
   int na = m->nnode_all, ns = m->nseg;
+  double tp = sim_stage_start(d);
+  c.tstage = &tp;
   vd_arena_reset(&d->arena);
   // the stretch at the start: a step may not double it beyond VD_SIM_MAX_STRAIN (a stretch the
   // state already had, e.g. from a contact holding a node, is not a new failure)
   double strain0 = c.statics ? 0 : max_stretch(m, d);
+  sim_stage(d, VD_SIM_STAGE_VELOCITY, &tp);
   // loads at the start of the step
   sim_forces(m, d, w);
+  sim_stage(d, VD_SIM_STAGE_FORCES, &tp);
   memcpy(w->node_prev, d->node_pos, (size_t)na * sizeof(vd_vec3));
   memcpy(w->seg_prev, d->seg_quat, (size_t)ns * sizeof(vd_quat));
   if (c.gamma > 0)
@@ -179,6 +183,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
       d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_scale(op, h));
     }
   }
+  sim_stage(d, VD_SIM_STAGE_PREDICT, &tp);
   // contact candidates near the predicted state
   c.contacts = NULL;
   c.ncontact = 0;
@@ -193,13 +198,16 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     // self-contacts: each primitive reaches twice its own nodes' displacement (sim_self.c)
     if (m->opt.self_collision) c.ncontact = sim_self_find(m, d, 0.002, c.contacts, c.ncontact, &c.contacts);
   }
+  sim_stage(d, VD_SIM_STAGE_CONTACTS, &tp);
   // constraints
   // statics needs the primal residual that only the direct solver keeps
   int solved = 1;
-  if (m->opt.solver == VD_SIM_GS && !c.statics)
+  if (m->opt.solver == VD_SIM_GS && !c.statics) {
     sim_solve_gs(m, d, &c);
-  else
+    sim_stage(d, VD_SIM_STAGE_SOLVE, &tp);
+  } else {
     solved = sim_solve_direct(m, d, &c);
+  }
   // contacts have the last word (no penetration), then friction
   d->ncontact = c.ncontact;
   d->max_penetration = 0;
@@ -211,6 +219,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
       if (-s > d->max_penetration) d->max_penetration = -s;
     }
   }
+  sim_stage(d, VD_SIM_STAGE_PROJECT, &tp);
   // a failed step: put the previous state back and say why; at the smallest substep a state
   // stretched up to VD_SIM_BLOWUP_STRAIN is kept (counted), beyond it the step fails
   int fail = !finite_state(m, d) ? VD_SIM_WARN_NONFINITE : !solved ? VD_SIM_WARN_SOLVER : -1;
@@ -242,7 +251,9 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     vd_vec3 dq = quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])));
     d->seg_omega[t] = vd_scale(dq, damp / h);
   }
+  sim_stage(d, VD_SIM_STAGE_VELOCITY, &tp);
   if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
+  sim_stage(d, VD_SIM_STAGE_FRACTURE, &tp);
   for (int k = 0; k < d->ncollider; k++) d->collider[k].vel = vd_v3(0, 0, 0);
   d->time += c.statics ? 0.0 : h;
   return -1;
