@@ -170,6 +170,65 @@ typedef struct sim_self {
 } sim_self;
 
 // ---------------------------------------------------------------------------------------------
+// the direct solver's schedule and blocks (sim_plan.c, sim_direct.c)
+
+#define SIM_W 4             // bodies eliminated side by side in one block (lanes)
+#define SIM_MAX_THREADS 64  // most threads one state's step may use
+
+// One block of SIM_W bodies, each field an array over the lanes (structure of arrays), so
+// the elimination's 6x6 and 3x3 block arithmetic runs lane-parallel (vectorised). A body is
+// one free segment: its end node and its frame (6 dofs); its joint is the segment's
+// stretch-shear rows (in world axes here) and its bend-twist rows with the parent. Symmetric
+// 6x6 matrices are stored as [A (3x3 upper: 00 01 02 11 12 22) | B (3x3 row-major) | D (upper)].
+typedef struct sim_blk {
+  double h[21][SIM_W];   // body matrix H, then its inverse
+  double s[21][SIM_W];   // joint Schur matrix S = J H^-1 J^T + alpha~', then its inverse
+  double g[6][SIM_W];    // body residual (position rows N s^2, rotation rows N m s^2)
+  double r[6][SIM_W];    // joint right-hand side
+  double e[3][SIM_W];    // segment vector x_end - x_start (m)
+  double gm[9][SIM_W];   // bend-twist Jacobian G (1/m, row-major)
+  double c[6][SIM_W];    // damped constraint values c': stretch rows in world axes (m), bend (1/m)
+  double al[9][SIM_W];   // damped compliances alpha~': stretch (upper 3x3, world), bend (diagonal)
+  double lf[6][SIM_W];   // the joint's multipliers: stretch as R lambda_s / l0 (world), bend
+  double mi[5][SIM_W];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib, and d3 through rot
+  double dh[21][SIM_W];  // contribution J_p^T S^-1 J_p to the parent's H
+  double dg[6][SIM_W];   // contribution to the parent's g
+  double dy[6][SIM_W];   // body update (m, rad)
+  double dl[6][SIM_W];   // multiplier update (world stretch rows, bend rows)
+  double ok[SIM_W];      // 1 while both factorisations of the lane held
+  double d3[3][SIM_W];   // tips: the frame's d3
+} sim_blk;
+
+// The elimination schedule of a model for nthread threads: blocks in an order where every
+// body's children come in earlier blocks; thread k eliminates its subtrees' blocks
+// [part[k], part[k+1]), then one thread the top part [part[nthread], nblock). Each body sums
+// its children's contributions in the fixed order of kid_slot, so any schedule and any thread
+// count give the same bytes.
+typedef struct sim_plan {
+  int nbody, nblock, nslot;  // free segments, blocks, nblock * SIM_W
+  int nthread;               // threads the blocks are cut for
+  int part[SIM_MAX_THREADS + 2];
+  int* slot_seg;             // segment of each slot, -1 for padding (nslot)
+  int* seg_slot;             // slot of each segment, -1 when fixed (nseg)
+  int* par_slot;             // slot of the parent body, -1 when kinematic or padding (nslot)
+  int* kid_start;            // children of slot s: kid_slot[kid_start[s] .. kid_start[s + 1]) (nslot + 1)
+  int* kid_slot;             // (nbody)
+  unsigned char* tip_block;  // 1 when block b holds tips (no children) only (nblock)
+  double* tie_h;             // ties on each slot's node, then on each spare: sum of h^2 / compliance (nslot + nspare)
+  double* tie_g;             // ... and their residual sum c h^2 / compliance ((nslot + nspare) x 3)
+  double* spare_dy;          // update of each spare node this iteration (nspare x 3)
+  sim_blk* blk;              // the blocks (nblock, 64-byte aligned inside mem)
+  void* mem;                 // one allocation for all of the above
+  size_t nbytes;             // its size
+} sim_plan;
+
+// Build the schedule of model m for nthread threads (1..SIM_MAX_THREADS) into p (freed and
+// replaced); VD_ERR_NOMEM when out of memory (p then empty).
+vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p);
+// Free a plan (an empty one is fine).
+void sim_plan_free(sim_plan* p);
+
+// ---------------------------------------------------------------------------------------------
 // solver scratch kept in vd_sim_data::work
 
 typedef struct sim_work {
@@ -181,15 +240,10 @@ typedef struct sim_work {
   double* c_prev;       // constraint values at the start of the step (nseg x 6)
   double* lambda_save;  // multipliers before a statics step, to undo it (nseg x 6)
   int* spare_of;        // spare index -> segment (nspare)
-  // direct solver (bodies: nseg segments then nspare spares)
-  double* h;            // body matrices, then their inverses (nbody x 36)
-  double* gb;           // body right-hand sides (nbody x 6)
-  double* dy;           // body updates (nbody x 6)
-  double* s;            // inverses of the joint Schur matrices (nseg x 36)
-  double* r;            // joint right-hand sides (nseg x 6)
-  double* x;            // H_child^-1 J_child^T (nseg x 36)
-  double* dl;           // joint multiplier updates (nseg x 6)
-  sim_joint* joint;     // joints linearised this iteration (nseg)
+  // direct solver
+  sim_plan plan;        // its schedule and blocks
+  double* rot;          // rotation matrix of every frame this iteration (nseg x 9)
+
   double* tie_lambda;   // multipliers of model and user ties (ntie_all x 3)
   int cap_tie_lambda;   // capacity of tie_lambda (rows)
   int model_ties;       // stake ties of the model (the first rows)
