@@ -135,12 +135,16 @@ static double seg_param(const vd_sim_collider* k, vd_vec3 a, vd_vec3 b) {
 // its radius. (Node spheres of the segment radius reach r along the axis as well: they pushed
 // the first free node of the tree's upright trunk, r = 8.2 cm, from 3 cm above the ground to
 // 8.2 cm, stretching the 2 cm segment below it by 260 %.)
-static void plane_reach(const vd_sim_model* m, const vd_sim_data* d, vd_vec3 n, double* reach) {
+// Only segments with an end in near[] (a node whose height above the plane, less its largest
+// radius, is below the margin) are looked at: the others cannot make a candidate.
+static void plane_reach(const vd_sim_model* m, const vd_sim_data* d, vd_vec3 n, const unsigned char* near,
+                        double* reach) {
   for (int i = 0; i < m->nnode_all; i++)
     reach[i] = m->node_sphere[i] > 0 ? m->node_sphere[i] : -1;
   for (int t = 0; t < m->nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FRUITSEG) continue;
     int a = d->seg_start[t], b = m->seg_node[2 * t + 1];
+    if (!near[a] && !near[b]) continue;
     vd_vec3 e = vd_sub(d->node_pos[b], d->node_pos[a]);
     double l2 = vd_dot(e, e), en = vd_dot(e, n);
     double s2 = l2 > 0 ? 1 - en * en / l2 : 1;
@@ -150,13 +154,33 @@ static void plane_reach(const vd_sim_model* m, const vd_sim_data* d, vd_vec3 n, 
   }
 }
 
+// a ball around collider k (centre, radius in m) holding all of it; for a mesh, its grid's
+// box (the grid's distance outside the box is at least the distance to the box)
+static double collider_ball(const vd_sim_collider* k, vd_vec3* centre) {
+  *centre = k->pos;
+  switch (k->shape) {
+    case VD_SIM_SPHERE: return k->size[0];
+    case VD_SIM_CAPSULE: return k->size[0] + k->size[1];
+    case VD_SIM_BOX: return sqrt(k->size[0] * k->size[0] + k->size[1] * k->size[1] + k->size[2] * k->size[2]);
+    case VD_SIM_MESH: {
+      if (!k->sdf) return 1e300;
+      const vd_sdf* g = k->sdf;
+      vd_vec3 half = vd_scale(vd_v3(g->nx - 1, g->ny - 1, g->nz - 1), 0.5 * g->cell);
+      *centre = vd_add(k->pos, q_rotate(k->quat, vd_add(g->origin, half)));
+      return v_norm(half);
+    }
+    default: return 1e300;
+  }
+}
+
 int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_contact** out) {
   *out = NULL;
   if (!d->ncollider) return 0;
   size_t cap = (size_t)d->ncollider * (size_t)(m->nseg + m->nnode_all);
   sim_contact* c = vd_arena_alloc(&d->arena, cap * sizeof(sim_contact));
   double* reach = vd_arena_alloc(&d->arena, (size_t)m->nnode_all * sizeof(double));
-  if (!c || !reach) {
+  unsigned char* near = vd_arena_alloc(&d->arena, (size_t)m->nnode_all);
+  if (!c || !reach || !near) {
     sim_warn(d, VD_SIM_WARN_ARENA);
     return 0;
   }
@@ -164,22 +188,44 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
   for (int k = 0; k < d->ncollider; k++) {
     const vd_sim_collider* col = &d->collider[k];
     vd_vec3 nrm;
-    // nodes: every moving node against planes (with the rod's reach towards the plane), fruit
-    // spheres against the rest
-    if (col->shape == VD_SIM_PLANE) plane_reach(m, d, q_rotate(col->quat, vd_v3(0, 0, 1)), reach);
+    if (col->shape == VD_SIM_PLANE) {
+      // every moving node with the rod's reach towards the plane; a node higher than its
+      // largest radius plus the margin cannot touch, and needs no reach
+      vd_vec3 pn = q_rotate(col->quat, vd_v3(0, 0, 1));
+      const sim_work* w = (const sim_work*)d->work;
+      int any = 0;
+      for (int i = 0; i < m->nnode_all; i++) {
+        // a spare node carries the segment that broke onto it
+        double rmax = i < m->nnode ? m->node_radius[i] : m->seg_radius[w->spare_of[i - m->nnode]];
+        near[i] = sim_node_moves(m, d, i) && vd_dot(pn, vd_sub(d->node_pos[i], col->pos)) - rmax < margin;
+        any |= near[i];
+      }
+      if (!any) continue;
+      plane_reach(m, d, pn, near, reach);
+      for (int i = 0; i < m->nnode_all; i++) {
+        if (!near[i] || reach[i] < 0) continue;
+        if (sim_collider_distance(col, d->node_pos[i], &nrm) - reach[i] < margin)
+          c[n++] = (sim_contact){i, -1, 0, reach[i], k, 0, -1, -1, 0, 0};
+      }
+      continue;
+    }
+    // fruit spheres, then segment capsules; elements whose bounding ball is farther from the
+    // collider's than the margin are skipped
+    vd_vec3 cc;
+    double cr = collider_ball(col, &cc);
     for (int i = 0; i < m->nnode_all; i++) {
-      if (sim_node_w(m, d, i) <= 0) continue;
-      double r = col->shape == VD_SIM_PLANE ? reach[i] : m->node_sphere[i];
-      if (r < 0 || (r == 0 && col->shape != VD_SIM_PLANE)) continue;
+      double r = m->node_sphere[i];
+      if (!(r > 0) || !sim_node_moves(m, d, i)) continue;
+      if (v_norm(vd_sub(d->node_pos[i], cc)) - cr - r >= margin) continue;
       if (sim_collider_distance(col, d->node_pos[i], &nrm) - r < margin)
         c[n++] = (sim_contact){i, -1, 0, r, k, 0, -1, -1, 0, 0};
     }
-    if (col->shape == VD_SIM_PLANE) continue;
-    // segment capsules
     for (int t = 0; t < m->nseg; t++) {
       if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
       int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
       vd_vec3 a = d->node_pos[na], b = d->node_pos[nb];
+      vd_vec3 mid = vd_scale(vd_add(a, b), 0.5);
+      if (v_norm(vd_sub(mid, cc)) - 0.5 * v_norm(vd_sub(b, a)) - cr - m->seg_radius[t] >= margin) continue;
       double u = seg_param(col, a, b);
       double r = m->seg_radius[t];
       if (sim_collider_distance(col, vd_add(a, vd_scale(vd_sub(b, a), u)), &nrm) - r < margin)

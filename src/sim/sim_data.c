@@ -19,14 +19,14 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
   size_t o_np = take(&top, na * sizeof(vd_vec3)), o_sp = take(&top, ns * sizeof(vd_quat));
   size_t o_fe = take(&top, na * sizeof(vd_vec3)), o_te = take(&top, ns * sizeof(vd_vec3)), o_dr = take(&top, na * D);
   size_t o_cp = take(&top, ns * 6 * D), o_so = take(&top, nsp * sizeof(int)), o_ls = take(&top, ns * 6 * D);
-  size_t o_rot = take(&top, ns * 9 * D);
+
   char* blk = vd_calloc(1, top);
   if (!blk) return NULL;
   sim_work* w = (sim_work*)(blk + o_w);
   w->node_prev = (vd_vec3*)(blk + o_np), w->seg_prev = (vd_quat*)(blk + o_sp);
   w->node_fext = (vd_vec3*)(blk + o_fe), w->seg_text = (vd_vec3*)(blk + o_te), w->node_drag = (double*)(blk + o_dr);
   w->c_prev = (double*)(blk + o_cp), w->spare_of = (int*)(blk + o_so), w->lambda_save = (double*)(blk + o_ls);
-  w->rot = (double*)(blk + o_rot);
+
   w->tie_lambda = vd_calloc(ntl, 3 * D);
   if (!w->tie_lambda || sim_plan_build(m, 1, &w->plan)) {
     vd_free(w->tie_lambda, ntl * 3 * D);
@@ -219,7 +219,7 @@ int vd_sim_find_organ(const vd_sim_model* m, const vd_model* plant, const char* 
 double vd_sim_kinetic_energy(const vd_sim_model* m, const vd_sim_data* d) {
   double e = 0;
   for (int i = 0; i < m->nnode_all; i++)
-    if (sim_node_w(m, d, i) > 0) e += 0.5 * d->node_mass[i] * vd_dot(d->node_vel[i], d->node_vel[i]);
+    if (sim_node_moves(m, d, i)) e += 0.5 * d->node_mass[i] * vd_dot(d->node_vel[i], d->node_vel[i]);
   for (int t = 0; t < m->nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
     vd_vec3 w = q_rotate(q_conj(d->seg_quat[t]), d->seg_omega[t]);

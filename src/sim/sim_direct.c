@@ -171,21 +171,35 @@ SIM_INLINE void qmul_lanes(lane* restrict a, lane* restrict b, lane* restrict c,
   }
 }
 
-// rotation vector of q (the shorter way: q and -q alike) as quat_log does it, with
-// 2 atan2(s, w) / s = (2 / w) atan(t) / t, t = s / w, by its series where t <= 0.1 (to 1e-19);
-// lanes where t > 0.1 get quat_log itself (fix up by the caller: need[l] = 1)
+// rotation vector of q (the shorter way: q and -q alike) as quat_log does it where
+// t = |Im q| / Re q <= 0.1 (its series); elsewhere need[l] = 1 and the caller calls quat_log
 SIM_INLINE void qlog_lanes(lane* restrict q, lane* restrict v, lane need) {
   L {
     double sg = q[0][l] < 0 ? -1.0 : 1.0;
     double w = sg * q[0][l], x = sg * q[1][l], y = sg * q[2][l], z = sg * q[3][l];
     double s2 = x * x + y * y + z * z, w2 = w * w;
-    double t2 = s2 / (w2 > 0 ? w2 : 1.0);
-    double p = 1.0 / 17;
-    p = 1.0 / 15 - t2 * p, p = 1.0 / 13 - t2 * p, p = 1.0 / 11 - t2 * p, p = 1.0 / 9 - t2 * p;
-    p = 1.0 / 7 - t2 * p, p = 1.0 / 5 - t2 * p, p = 1.0 / 3 - t2 * p, p = 1.0 - t2 * p;
-    double k = 2 * p / (w > 0 ? w : 1.0);
+    int ok = w > 0 && s2 <= 0.01 * w2;
+    double k = 2 * sim_atan_ratio(ok ? s2 / w2 : 0.0) / (ok ? w : 1.0);
     v[0][l] = k * x, v[1][l] = k * y, v[2][l] = k * z;
-    need[l] = w > 0 && t2 <= 0.01 ? 0.0 : 1.0;
+    need[l] = ok ? 0.0 : 1.0;
+  }
+}
+
+// q = exp(v) q, normalised, as quat_rotate_by does it where |v| <= 0.1 rad (its series);
+// elsewhere need[l] = 1 and the caller calls quat_rotate_by
+SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
+  L {
+    double a2 = v[0][l] * v[0][l] + v[1][l] * v[1][l] + v[2][l] * v[2][l], c, k;
+    sim_exp_series(a2 <= 0.01 ? a2 : 0.0, &c, &k);
+    double ex = v[0][l] * k, ey = v[1][l] * k, ez = v[2][l] * k;
+    double aw = c, bw = q[0][l], bx = q[1][l], by = q[2][l], bz = q[3][l];
+    double rw = aw * bw - ex * bx - ey * by - ez * bz;
+    double rx = aw * bx + ex * bw + ey * bz - ez * by;
+    double ry = aw * by - ex * bz + ey * bw + ez * bx;
+    double rz = aw * bz + ex * by - ey * bx + ez * bw;
+    double n = sqrt(rw * rw + rx * rx + ry * ry + rz * rz), in = 1.0 / n;
+    q[0][l] = rw * in, q[1][l] = rx * in, q[2][l] = ry * in, q[3][l] = rz * in;
+    need[l] = a2 <= 0.01 ? 0.0 : 1.0;
   }
 }
 
@@ -308,8 +322,10 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
 // residual g with -J^T lambda, the joint's values, compliances and Jacobians (world stretch rows)
 PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, double h, double gam, vd_sim_bend kind) {
   double h2 = h * h, ig = 1.0 / (1 + gam);
-  lane rt[9], rp[9], dq[4], dth[3], need, cb[3], dc[9];
+  lane *rt = b->rt, rp[9], dq[4], dth[3], need, cb[3], dc[9];
   rot_lanes(in->qt, rt);
+  for (int k = 0; k < 4; k++) L b->qt[k][l] = in->qt[k][l];
+  L b->l0[l] = in->l0[l];
   rot_lanes(in->qp, rp);
   // the frame's turn since the step's start
   qmul_lanes(in->qt, in->qv, dq, 1, -1);
@@ -592,8 +608,6 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
   sim_plan* p = &w->plan;
   double h2 = ctx->h * ctx->h;
   int nseg = m->nseg;
-  // every frame's rotation matrix, once (for the multipliers' update)
-  for (int t = 0; t < nseg; t++) m3_from_quat(w->rot + 9 * t, d->seg_quat[t]);
   // ties are leaf joints of the body that owns their node: H += I / alpha~, g += c / alpha~
   int nts = p->nslot + m->nspare;
   memset(p->tie_h, 0, (size_t)nts * sizeof(double));
@@ -633,21 +647,28 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
   }
   // apply: positions, frames, multipliers (stretch rows back to the material frame:
   // dlambda_s = l0 R^T dl^)
-  for (int s = 0; s < p->nslot; s++) {
-    int t = p->slot_seg[s];
-    if (t < 0) continue;
-    const sim_blk* b = &p->blk[s / SIM_W];
-    int l = s % SIM_W, n = m->seg_node[2 * t + 1];
-    const double* rt = w->rot + 9 * t;
-    d->node_pos[n] = vd_add(d->node_pos[n], vd_v3(scale * b->dy[0][l], scale * b->dy[1][l], scale * b->dy[2][l]));
-    d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_v3(scale * b->dy[3][l], scale * b->dy[4][l], scale * b->dy[5][l]));
-    double* lam = d->seg_lambda + 6 * t;
-    double l0 = m->seg_len0[t], dl[3] = {scale * b->dl[0][l], scale * b->dl[1][l], scale * b->dl[2][l]};
-    for (int k = 0; k < 3; k++) lam[k] += l0 * (rt[k] * dl[0] + rt[3 + k] * dl[1] + rt[6 + k] * dl[2]);
-    if (!d->seg_broken[t] && m->seg_parent[t] >= 0)
-      for (int k = 0; k < 3; k++) lam[3 + k] += scale * b->dl[3 + k][l];
-    else
-      lam[3] = lam[4] = lam[5] = 0;
+  for (int bi = 0; bi < p->nblock; bi++) {
+    sim_blk* b = &p->blk[bi];
+    lane v[3], need, ls[3];
+    for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
+    qrot_lanes(b->qt, v, need);
+    for (int k = 0; k < 3; k++)
+      L ls[k][l] = b->l0[l] * (b->rt[k][l] * b->dl[0][l] + b->rt[3 + k][l] * b->dl[1][l] + b->rt[6 + k][l] * b->dl[2][l]);
+    for (int l = 0; l < SIM_W; l++) {
+      int t = p->slot_seg[bi * SIM_W + l];
+      if (t < 0) continue;
+      int n = m->seg_node[2 * t + 1];
+      vd_vec3* x = &d->node_pos[n];
+      x->x += scale * b->dy[0][l], x->y += scale * b->dy[1][l], x->z += scale * b->dy[2][l];
+      d->seg_quat[t] = need[l] > 0 ? quat_rotate_by(d->seg_quat[t], vd_v3(v[0][l], v[1][l], v[2][l]))
+                                   : (vd_quat){b->qt[0][l], b->qt[1][l], b->qt[2][l], b->qt[3][l]};
+      double* lam = d->seg_lambda + 6 * t;
+      for (int k = 0; k < 3; k++) lam[k] += scale * ls[k][l];
+      if (!d->seg_broken[t] && m->seg_parent[t] >= 0)
+        for (int k = 0; k < 3; k++) lam[3 + k] += scale * b->dl[3 + k][l];
+      else
+        lam[3] = lam[4] = lam[5] = 0;
+    }
   }
   for (int t = 0; t < nseg; t++) {
     if (!d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;

@@ -37,7 +37,7 @@ vd_vec3 sim_wind_at(const vd_sim_opt* o, double t) {
 
 // velocity of a node (zero when kinematic)
 static vd_vec3 node_v(const vd_sim_model* m, const vd_sim_data* d, int n) {
-  return sim_node_w(m, d, n) > 0 ? d->node_vel[n] : vd_v3(0, 0, 0);
+  return sim_node_moves(m, d, n) ? d->node_vel[n] : vd_v3(0, 0, 0);
 }
 
 void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
@@ -46,7 +46,7 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
   // gravity and the caller's loads
   for (int n = 0; n < nn; n++) {
     double mass = d->node_mass[n];
-    w->node_fext[n] = sim_node_w(m, d, n) > 0 ? vd_add(vd_scale(o->gravity, mass), d->node_force[n])
+    w->node_fext[n] = sim_node_moves(m, d, n) ? vd_add(vd_scale(o->gravity, mass), d->node_force[n])
                                               : vd_v3(0, 0, 0);
   }
   for (int t = 0; t < m->nseg; t++) w->seg_text[t] = d->seg_torque[t];
@@ -54,7 +54,7 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
   // Stokes drag (numerical damping only)
   if (o->stokes_viscosity > 0)
     for (int n = 0; n < nn; n++)
-      if (sim_node_w(m, d, n) > 0) {
+      if (sim_node_moves(m, d, n)) {
         double c = 6 * VD_PI * o->stokes_viscosity * m->node_radius[n];
         w->node_fext[n] = vd_madd(w->node_fext[n], d->node_vel[n], -c);
         w->node_drag[n] += c;
@@ -66,16 +66,17 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
   for (int t = 0; t < m->nseg; t++) {
     if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
     int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
-    double wa = sim_node_w(m, d, na), wb = sim_node_w(m, d, nb);
-    if (wa <= 0 && wb <= 0) continue;
+    int ma = sim_node_moves(m, d, na), mb = sim_node_moves(m, d, nb);
+    if (!ma && !mb) continue;
     vd_vec3 u = vd_sub(wind, vd_scale(vd_add(node_v(m, d, na), node_v(m, d, nb)), 0.5));
     vd_quat qt = d->seg_quat[t];
     vd_vec3 d3 = quat_d3(qt);
     vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
     double area = 2 * m->seg_radius[t] * m->seg_len0[t];
-    vd_vec3 f = vd_scale(up, q * m->seg_cd[t] * area * v_norm(up));
+    double kq = q * m->seg_cd[t] * area * v_norm(up);
+    vd_vec3 f = vd_scale(up, kq);
     // damping of F = k |u| u: dF/du has eigenvalues k |u| and 2 k |u|; the larger is taken
-    double c = 2 * q * m->seg_cd[t] * area * v_norm(up);
+    double c = 2 * kq;
     const double* ln = m->seg_leaf_normal + 3 * t;
     if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
       vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
@@ -85,7 +86,7 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
       c += 2 * q * m->leaf_cd * a * fabs(un);
     }
     // half to each end that moves (all of it when the other end is held)
-    double sa = wa > 0 ? (wb > 0 ? 0.5 : 1.0) : 0.0;
+    double sa = ma ? (mb ? 0.5 : 1.0) : 0.0;
     w->node_fext[na] = vd_madd(w->node_fext[na], f, sa);
     w->node_fext[nb] = vd_madd(w->node_fext[nb], f, 1.0 - sa);
     w->node_drag[na] += sa * c;
@@ -93,11 +94,12 @@ void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
   }
   // spheres (fruits, buds) on their centre node
   for (int n = 0; n < nn; n++) {
-    if (m->node_sphere[n] <= 0 || sim_node_w(m, d, n) <= 0) continue;
+    if (m->node_sphere[n] <= 0 || !sim_node_moves(m, d, n)) continue;
     vd_vec3 u = vd_sub(wind, d->node_vel[n]);
     int o2 = m->node_owner[n];
     double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
-    w->node_fext[n] = vd_madd(w->node_fext[n], u, q * cd * VD_PI * r * r * v_norm(u));
-    w->node_drag[n] += 2 * q * cd * VD_PI * r * r * v_norm(u);
+    double kq = q * cd * VD_PI * r * r * v_norm(u);
+    w->node_fext[n] = vd_madd(w->node_fext[n], u, kq);
+    w->node_drag[n] += 2 * kq;
   }
 }

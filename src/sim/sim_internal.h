@@ -90,6 +90,22 @@ static inline vd_vec3 q_rotate(vd_quat q, vd_vec3 v) {
 }
 static inline double v_norm(vd_vec3 a) { return sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
 
+// Series of the maps for small angles, shared by the scalar maps below and the direct solver's
+// lane code (same operations, same bytes). For a rotation vector of squared angle a2 <= 0.01:
+// cos(a / 2) and sin(a / 2) / a (to 1e-20).
+static inline void sim_exp_series(double a2, double* c, double* k) {
+  double x2 = 0.25 * a2;
+  *c = 1 - x2 * (1.0 / 2 - x2 * (1.0 / 24 - x2 * (1.0 / 720 - x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
+  *k = 0.5 * (1 - x2 * (1.0 / 6 - x2 * (1.0 / 120 - x2 * (1.0 / 5040 - x2 * (1.0 / 362880 - x2 * (1.0 / 39916800))))));
+}
+// atan(t) / t for t2 = t^2 <= 0.01 (to 1e-19)
+static inline double sim_atan_ratio(double t2) {
+  double p = 1.0 / 17;
+  p = 1.0 / 15 - t2 * p, p = 1.0 / 13 - t2 * p, p = 1.0 / 11 - t2 * p, p = 1.0 / 9 - t2 * p;
+  p = 1.0 / 7 - t2 * p, p = 1.0 / 5 - t2 * p, p = 1.0 / 3 - t2 * p;
+  return 1.0 - t2 * p;
+}
+
 // rotation by the rotation vector v (exponential map)
 vd_quat quat_exp(vd_vec3 v);
 // rotation vector of q (logarithm map), shortest (|angle| <= pi)
@@ -190,13 +206,16 @@ typedef struct sim_blk {
   double c[6][SIM_W];    // damped constraint values c': stretch rows in world axes (m), bend (1/m)
   double al[9][SIM_W];   // damped compliances alpha~': stretch (upper 3x3, world), bend (diagonal)
   double lf[6][SIM_W];   // the joint's multipliers: stretch as R lambda_s / l0 (world), bend
-  double mi[5][SIM_W];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib, and d3 through rot
+  double mi[3][SIM_W];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib
+  double d3[3][SIM_W];   // the frame's d3
   double dh[21][SIM_W];  // contribution J_p^T S^-1 J_p to the parent's H
   double dg[6][SIM_W];   // contribution to the parent's g
   double dy[6][SIM_W];   // body update (m, rad)
   double dl[6][SIM_W];   // multiplier update (world stretch rows, bend rows)
   double ok[SIM_W];      // 1 while both factorisations of the lane held
-  double d3[3][SIM_W];   // tips: the frame's d3
+  double qt[4][SIM_W];   // the frame at the linearisation
+  double rt[9][SIM_W];   // its rotation matrix
+  double l0[SIM_W];      // rest length (m)
 } sim_blk;
 
 // The elimination schedule of a model for nthread threads: blocks in an order where every
@@ -242,7 +261,6 @@ typedef struct sim_work {
   int* spare_of;        // spare index -> segment (nspare)
   // direct solver
   sim_plan plan;        // its schedule and blocks
-  double* rot;          // rotation matrix of every frame this iteration (nseg x 9)
 
   double* tie_lambda;   // multipliers of model and user ties (ntie_all x 3)
   int cap_tie_lambda;   // capacity of tie_lambda (rows)
@@ -292,6 +310,10 @@ static inline void sim_warn(vd_sim_data* d, int k) {
 int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
+// 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division
+static inline int sim_node_moves(const vd_sim_model* m, const vd_sim_data* d, int n) {
+  return !m->node_fixed[n] && d->node_mass[n] > 0;
+}
 // inverse mass of a node (0 when kinematic)
 static inline double sim_node_w(const vd_sim_model* m, const vd_sim_data* d, int n) {
   return m->node_fixed[n] || d->node_mass[n] <= 0 ? 0.0 : 1.0 / d->node_mass[n];

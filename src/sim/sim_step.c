@@ -42,7 +42,7 @@ void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t) {
   if (d->node_mass[a] > 2 * share) d->node_mass[a] -= share;
   d->node_mass[k] = share;
   d->node_pos[k] = d->node_pos[a];
-  d->node_vel[k] = sim_node_w(m, d, a) > 0 ? d->node_vel[a] : vd_v3(0, 0, 0);
+  d->node_vel[k] = sim_node_moves(m, d, a) ? d->node_vel[a] : vd_v3(0, 0, 0);
   d->node_force[k] = vd_v3(0, 0, 0);
   d->seg_start[t] = k;
   d->seg_broken[t] = 1;
@@ -109,12 +109,12 @@ static double potential_energy(const vd_sim_model* m, const vd_sim_data* d, cons
     vd_vec3 target;
     double comp;
     sim_tie_get(m, d, k, &n, &target, &comp);
-    if (sim_node_w(m, d, n) <= 0) continue;
+    if (!sim_node_moves(m, d, n)) continue;
     vd_vec3 cc = vd_sub(d->node_pos[n], target);
     e += 0.5 * vd_dot(cc, cc) / comp;
   }
   for (int i = 0; i < m->nnode_all; i++)
-    if (sim_node_w(m, d, i) > 0) e -= vd_dot(w->node_fext[i], d->node_pos[i]);
+    if (sim_node_moves(m, d, i)) e -= vd_dot(w->node_fext[i], d->node_pos[i]);
   return e;
 }
 
@@ -164,22 +164,22 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     memset(w->tie_lambda, 0, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
     double fl = m->opt.solver == VD_SIM_GS ? h : 0.0;
     for (int i = 0; i < na; i++) {
-      if (sim_node_w(m, d, i) <= 0) continue;
+      if (!sim_node_moves(m, d, i)) continue;
       vd_vec3 v = vd_madd(d->node_vel[i], w->node_fext[i], fl / (d->node_mass[i] + h * w->node_drag[i]));
       d->node_pos[i] = vd_madd(d->node_pos[i], v, h);
     }
     for (int t = 0; t < ns; t++) {
       if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-      double r[9], iinv[9];
-      m3_from_quat(r, d->seg_quat[t]);
-      double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
-      m3_inv_inertia(iinv, r, ib, it);
-      vd_vec3 om = d->seg_omega[t];
-      // I omega in world axes: ib omega + (it - ib) (d3 . omega) d3
-      vd_vec3 d3 = vd_v3(r[2], r[5], r[8]);
-      vd_vec3 io = vd_madd(vd_scale(om, ib), d3, (it - ib) * vd_dot(d3, om));
-      vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(om, io));
-      vd_vec3 op = vd_madd(om, m3_mul_v(iinv, tq), fl);
+      vd_vec3 op = d->seg_omega[t];
+      if (fl != 0) {
+        // omega + h I^-1 (tau - omega x I omega), I = ib + (it - ib) d3 d3^T in world axes
+        vd_vec3 d3 = quat_d3(d->seg_quat[t]);
+        double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
+        vd_vec3 io = vd_madd(vd_scale(op, ib), d3, (it - ib) * vd_dot(d3, op));
+        vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(op, io));
+        vd_vec3 it_tq = vd_madd(vd_scale(tq, 1.0 / ib), d3, (1.0 / it - 1.0 / ib) * vd_dot(d3, tq));
+        op = vd_madd(op, it_tq, fl);
+      }
       d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_scale(op, h));
     }
   }
@@ -190,7 +190,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   if (m->opt.contacts && (d->ncollider || m->opt.self_collision)) {
     double vmax = 0;
     for (int i = 0; i < na; i++)
-      if (sim_node_w(m, d, i) > 0) {
+      if (sim_node_moves(m, d, i)) {
         double s = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
         if (s > vmax) vmax = s;
       }
@@ -237,7 +237,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   // velocities from the step's motion
   double damp = 1.0 / (1.0 + (m->opt.mass_damping + c.extra_damping) * h);
   for (int i = 0; i < na; i++) {
-    if (sim_node_w(m, d, i) <= 0 || c.statics) {
+    if (!sim_node_moves(m, d, i) || c.statics) {
       d->node_vel[i] = vd_v3(0, 0, 0);
       continue;
     }
