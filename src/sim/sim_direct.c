@@ -15,7 +15,7 @@
 //   leaves the solution unchanged (dl = T^T dl^) and turns their Jacobian into [I, [E]x] on the
 //   body and [-I, 0] on the parent (E = x_end - x_start), with compliance
 //   alpha^ = l0^2 R diag(alpha~) R^T: cross products instead of 3x3 products.
-// * Bodies are eliminated SIM_W at a time (sim_plan.c): every quantity of a block is stored
+// * Bodies are eliminated SIM_W (8) at a time (sim_plan.c): every quantity of a block is stored
 //   lane by lane (sim_blk), and the block arithmetic of a step runs as one loop over the lanes,
 //   which the compiler vectorises (each lane's arithmetic is the scalar one: same bytes with any
 //   vector width, no fused multiply-adds, -ffp-contract=off).
@@ -23,6 +23,8 @@
 //   in the fixed order of its children, so the bytes do not depend on the schedule or threads.
 // * Tips (a third of the tomato) have a diagonal body matrix: their inverse is written down.
 // * 6x6 inverses by 3x3 Schur blocks (two divisions each), used through products.
+#include <stddef.h>
+
 #include "sim_internal.h"
 
 // a profiling build (-DVD_PROF_NOINLINE) keeps the stages apart for callgrind
@@ -34,14 +36,17 @@
 #define SIM_INLINE_PROF static inline __attribute__((always_inline))
 #endif
 
-// Every kernel is inlined into the two block loops, which are compiled twice (x86-64 with
-// gcc or clang): for AVX2 (four lanes in one instruction) and for the baseline (SSE2, two),
-// picked at load time by the CPU; both give the same bytes (lane arithmetic is scalar IEEE
-// arithmetic either way, -ffp-contract=off)
+// Every kernel is inlined into the block loops, which are compiled three times (x86-64 with gcc
+// or clang; -DVD_SIM_PORTABLE for one baseline build): for AVX-512 (eight lanes in one
+// instruction), AVX2 (four) and the baseline (SSE2, two), picked at load time by the CPU. All
+// give the same bytes: each lane's arithmetic is the scalar IEEE arithmetic in the same order,
+// with no fused multiply-adds (-ffp-contract=off); the tomato's frames were compared byte for
+// byte between the three and between blocks of four and eight lanes.
 #define SIM_INLINE static inline __attribute__((always_inline))
-#if defined(__x86_64__) && defined(__has_attribute) && !defined(VD_PROF_NOINLINE) && !defined(__SANITIZE_ADDRESS__)
+#if defined(__x86_64__) && defined(__has_attribute) && !defined(VD_PROF_NOINLINE) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(VD_SIM_PORTABLE)
 #if __has_attribute(target_clones)
-#define SIM_CLONES __attribute__((target_clones("avx2", "default")))
+#define SIM_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 #endif
 #ifndef SIM_CLONES
@@ -206,40 +211,37 @@ SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
 // ---------------------------------------------------------------------------------------------
 // linearisation of the bodies and joints of a block
 
-// a block's inputs, gathered lane by lane
+// a block's inputs, gathered lane by lane (the model's part is in the plan's sim_stat)
 typedef struct sim_in {
-  lane qt[4], qp[4], qv[4], q0[4];  // frame, parent frame (identity: no bend rows), frame at the step's start, rest
-  lane e[3];                         // x_end - x_start (m)
-  lane dx[3];                        // x_end - x_start_of_step - h v (m)
-  lane fe[3], om[3], te[3];          // external force (N), angular velocity (rad/s), external torque (N m)
-  lane lam[6], cp[6];                // multipliers, constraint values at the step's start
-  lane acs[3], acb[3];               // compliances / h^2
-  lane mass, tieh, tieg[3];          // mass with drag (kg), ties on the node
-  lane l0, lbar, ib, it, bend;       // rest length, Darboux length, inertias, 1 when the bend rows are active
+  lane qt[4], qp[4], qv[4];   // frame, parent frame (identity: no bend rows), frame at the step's start
+  lane e[3];                  // x_end - x_start (m)
+  lane dx[3];                 // x_end - x_start_of_step - h v (m)
+  lane fe[3], om[3], te[3];   // external force (N), angular velocity (rad/s), external torque (N m)
+  lane lam[6], cp[6];         // multipliers, constraint values at the step's start (0 without damping)
+  lane mass, tieh, tieg[3];   // mass with drag (kg), ties on the node
+  lane bend;                  // 1 when the bend rows are active
+  sim_stat* st;               // the block's model data
 } sim_in;
 
 // gather lane l of a block from slot s (padding: a unit body and joint)
 PROF_NOINLINE static void gather_in(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
-                      sim_in* in, int l, int s) {
+                                    sim_in* in, int l, int s) {
   const sim_plan* p = &w->plan;
   int t = p->slot_seg[s];
-  double h = ctx->h, h2 = h * h;
+  double h = ctx->h;
   if (t < 0) {
     double* f = &in->qt[0][0];
-    for (size_t k = 0; k < sizeof *in / sizeof(lane); k++) f[SIM_W * k + l] = 0;
-    in->qt[0][l] = in->qp[0][l] = in->qv[0][l] = in->q0[0][l] = 1;
-    in->acs[0][l] = in->acs[1][l] = in->acs[2][l] = in->acb[0][l] = in->acb[1][l] = in->acb[2][l] = 1;
-    in->mass[l] = in->l0[l] = in->lbar[l] = in->ib[l] = in->it[l] = 1;
+    for (size_t k = 0; k < offsetof(sim_in, st) / sizeof(lane); k++) f[SIM_W * k + l] = 0;
+    in->qt[0][l] = in->qp[0][l] = in->qv[0][l] = 1;
+    in->mass[l] = 1;
     return;
   }
   int nb = m->seg_node[2 * t + 1], na = d->seg_start[t], par = m->seg_parent[t];
   int bend = !d->seg_broken[t] && par >= 0;
   vd_quat q = d->seg_quat[t], qp = bend ? d->seg_quat[par] : vd_quat_identity(), qv = w->seg_prev[t];
-  vd_quat q0 = m->seg_rest[t];
   in->qt[0][l] = q.w, in->qt[1][l] = q.x, in->qt[2][l] = q.y, in->qt[3][l] = q.z;
   in->qp[0][l] = qp.w, in->qp[1][l] = qp.x, in->qp[2][l] = qp.y, in->qp[3][l] = qp.z;
   in->qv[0][l] = qv.w, in->qv[1][l] = qv.x, in->qv[2][l] = qv.y, in->qv[3][l] = qv.z;
-  in->q0[0][l] = q0.w, in->q0[1][l] = q0.x, in->q0[2][l] = q0.y, in->q0[3][l] = q0.z;
   vd_vec3 xb = d->node_pos[nb], xa = d->node_pos[na], xv = w->node_prev[nb], v = d->node_vel[nb];
   vd_vec3 fe = w->node_fext[nb], om = d->seg_omega[t], te = w->seg_text[t];
   in->e[0][l] = xb.x - xa.x, in->e[1][l] = xb.y - xa.y, in->e[2][l] = xb.z - xa.z;
@@ -248,17 +250,15 @@ PROF_NOINLINE static void gather_in(const vd_sim_model* m, const vd_sim_data* d,
   in->om[0][l] = om.x, in->om[1][l] = om.y, in->om[2][l] = om.z;
   in->te[0][l] = te.x, in->te[1][l] = te.y, in->te[2][l] = te.z;
   const double* lam = d->seg_lambda + 6 * t;
+  for (int k = 0; k < 6; k++) in->lam[k][l] = lam[k];
   const double* cp = w->c_prev + 6 * t;
-  for (int k = 0; k < 6; k++) in->lam[k][l] = lam[k], in->cp[k][l] = cp[k];
-  for (int k = 0; k < 3; k++) {
-    in->acs[k][l] = m->seg_cs[3 * t + k] / h2;
-    in->acb[k][l] = bend ? m->seg_cb[3 * t + k] / h2 : 1.0 / h2;
-    in->tieg[k][l] = p->tie_g[3 * s + k];
-  }
+  if (ctx->gamma > 0)
+    for (int k = 0; k < 6; k++) in->cp[k][l] = cp[k];
+  else
+    for (int k = 0; k < 6; k++) in->cp[k][l] = 0;
+  for (int k = 0; k < 3; k++) in->tieg[k][l] = p->tie_g[3 * s + k];
   in->mass[l] = d->node_mass[nb] + h * w->node_drag[nb];
   in->tieh[l] = p->tie_h[s];
-  in->l0[l] = m->seg_len0[t], in->lbar[l] = m->seg_lbar[t];
-  in->ib[l] = m->seg_inertia[2 * t], in->it[l] = m->seg_inertia[2 * t + 1];
   in->bend[l] = bend;
 }
 
@@ -269,16 +269,16 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
   qmul_lanes(in->qp, in->qt, qr, -1, 1);
   // the sign that puts q_rel on the rest rotation's side
   L {
-    double dot = qr[0][l] * in->q0[0][l] + qr[1][l] * in->q0[1][l] + qr[2][l] * in->q0[2][l] + qr[3][l] * in->q0[3][l];
+    double dot = qr[0][l] * in->st->q0[0][l] + qr[1][l] * in->st->q0[1][l] + qr[2][l] * in->st->q0[2][l] + qr[3][l] * in->st->q0[3][l];
     double sg = dot < 0 ? -1.0 : 1.0;
     for (int k = 0; k < 4; k++) qr[k][l] *= sg;
   }
   if (kind == VD_SIM_BEND_QUAT) {
     L {
-      double f = 1.0 / in->lbar[l], k2 = 2.0 * f;
-      cb[0][l] = k2 * (qr[1][l] - in->q0[1][l]);
-      cb[1][l] = k2 * (qr[2][l] - in->q0[2][l]);
-      cb[2][l] = k2 * (qr[3][l] - in->q0[3][l]);
+      double f = 1.0 / in->st->lbar[l], k2 = 2.0 * f;
+      cb[0][l] = k2 * (qr[1][l] - in->st->q0[1][l]);
+      cb[1][l] = k2 * (qr[2][l] - in->st->q0[2][l]);
+      cb[2][l] = k2 * (qr[3][l] - in->st->q0[3][l]);
       dc[0][l] = f * qr[0][l], dc[1][l] = f * qr[3][l], dc[2][l] = -f * qr[2][l];
       dc[3][l] = -f * qr[3][l], dc[4][l] = f * qr[0][l], dc[5][l] = f * qr[1][l];
       dc[6][l] = f * qr[2][l], dc[7][l] = -f * qr[1][l], dc[8][l] = f * qr[0][l];
@@ -288,7 +288,7 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
   // log measure: the turn qd = conj(q0) q (w >= 0), ph = log(qd), C = ph / l-bar,
   // dC/dpsi = J_l^-1(ph) R0^T / l-bar, J_l^-1 = I - [ph]x / 2 + beta [ph]x^2
   lane qd[4], ph[3], need, r0[9], beta, f, dd, jl[9];
-  qmul_lanes(in->q0, qr, qd, -1, 1);
+  qmul_lanes(in->st->q0, qr, qd, -1, 1);
   qlog_lanes(qd, ph, need);
   for (int l = 0; l < SIM_W; l++)
     if (need[l] > 0) {
@@ -305,13 +305,13 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
     double frm = (1 - 0.5 * a * qd[0][l] / (big ? s : 1.0)) / (big ? a2 : 1.0);
     beta[l] = big ? frm : ser;
     dd[l] = 1 - beta[l] * a2;
-    f[l] = 1.0 / in->lbar[l];
+    f[l] = 1.0 / in->st->lbar[l];
   }
   for (int i = 0; i < 3; i++)
     for (int k = 0; k < 3; k++) L jl[3 * i + k][l] = beta[l] * ph[i][l] * ph[k][l] + (i == k ? dd[l] : 0.0);
   L jl[1][l] += 0.5 * ph[2][l], jl[2][l] -= 0.5 * ph[1][l], jl[5][l] += 0.5 * ph[0][l];
   L jl[3][l] -= 0.5 * ph[2][l], jl[6][l] += 0.5 * ph[1][l], jl[7][l] -= 0.5 * ph[0][l];
-  rot_lanes(in->q0, r0);
+  rot_lanes(in->st->q0, r0);
   for (int k = 0; k < 3; k++) L cb[k][l] = f[l] * ph[k][l];
   for (int i = 0; i < 3; i++)
     for (int k = 0; k < 3; k++)
@@ -325,7 +325,7 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   lane *rt = b->rt, rp[9], dq[4], dth[3], need, cb[3], dc[9];
   rot_lanes(in->qt, rt);
   for (int k = 0; k < 4; k++) L b->qt[k][l] = in->qt[k][l];
-  L b->l0[l] = in->l0[l];
+  L b->l0[l] = in->st->l0[l];
   rot_lanes(in->qp, rp);
   // the frame's turn since the step's start
   qmul_lanes(in->qt, in->qv, dq, 1, -1);
@@ -336,13 +336,19 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
       dth[0][l] = v.x, dth[1][l] = v.y, dth[2][l] = v.z;
     }
   bend_lanes(kind, in, cb, dc);
+  // compliances / h^2 (inactive bend rows: unit compliance)
+  lane acs[3], acb[3];
+  for (int k = 0; k < 3; k++) {
+    L acs[k][l] = in->st->cs[k][l] / h2;
+    L acb[k][l] = in->bend[l] > 0 ? in->st->cb[k][l] / h2 : 1.0 / h2;
+  }
   // body: world inertia ib I + (it - ib) d3 d3^T; g_t = I (dth - h om) - h^2 (tau - om x I om)
   lane* d3 = b->d3;
   lane ci, iw[6], dt[3], io[3], tq[3], il0;
-  L ci[l] = in->it[l] - in->ib[l], il0[l] = 1.0 / in->l0[l];
+  L ci[l] = in->st->it[l] - in->st->ib[l], il0[l] = 1.0 / in->st->l0[l];
   L d3[0][l] = rt[2][l], d3[1][l] = rt[5][l], d3[2][l] = rt[8][l];
   for (int i = 0; i < 3; i++)
-    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->ib[l] : 0.0) + ci[l] * d3[i][l] * d3[k][l];
+    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->st->ib[l] : 0.0) + ci[l] * d3[i][l] * d3[k][l];
   for (int k = 0; k < 3; k++) L dt[k][l] = dth[k][l] - h * in->om[k][l];
   for (int i = 0; i < 3; i++) {
     L io[i][l] = iw[SYM[i][0]][l] * in->om[0][l] + iw[SYM[i][1]][l] * in->om[1][l] + iw[SYM[i][2]][l] * in->om[2][l];
@@ -357,17 +363,17 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   for (int k = 0; k < 3; k++)
     L {
       double cs = (rt[k][l] * in->e[0][l] + rt[3 + k][l] * in->e[1][l] + rt[6 + k][l] * in->e[2][l]) * il0[l] - (k == 2 ? 1.0 : 0.0);
-      v[k][l] = (cs + in->acs[k][l] * in->lam[k][l] + gam * (cs - in->cp[k][l])) * ig;
+      v[k][l] = (cs + acs[k][l] * in->lam[k][l] + gam * (cs - in->cp[k][l])) * ig;
     }
   for (int i = 0; i < 3; i++) {
     L b->lf[i][l] = (rt[3 * i][l] * in->lam[0][l] + rt[3 * i + 1][l] * in->lam[1][l] + rt[3 * i + 2][l] * in->lam[2][l]) * il0[l];
-    L b->c[i][l] = in->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
+    L b->c[i][l] = in->st->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
   }
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L b->al[SYM[i][k]][l] = in->l0[l] * in->l0[l] * ig *
-                              (rt[3 * i][l] * in->acs[0][l] * rt[3 * k][l] + rt[3 * i + 1][l] * in->acs[1][l] * rt[3 * k + 1][l] +
-                               rt[3 * i + 2][l] * in->acs[2][l] * rt[3 * k + 2][l]);
+      L b->al[SYM[i][k]][l] = in->st->l0[l] * in->st->l0[l] * ig *
+                              (rt[3 * i][l] * acs[0][l] * rt[3 * k][l] + rt[3 * i + 1][l] * acs[1][l] * rt[3 * k + 1][l] +
+                               rt[3 * i + 2][l] * acs[2][l] * rt[3 * k + 2][l]);
   // bend-twist: G = dC/dpsi R_p^T (zero when inactive)
   lane* gm = b->gm;
   for (int i = 0; i < 3; i++)
@@ -376,8 +382,8 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   for (int k = 0; k < 3; k++)
     L {
       double c = in->bend[l] * cb[k][l];
-      b->c[3 + k][l] = (c + in->acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
-      b->al[6 + k][l] = in->acb[k][l] * ig;
+      b->c[3 + k][l] = (c + acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
+      b->al[6 + k][l] = acb[k][l] * ig;
       b->lf[3 + k][l] = in->lam[3 + k][l];
     }
   // g = M (y - y_n - h v_n) - h^2 f - J^T lambda, J^T lambda = [f; f x E + G^T lambda_b]
@@ -394,7 +400,7 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   L {
     double mt = in->mass[l] + in->tieh[l];
     b->h[S00][l] = mt, b->h[S11][l] = mt, b->h[S22][l] = mt;
-    b->mi[0][l] = 1.0 / mt, b->mi[1][l] = 1.0 / in->ib[l], b->mi[2][l] = 1.0 / in->it[l] - 1.0 / in->ib[l];
+    b->mi[0][l] = 1.0 / mt, b->mi[1][l] = 1.0 / in->st->ib[l], b->mi[2][l] = 1.0 / in->st->it[l] - 1.0 / in->st->ib[l];
   }
   for (int k = 0; k < 6; k++) L b->h[15 + k][l] = iw[k][l];
 }
@@ -561,6 +567,7 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
   for (int bi = b0; bi < b1; bi++) {
     sim_blk* b = &p->blk[bi];
     sim_in in;
+    in.st = &p->stat[bi];
     for (int l = 0; l < SIM_W; l++) gather_in(m, d, w, ctx, &in, l, bi * SIM_W + l);
     eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
     for (int l = 0; l < SIM_W; l++) {
@@ -603,6 +610,57 @@ SIM_CLONES static void back_range(const vd_sim_model* m, const vd_sim_data* d, s
   }
 }
 
+// trust region: a Newton update that turns a frame by more than SIM_MAX_TURN or moves a
+// node by more than SIM_MAX_MOVE rest lengths of its segment is scaled down as a whole (the
+// linearisation means nothing that far out; from there a full update diverges). Corrections
+// of a light node's prediction reach a few rest lengths in normal runs; these do not.
+SIM_CLONES static double trust_scale(const sim_plan* p) {
+  double turn2 = 0, move2 = 0;  // largest squared turn and squared move in rest lengths
+  for (int bi = 0; bi < p->nblock; bi++) {
+    const sim_blk* b = &p->blk[bi];
+    lane tu, mo;
+    L tu[l] = b->dy[3][l] * b->dy[3][l] + b->dy[4][l] * b->dy[4][l] + b->dy[5][l] * b->dy[5][l];
+    L mo[l] = (b->dy[0][l] * b->dy[0][l] + b->dy[1][l] * b->dy[1][l] + b->dy[2][l] * b->dy[2][l]) / (b->l0[l] * b->l0[l]);
+    for (int l = 0; l < SIM_W; l++) {
+      if (p->slot_seg[bi * SIM_W + l] < 0) continue;
+      if (tu[l] > turn2) turn2 = tu[l];
+      if (mo[l] > move2) move2 = mo[l];
+    }
+  }
+  double scale = 1, turn = sqrt(turn2), move = sqrt(move2);
+  if (turn > SIM_MAX_TURN) scale = SIM_MAX_TURN / turn;
+  if (move * scale > SIM_MAX_MOVE) scale = SIM_MAX_MOVE / move;
+  return scale;
+}
+
+// apply the update scaled by scale: positions, frames, multipliers (stretch rows back to the
+// material frame: dlambda_s = l0 R^T dl^)
+SIM_CLONES static void apply_blocks(const vd_sim_model* m, vd_sim_data* d, sim_plan* p, double scale) {
+  for (int bi = 0; bi < p->nblock; bi++) {
+    sim_blk* b = &p->blk[bi];
+    lane v[3], need, ls[3];
+    for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
+    qrot_lanes(b->qt, v, need);
+    for (int k = 0; k < 3; k++)
+      L ls[k][l] = scale * (b->l0[l] * (b->rt[k][l] * b->dl[0][l] + b->rt[3 + k][l] * b->dl[1][l] + b->rt[6 + k][l] * b->dl[2][l]));
+    for (int l = 0; l < SIM_W; l++) {
+      int t = p->slot_seg[bi * SIM_W + l];
+      if (t < 0) continue;
+      int n = m->seg_node[2 * t + 1];
+      vd_vec3* x = &d->node_pos[n];
+      x->x += scale * b->dy[0][l], x->y += scale * b->dy[1][l], x->z += scale * b->dy[2][l];
+      d->seg_quat[t] = need[l] > 0 ? quat_rotate_by(d->seg_quat[t], vd_v3(v[0][l], v[1][l], v[2][l]))
+                                   : (vd_quat){b->qt[0][l], b->qt[1][l], b->qt[2][l], b->qt[3][l]};
+      double* lam = d->seg_lambda + 6 * t;
+      for (int k = 0; k < 3; k++) lam[k] += ls[k][l];
+      if (!d->seg_broken[t] && m->seg_parent[t] >= 0)
+        for (int k = 0; k < 3; k++) lam[3 + k] += scale * b->dl[3 + k][l];
+      else
+        lam[3] = lam[4] = lam[5] = 0;
+    }
+  }
+}
+
 // one Newton iteration; returns 0 when a factorisation failed (state left unchanged)
 static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim_step_ctx* ctx) {
   sim_plan* p = &w->plan;
@@ -630,46 +688,8 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
   if (!forward_range(m, d, w, ctx, 0, p->nblock)) return 0;
   sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
   back_range(m, d, w, 0, p->nblock);
-  // trust region: a Newton update that turns a frame by more than SIM_MAX_TURN or moves a
-  // node by more than SIM_MAX_MOVE rest lengths of its segment is scaled down as a whole (the
-  // linearisation means nothing that far out; from there a full update diverges). Corrections
-  // of a light node's prediction reach a few rest lengths in normal runs; these do not.
-  double scale = 1;
-  for (int s = 0; s < p->nslot; s++) {
-    int t = p->slot_seg[s];
-    if (t < 0) continue;
-    const sim_blk* b = &p->blk[s / SIM_W];
-    int l = s % SIM_W;
-    double turn = sqrt(b->dy[3][l] * b->dy[3][l] + b->dy[4][l] * b->dy[4][l] + b->dy[5][l] * b->dy[5][l]);
-    double move = sqrt(b->dy[0][l] * b->dy[0][l] + b->dy[1][l] * b->dy[1][l] + b->dy[2][l] * b->dy[2][l]) / m->seg_len0[t];
-    if (turn * scale > SIM_MAX_TURN) scale = SIM_MAX_TURN / turn;
-    if (move * scale > SIM_MAX_MOVE) scale = SIM_MAX_MOVE / move;
-  }
-  // apply: positions, frames, multipliers (stretch rows back to the material frame:
-  // dlambda_s = l0 R^T dl^)
-  for (int bi = 0; bi < p->nblock; bi++) {
-    sim_blk* b = &p->blk[bi];
-    lane v[3], need, ls[3];
-    for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
-    qrot_lanes(b->qt, v, need);
-    for (int k = 0; k < 3; k++)
-      L ls[k][l] = b->l0[l] * (b->rt[k][l] * b->dl[0][l] + b->rt[3 + k][l] * b->dl[1][l] + b->rt[6 + k][l] * b->dl[2][l]);
-    for (int l = 0; l < SIM_W; l++) {
-      int t = p->slot_seg[bi * SIM_W + l];
-      if (t < 0) continue;
-      int n = m->seg_node[2 * t + 1];
-      vd_vec3* x = &d->node_pos[n];
-      x->x += scale * b->dy[0][l], x->y += scale * b->dy[1][l], x->z += scale * b->dy[2][l];
-      d->seg_quat[t] = need[l] > 0 ? quat_rotate_by(d->seg_quat[t], vd_v3(v[0][l], v[1][l], v[2][l]))
-                                   : (vd_quat){b->qt[0][l], b->qt[1][l], b->qt[2][l], b->qt[3][l]};
-      double* lam = d->seg_lambda + 6 * t;
-      for (int k = 0; k < 3; k++) lam[k] += scale * ls[k][l];
-      if (!d->seg_broken[t] && m->seg_parent[t] >= 0)
-        for (int k = 0; k < 3; k++) lam[3 + k] += scale * b->dl[3 + k][l];
-      else
-        lam[3] = lam[4] = lam[5] = 0;
-    }
-  }
+  double scale = trust_scale(p);
+  apply_blocks(m, d, p, scale);
   for (int t = 0; t < nseg; t++) {
     if (!d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;
     int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;

@@ -107,11 +107,26 @@ static inline double sim_atan_ratio(double t2) {
 }
 
 // rotation by the rotation vector v (exponential map)
-vd_quat quat_exp(vd_vec3 v);
+vd_quat quat_exp_big(vd_vec3 v);
+static inline vd_quat quat_exp(vd_vec3 v) {
+  double a2 = v.x * v.x + v.y * v.y + v.z * v.z, c, k;
+  if (!(a2 <= 0.01)) return quat_exp_big(v);
+  sim_exp_series(a2, &c, &k);  // below 0.1 rad (the steps' turns): no libm call
+  vd_quat q = {c, v.x * k, v.y * k, v.z * k};
+  return q;
+}
 // rotation vector of q (logarithm map), shortest (|angle| <= pi)
-vd_vec3 quat_log(vd_quat q);
+vd_vec3 quat_log_big(vd_quat q);
+static inline vd_vec3 quat_log(vd_quat q) {
+  if (q.w < 0) q.w = -q.w, q.x = -q.x, q.y = -q.y, q.z = -q.z;
+  double s2 = q.x * q.x + q.y * q.y + q.z * q.z, w2 = q.w * q.w;
+  if (!(q.w > 0 && s2 <= 0.01 * w2)) return quat_log_big(q);
+  // 2 atan2(s, w) / s = (2 / w) atan(t) / t, t = s / w <= 0.1
+  double k = 2 * sim_atan_ratio(s2 / w2) / q.w;
+  return vd_v3(q.x * k, q.y * k, q.z * k);
+}
 // q rotated by the world rotation vector v: exp(v) q, normalised
-vd_quat quat_rotate_by(vd_quat q, vd_vec3 v);
+static inline vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) { return q_normalize(q_mul(quat_exp(v), q)); }
 static inline double quat_dot(vd_quat a, vd_quat b) { return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline vd_vec3 quat_im(vd_quat q) { return vd_v3(q.x, q.y, q.z); }
 // d3 (z axis) of a frame
@@ -188,7 +203,7 @@ typedef struct sim_self {
 // ---------------------------------------------------------------------------------------------
 // the direct solver's schedule and blocks (sim_plan.c, sim_direct.c)
 
-#define SIM_W 4             // bodies eliminated side by side in one block (lanes)
+#define SIM_W 8             // bodies eliminated side by side in one block (lanes: one AVX-512 vector)
 #define SIM_MAX_THREADS 64  // most threads one state's step may use
 
 // One block of SIM_W bodies, each field an array over the lanes (structure of arrays), so
@@ -218,6 +233,18 @@ typedef struct sim_blk {
   double l0[SIM_W];      // rest length (m)
 } sim_blk;
 
+// What a block's bodies and joints keep from the model (lane by lane), so that a step gathers
+// only the state. Padding lanes hold a unit body and joint.
+typedef struct sim_stat {
+  double q0[4][SIM_W];   // rest relative rotation of the bend-twist constraint
+  double cs[3][SIM_W];   // stretch-shear compliances
+  double cb[3][SIM_W];   // bend-twist compliances
+  double l0[SIM_W];      // rest length (m)
+  double lbar[SIM_W];    // Darboux length (m)
+  double ib[SIM_W];      // rotary inertia about d1, d2 (kg m^2)
+  double it[SIM_W];      // ... about d3
+} sim_stat;
+
 // The elimination schedule of a model for nthread threads: blocks in an order where every
 // body's children come in earlier blocks; thread k eliminates its subtrees' blocks
 // [part[k], part[k+1]), then one thread the top part [part[nthread], nblock). Each body sums
@@ -237,6 +264,7 @@ typedef struct sim_plan {
   double* tie_g;             // ... and their residual sum c h^2 / compliance ((nslot + nspare) x 3)
   double* spare_dy;          // update of each spare node this iteration (nspare x 3)
   sim_blk* blk;              // the blocks (nblock, 64-byte aligned inside mem)
+  sim_stat* stat;            // their model data (nblock, 64-byte aligned)
   void* mem;                 // one allocation for all of the above
   size_t nbytes;             // its size
 } sim_plan;

@@ -77,38 +77,18 @@ void m6_chol_solve(const double* l, double* b) {
   }
 }
 
-vd_quat quat_exp(vd_vec3 v) {
-  double a2 = v.x * v.x + v.y * v.y + v.z * v.z;
-  vd_quat q;
-  double c, k;
-  if (a2 <= 0.01) {
-    sim_exp_series(a2, &c, &k);  // below 0.1 rad (the steps' turns): no libm call
-  } else {
-    double a = sqrt(a2);
-    c = cos(0.5 * a), k = sin(0.5 * a) / a;
-  }
-  q.w = c;
-  q.x = v.x * k, q.y = v.y * k, q.z = v.z * k;
+vd_quat quat_exp_big(vd_vec3 v) {
+  double a = v_norm(v), k = sin(0.5 * a) / a;
+  vd_quat q = {cos(0.5 * a), v.x * k, v.y * k, v.z * k};
   return q;
 }
 
-vd_vec3 quat_log(vd_quat q) {
+vd_vec3 quat_log_big(vd_quat q) {
   if (q.w < 0) q.w = -q.w, q.x = -q.x, q.y = -q.y, q.z = -q.z;
-  double s2 = q.x * q.x + q.y * q.y + q.z * q.z, w2 = q.w * q.w;
-  double k;
-  if (q.w > 0 && s2 <= 0.01 * w2) {
-    // 2 atan2(s, w) / s = (2 / w) atan(t) / t, t = s / w <= 0.1
-    k = 2 * sim_atan_ratio(s2 / w2) / q.w;
-  } else {
-    double s = sqrt(s2);
-    if (s < 1e-12) return vd_v3(2 * q.x, 2 * q.y, 2 * q.z);
-    k = 2 * atan2(s, q.w) / s;
-  }
+  double s = sqrt(q.x * q.x + q.y * q.y + q.z * q.z);
+  if (s < 1e-12) return vd_v3(2 * q.x, 2 * q.y, 2 * q.z);
+  double k = 2 * atan2(s, q.w) / s;
   return vd_v3(q.x * k, q.y * k, q.z * k);
-}
-
-vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) {
-  return q_normalize(q_mul(quat_exp(v), q));
 }
 
 vd_quat quat_between(vd_vec3 a, vd_vec3 b) {

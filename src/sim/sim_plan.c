@@ -5,7 +5,7 @@
 // A body can be eliminated once its children are. Tips are ready at once and go first, in
 // blocks of tips only (their body matrix is diagonal, sim_direct.c has a kernel for it); then
 // list scheduling: each block takes the SIM_W ready bodies farthest from the root (the longest
-// chain still to go), which packs the tomato's 1455 bodies into 369 blocks of 4 (364 at best).
+// chain still to go), which packs the tomato's 1455 bodies into 190 blocks of 8 (182 at best).
 // For several threads the tree is cut into subtrees, split from the root down until the largest
 // holds at most nbody / (4 nthread) bodies, and handed out largest first to the least loaded
 // thread; the bodies split off form the top part, eliminated after the subtrees.
@@ -212,6 +212,7 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     size_t o_th = TAKE(((size_t)nslot + nsp) * sizeof(double)), o_tg = TAKE(((size_t)nslot + nsp) * 3 * sizeof(double));
     size_t o_sd = TAKE(((size_t)nsp + 1) * 3 * sizeof(double));
     size_t o_bk = TAKE((size_t)nblock * sizeof(sim_blk) + 64);
+    size_t o_st = TAKE((size_t)nblock * sizeof(sim_stat) + 64);
 #undef TAKE
     char* mem = vd_calloc(1, top);
     if (!mem) {
@@ -226,6 +227,8 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     p->tie_h = (double*)(mem + o_th), p->tie_g = (double*)(mem + o_tg), p->spare_dy = (double*)(mem + o_sd);
     uintptr_t a = (uintptr_t)(mem + o_bk);
     p->blk = (sim_blk*)(mem + o_bk + ((64 - (a & 63)) & 63));
+    a = (uintptr_t)(mem + o_st);
+    p->stat = (sim_stat*)(mem + o_st + ((64 - (a & 63)) & 63));
     memcpy(p->tip_block, b.tips, (size_t)nblock);
     for (int t = 0; t < ns; t++) p->seg_slot[t] = -1;
     for (int s = 0; s < nslot; s++) {
@@ -242,6 +245,19 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
       for (int k = b.kstart[t]; k < b.kstart[t + 1]; k++) p->kid_slot[nk++] = p->seg_slot[b.kids[k]];
     }
     p->kid_start[nslot] = nk;
+    // the model's data of each lane
+    for (int s = 0; s < nslot; s++) {
+      sim_stat* sb = &p->stat[s / SIM_W];
+      int l = s % SIM_W, t = p->slot_seg[s];
+      vd_quat q0 = t >= 0 ? m->seg_rest[t] : vd_quat_identity();
+      sb->q0[0][l] = q0.w, sb->q0[1][l] = q0.x, sb->q0[2][l] = q0.y, sb->q0[3][l] = q0.z;
+      for (int k = 0; k < 3; k++) {
+        sb->cs[k][l] = t >= 0 ? m->seg_cs[3 * t + k] : 1.0;
+        sb->cb[k][l] = t >= 0 ? m->seg_cb[3 * t + k] : 1.0;
+      }
+      sb->l0[l] = t >= 0 ? m->seg_len0[t] : 1.0, sb->lbar[l] = t >= 0 ? m->seg_lbar[t] : 1.0;
+      sb->ib[l] = t >= 0 ? m->seg_inertia[2 * t] : 1.0, sb->it[l] = t >= 0 ? m->seg_inertia[2 * t + 1] : 1.0;
+    }
   }
 done:
   vd_free(b.par, n1 * I), vd_free(b.kstart, (n1 + 1) * I), vd_free(b.kids, n1 * I);

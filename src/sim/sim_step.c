@@ -165,7 +165,8 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     double fl = m->opt.solver == VD_SIM_GS ? h : 0.0;
     for (int i = 0; i < na; i++) {
       if (!sim_node_moves(m, d, i)) continue;
-      vd_vec3 v = vd_madd(d->node_vel[i], w->node_fext[i], fl / (d->node_mass[i] + h * w->node_drag[i]));
+      vd_vec3 v = d->node_vel[i];
+      if (fl != 0) v = vd_madd(v, w->node_fext[i], fl / (d->node_mass[i] + h * w->node_drag[i]));
       d->node_pos[i] = vd_madd(d->node_pos[i], v, h);
     }
     for (int t = 0; t < ns; t++) {
