@@ -25,6 +25,8 @@ static const char* sim_help =
     "      --duration T        simulated time (s); default 1, or 0 after --settle/--statics\n"
     "      --dt H              time step (s), default 0.001\n"
     "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 1\n"
+    "      --threads N         threads for one plant's step (default 1): the direct solver's\n"
+    "                          subtrees; the same bytes for any N\n"
     "      --solver S          direct (exact tree solve, default) or gs (XPBD Gauss-Seidel)\n"
     "      --settle            first run damped dynamics until the plant is still\n"
     "      --statics           first solve the static equilibrium directly\n"
@@ -606,6 +608,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->opt.dt, x_ > 0 && x_ <= 1, "a time step in (0, 1] (s)");
     } else if (!strcmp(a, "--iterations")) {
       NUM(o->opt.iterations, x_ >= 1 && x_ <= 10000 && x_ == floor(x_), "an integer in 1..10000");
+    } else if (!strcmp(a, "--threads")) {
+      NUM(o->opt.threads, x_ >= 1 && x_ <= 64 && x_ == floor(x_), "an integer in 1..64");
     } else if (!strcmp(a, "--solver")) {
       VAL();
       if (!strcmp(val, "direct")) o->opt.solver = VD_SIM_DIRECT;

@@ -177,6 +177,9 @@ typedef struct vd_sim_opt {
   int fracture;               // 1: joints break at their thresholds
   int contacts;               // 1: colliders are projected
   double friction;            // Coulomb friction coefficient of contacts (-)
+  int threads;                // threads one state's step uses (the direct solver's subtrees, per-segment
+                              // loops); the bytes do not depend on it; changing it rebuilds the
+                              // solver's schedule at the next step (one allocation)
   int self_collision;         // 1: the plant's capsules and fruit spheres collide with each other
                               // (vd_collide_self; topological neighbours and pairs touching in
                               // the modelled shape excluded)
@@ -185,7 +188,8 @@ typedef struct vd_sim_opt {
 // Defaults: dt 1e-3 s, iterations 1, solver direct, gravity (0, 0, -9.81) m/s^2,
 // air_density 1.226 kg/m^3, wind 0 m/s, gust_amplitude 0, gust_period 2 s, no wind series,
 // drag 1, stokes_viscosity 0 Pa s, damping 0 s, mass_damping 0 1/s, fracture 1, contacts 1,
-// friction 0.5, self_collision 0 (off: it costs ~30 % on the tomato with a probe, docs/physics.md).
+// friction 0.5, threads 1, self_collision 0 (off: it costs ~30 % on the tomato with a probe,
+// docs/physics.md).
 vd_sim_opt vd_sim_opt_default(void);
 
 // rod segment flags

@@ -18,6 +18,7 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
   size_t o_w = take(&top, sizeof(sim_work));
   size_t o_np = take(&top, na * sizeof(vd_vec3)), o_sp = take(&top, ns * sizeof(vd_quat));
   size_t o_fe = take(&top, na * sizeof(vd_vec3)), o_te = take(&top, ns * sizeof(vd_vec3)), o_dr = take(&top, na * D);
+  size_t o_sdr = take(&top, ns * 5 * D);
   size_t o_cp = take(&top, ns * 6 * D), o_so = take(&top, nsp * sizeof(int)), o_ls = take(&top, ns * 6 * D);
 
   char* blk = vd_calloc(1, top);
@@ -25,6 +26,7 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
   sim_work* w = (sim_work*)(blk + o_w);
   w->node_prev = (vd_vec3*)(blk + o_np), w->seg_prev = (vd_quat*)(blk + o_sp);
   w->node_fext = (vd_vec3*)(blk + o_fe), w->seg_text = (vd_vec3*)(blk + o_te), w->node_drag = (double*)(blk + o_dr);
+  w->seg_drag = (double*)(blk + o_sdr);
   w->c_prev = (double*)(blk + o_cp), w->spare_of = (int*)(blk + o_so), w->lambda_save = (double*)(blk + o_ls);
 
   w->tie_lambda = vd_calloc(ntl, 3 * D);

@@ -23,6 +23,7 @@
 //   in the fixed order of its children, so the bytes do not depend on the schedule or threads.
 // * Tips (a third of the tomato) have a diagonal body matrix: their inverse is written down.
 // * 6x6 inverses by 3x3 Schur blocks (two divisions each), used through products.
+#include <omp.h>
 #include <stddef.h>
 
 #include "sim_internal.h"
@@ -635,8 +636,8 @@ SIM_CLONES static double trust_scale(const sim_plan* p) {
 
 // apply the update scaled by scale: positions, frames, multipliers (stretch rows back to the
 // material frame: dlambda_s = l0 R^T dl^)
-SIM_CLONES static void apply_blocks(const vd_sim_model* m, vd_sim_data* d, sim_plan* p, double scale) {
-  for (int bi = 0; bi < p->nblock; bi++) {
+SIM_CLONES static void apply_blocks(const vd_sim_model* m, vd_sim_data* d, sim_plan* p, double scale, int b0, int b1) {
+  for (int bi = b0; bi < b1; bi++) {
     sim_blk* b = &p->blk[bi];
     lane v[3], need, ls[3];
     for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
@@ -685,11 +686,43 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
   }
   sim_stage(d, VD_SIM_STAGE_EVAL, ctx->tstage);
   // forward elimination (with each block's linearisation), then back substitution
-  if (!forward_range(m, d, w, ctx, 0, p->nblock)) return 0;
-  sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
-  back_range(m, d, w, 0, p->nblock);
-  double scale = trust_scale(p);
-  apply_blocks(m, d, p, scale);
+  double scale = 1;
+  if (p->nthread <= 1) {
+    if (!forward_range(m, d, w, ctx, 0, p->nblock)) return 0;
+    sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
+    back_range(m, d, w, 0, p->nblock);
+    scale = trust_scale(p);
+    apply_blocks(m, d, p, scale, 0, p->nblock);
+  } else {
+    // each thread its subtrees, then one thread the top part; back substitution the other way
+    // round; the update by blocks
+    int nt = p->nthread, ok = 1;
+#pragma omp parallel num_threads(nt)
+    {
+      int team = omp_get_num_threads(), me = omp_get_thread_num(), mine = 1;
+      for (int k = me; k < nt; k += team) mine &= forward_range(m, d, w, ctx, p->part[k], p->part[k + 1]);
+      if (!mine) {
+#pragma omp atomic write
+        ok = 0;
+      }
+#pragma omp barrier
+#pragma omp single
+      {
+        if (ok && !forward_range(m, d, w, ctx, p->part[nt], p->nblock)) ok = 0;
+        if (ok) back_range(m, d, w, p->part[nt], p->nblock);
+      }
+      if (ok) {
+        for (int k = me; k < nt; k += team) back_range(m, d, w, p->part[k], p->part[k + 1]);
+#pragma omp barrier
+#pragma omp single
+        scale = trust_scale(p);
+        int per = (p->nblock + team - 1) / team, b0 = me * per, b1 = b0 + per < p->nblock ? b0 + per : p->nblock;
+        if (b0 < b1) apply_blocks(m, d, p, scale, b0, b1);
+      }
+    }
+    if (!ok) return 0;
+    sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
+  }
   for (int t = 0; t < nseg; t++) {
     if (!d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;
     int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;
@@ -714,6 +747,13 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
 
 int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c) {
   sim_work* w = (sim_work*)d->work;
+  // the schedule is cut for opt.threads (rebuilt when that changes)
+  int nt = m->opt.threads < 1 ? 1 : m->opt.threads > SIM_MAX_THREADS ? SIM_MAX_THREADS : m->opt.threads;
+  if (w->plan.nthread != nt && sim_plan_build(m, nt, &w->plan)) {
+    sim_warn(d, VD_SIM_WARN_ARENA);
+    sim_plan_build(m, 1, &w->plan);  // fall back to one thread
+    if (!w->plan.mem) return 0;
+  }
   int iters = c->statics && m->opt.iterations < 4 ? 4 : m->opt.iterations;
   for (int it = 0; it < iters; it++) {
     if (!iterate(m, d, w, c)) return 0;

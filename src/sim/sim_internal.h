@@ -284,6 +284,7 @@ typedef struct sim_work {
   vd_vec3* node_fext;   // total external force this step (N) (nnode_all)
   vd_vec3* seg_text;    // total external torque this step (N m) (nseg)
   double* node_drag;    // air drag damping -dF/dv of each node, taken implicitly (kg/s) (nnode_all)
+  double* seg_drag;     // each segment's drag force (N), damping (kg/s) and start node's share (nseg x 5)
   double* c_prev;       // constraint values at the start of the step (nseg x 6)
   double* lambda_save;  // multipliers before a statics step, to undo it (nseg x 6)
   int* spare_of;        // spare index -> segment (nspare)
@@ -326,6 +327,18 @@ static inline void sim_stage(vd_sim_data* d, vd_sim_stage s, double* t) {
 }
 // The start of a timed span (0 when not profiling).
 static inline double sim_stage_start(const vd_sim_data* d) { return d->profile ? sim_clock() : 0.0; }
+
+// Threads of a state's step (opt.threads, at least 1), and a parallel loop over independent
+// elements with them: each element's arithmetic is the same on any thread, so the bytes do not
+// depend on the count (reductions are max or logical, which do not depend on the order).
+static inline int sim_threads(const vd_sim_model* m) {
+  return m->opt.threads < 1 ? 1 : m->opt.threads > SIM_MAX_THREADS ? SIM_MAX_THREADS : m->opt.threads;
+}
+// fn(ctx, chunk, i0, i1) over [0, n) cut into nchunk = min(nt, n / 256, SIM_MAX_THREADS)
+// contiguous chunks run by nt threads (at least one chunk; one chunk runs on the caller without
+// OpenMP); returns nchunk. Per-chunk results go to arrays indexed by chunk.
+typedef void (*sim_range_fn)(void* ctx, int chunk, int i0, int i1);
+int sim_parallel(int nt, int n, sim_range_fn fn, void* ctx);
 
 // Count one numerical warning of kind k (vd_sim_warning) in d->warning and d->nwarning.
 static inline void sim_warn(vd_sim_data* d, int k) {

@@ -115,6 +115,18 @@ static void schedule_part(build* b, int part) {
   }
 }
 
+int sim_parallel(int nt, int n, sim_range_fn fn, void* ctx) {
+  int nc = nt < n / 256 ? nt : n / 256;
+  if (nc > SIM_MAX_THREADS) nc = SIM_MAX_THREADS;
+  if (nc <= 1) {
+    fn(ctx, 0, 0, n);
+    return 1;
+  }
+#pragma omp parallel for num_threads(nt) schedule(static, 1)
+  for (int k = 0; k < nc; k++) fn(ctx, k, (int)((long)n * k / nc), (int)((long)n * (k + 1) / nc));
+  return nc;
+}
+
 void sim_plan_free(sim_plan* p) {
   vd_free(p->mem, p->nbytes);
   memset(p, 0, sizeof *p);
@@ -167,26 +179,45 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     if (b.par[t] >= 0) b.size[b.par[t]] += b.size[t];
   }
   b.hp.key = b.depth;
-  // the cut: split the largest subtree until every one holds at most nbody / (4 nthread)
-  // bodies (the split bodies form the top part), then hand them out largest first
+  // the cut: split the largest subtree (its root goes to the top part, its children become
+  // subtrees) as long as that shortens the estimated elimination, the largest thread's bodies
+  // / SIM_W (subtrees pack into full blocks, handed out largest first to the least loaded
+  // thread) plus the top part's bodies (a chain: about a block each); then cut there
   if (nthread > 1) {
     heap cut = {b.hp.v, 0, b.size};
-    for (int t = 0; t < ns; t++)
-      if (is_body(m, t) && b.par[t] < 0) heap_push(&cut, t);
-    int target = nbody / (4 * nthread);
-    if (target < 1) target = 1;
-    while (cut.n && b.size[cut.v[0]] > target) {
-      int t = heap_pop(&cut);
-      b.owner[t] = nthread;
-      for (int k = b.kstart[t]; k < b.kstart[t + 1]; k++) heap_push(&cut, b.kids[k]);
-    }
-    long load[SIM_MAX_THREADS] = {0};
-    while (cut.n) {
-      int t = heap_pop(&cut), best = 0;
-      for (int k = 1; k < nthread; k++)
-        if (load[k] < load[best]) best = k;
-      load[best] += b.size[t];
-      b.owner[t] = best;  // its whole subtree goes to that thread (below)
+    int* sorted = b.pending;  // scratch for the assignment
+    int best_splits = 0, splits = 0;
+    double best = 1e300;
+    for (int pass = 0; pass < 2; pass++) {
+      cut.n = 0, splits = 0;
+      for (int t = 0; t < ns; t++) {
+        b.owner[t] = 0;
+        if (is_body(m, t) && b.par[t] < 0) heap_push(&cut, t);
+      }
+      for (;;) {
+        // the assignment of the current subtrees (the heap holds them, largest first)
+        long load[SIM_MAX_THREADS] = {0};
+        int nsub = cut.n;
+        memcpy(sorted, cut.v, (size_t)nsub * sizeof(int));
+        heap tmp = {sorted, nsub, b.size};  // a copy of the heap: popped largest first
+        while (tmp.n) {
+          int t = heap_pop(&tmp), k0 = 0;
+          for (int k = 1; k < nthread; k++)
+            if (load[k] < load[k0]) k0 = k;
+          load[k0] += b.size[t];
+          if (pass == 1 && splits == best_splits) b.owner[t] = k0;
+        }
+        long mx = 0;
+        for (int k = 0; k < nthread; k++) mx = load[k] > mx ? load[k] : mx;
+        double est = (double)mx / SIM_W + splits;
+        if (pass == 0 && est < best) best = est, best_splits = splits;
+        // finer cuts than nbody / (16 nthread) do not pay
+        if ((pass == 1 && splits == best_splits) || !cut.n || b.size[cut.v[0]] * 16 * nthread <= nbody) break;
+        int t = heap_pop(&cut);
+        b.owner[t] = nthread;
+        splits++;
+        for (int k = b.kstart[t]; k < b.kstart[t + 1]; k++) heap_push(&cut, b.kids[k]);
+      }
     }
     // every body below a cut root takes its root's owner: walk parents first
     for (int i = ns - 1; i >= 0; i--) {
