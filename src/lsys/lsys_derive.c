@@ -602,80 +602,117 @@ static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, pass_ctx
   return st;
 }
 
-vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
-  vd_error local = {0};
-  ls->err = err ? err : &local;
+// the run's settings with defaults filled in; the interpreter budget starts
+static vd_lsys_def run_def(vd_lsystem* ls, const vd_lsys_def* def) {
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
   vm_budget(ls, d.max_ops);
-  vd_lstring tmp = vd_lstring_empty();
-  pass_ctx P = {NULL, 0, d.max_modules};
+  return d;
+}
+
+// the derivation length: def's steps, else the file's `derivation length`
+static vd_status run_length(vd_lsystem* ls, const vd_lsys_def* d, int* steps) {
+  *steps = d->steps;
+  if (*steps >= 0) return VD_OK;
+  *steps = 1;
+  if (!ls->derivation_length) return VD_OK;
+  value v;
+  vd_status st = vm_eval(ls, ls->derivation_length, NULL, &v);
+  if (st) return st;
+  if (!v_isnum(v) || v.n != floor(v.n) || v.n < 0 || v.n > 1e9)
+    return vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
+                    "derivation length must be a non-negative integer");
+  *steps = (int)v.n;
+  return VD_OK;
+}
+
+// top-level code with the seed, the derivation length (steps Nullable), the Start hook and the
+// axiom into out
+static vd_status run_axiom(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out, int* steps) {
   vd_status st = build_index(ls);
-  if (st) {
-    vm_error(ls, st, 0, 0, "out of memory");
-    goto done;
-  }
+  if (st) return vm_error(ls, st, 0, 0, "out of memory");
   if (out->src) {
     vd_free(out->src, sizeof(int64_t) * (size_t)out->cap);
     out->src = NULL;
   }
-  if ((st = run_toplevel(ls, d.seed))) goto done;
-  int steps = d.steps;
-  if (steps < 0) {
-    steps = 1;
-    if (ls->derivation_length) {
-      value v;
-      if ((st = vm_eval(ls, ls->derivation_length, NULL, &v))) goto done;
-      if (!v_isnum(v) || v.n != floor(v.n) || v.n < 0 || v.n > 1e9) {
-        st = vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
-                      "derivation length must be a non-negative integer");
-        goto done;
-      }
-      steps = (int)v.n;
-    }
-  }
+  if ((st = run_toplevel(ls, d->seed))) return st;
+  if (steps && (st = run_length(ls, d, steps))) return st;
   ls->hook_start = find_hook(ls, "Start");
   ls->hook_end = find_hook(ls, "End");
   ls->hook_starteach = find_hook(ls, "StartEach");
   ls->hook_endeach = find_hook(ls, "EndEach");
-  if ((st = call_hook(ls, ls->hook_start))) goto done;
-  // axiom
+  ls->steps_done = 0;
+  if ((st = call_hook(ls, ls->hook_start))) return st;
   lstr_clear(out);
-  if (!lstr_reserve(out, 64, 64)) {
-    st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-    goto done;
+  if (!lstr_reserve(out, 64, 64)) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  vm_out vo = {out, 0, d->max_modules, 0, 0};
+  if (ls->axiom) {
+    st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
+  } else {
+    int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
+    value* frame = vd_malloc(sizeof(value) * (size_t)nl);
+    if (!frame) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
+    st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
+    vd_free(frame, sizeof(value) * (size_t)nl);
   }
-  {
-    vm_out vo = {out, 0, d.max_modules, 0, 0};
-    if (ls->axiom) {
-      st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
-    } else {
-      int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
-      value* frame = vd_malloc(sizeof(value) * (size_t)nl);
-      if (!frame) {
-        st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-        goto done;
-      }
-      for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
-      st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
-      vd_free(frame, sizeof(value) * (size_t)nl);
-    }
-    if (st) goto done;
-  }
+  if (st) return st;
   if (has_cut(out)) apply_cut(out);
-  for (int step = 0; step < steps && !ls->stop_requested; step++) {
-    ls->iteration = step;
-    if ((st = call_hook(ls, ls->hook_starteach))) goto done;
-    int fired = 0;
-    if ((st = apply_rules(ls, SEC_PRODUCTION, out, &tmp, &P, &fired))) goto done;
-    lstr_swap(out, &tmp);
-    if (has_cut(out)) apply_cut(out);
-    if ((st = apply_section(ls, SEC_DECOMPOSITION, out, &tmp, &P))) goto done;
-    if ((st = call_hook(ls, ls->hook_endeach))) goto done;
-    if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
+  return VD_OK;
+}
+
+// one derivation step: StartEach, the productions, cut, decomposition, EndEach
+static vd_status run_step(vd_lsystem* ls, vd_lstring* cur, vd_lstring* tmp, pass_ctx* P) {
+  ls->iteration = ls->steps_done++;
+  vd_status st = call_hook(ls, ls->hook_starteach);
+  if (st) return st;
+  int fired = 0;
+  if ((st = apply_rules(ls, SEC_PRODUCTION, cur, tmp, P, &fired))) return st;
+  lstr_swap(cur, tmp);
+  if (has_cut(cur)) apply_cut(cur);
+  if ((st = apply_section(ls, SEC_DECOMPOSITION, cur, tmp, P))) return st;
+  return call_hook(ls, ls->hook_endeach);
+}
+
+vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  vd_lsys_def d = run_def(ls, def);
+  vd_lstring tmp = vd_lstring_empty();
+  pass_ctx P = {NULL, 0, d.max_modules};
+  int steps = 0;
+  vd_status st = run_axiom(ls, &d, out, &steps);
+  for (int step = 0; !st && step < steps && !ls->stop_requested; step++) {
+    st = run_step(ls, out, &tmp, &P);
+    if (!st && d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
   }
-  if ((st = call_hook(ls, ls->hook_end))) goto done;
-done:
+  if (!st) st = call_hook(ls, ls->hook_end);
+  return end_run(ls, st, &tmp, &P);
+}
+
+vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  vd_lsys_def d = run_def(ls, def);
+  vd_lstring tmp = vd_lstring_empty();
+  pass_ctx P = {NULL, 0, d.max_modules};
+  return end_run(ls, run_axiom(ls, &d, out, NULL), &tmp, &P);
+}
+
+vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* s, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  vd_lsys_def d = run_def(ls, def);
+  vd_lstring tmp = vd_lstring_empty();
+  pass_ctx P = {NULL, 0, d.max_modules};
+  vd_status st = VD_OK;
+  // every module names itself as its source; the passes carry that to what it becomes
+  if (!lstr_enable_src(s) || !lstr_enable_src(&tmp)) st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  for (int64_t i = 0; !st && i < s->n; i++) s->src[i] = i;
+  if (!st && ls->stop_requested)
+    st = vm_error(ls, VD_ERR_VALUE, 0, 0, "the L-system has stopped (Stop() was called): no more steps");
+  if (!st) st = run_step(ls, s, &tmp, &P);
+  if (!st && d.progress) d.progress(d.progress_user, ls->steps_done, ls->steps_done, s->n);
   return end_run(ls, st, &tmp, &P);
 }
 

@@ -215,6 +215,7 @@ struct vd_lsystem {
   vd_rng rng;
   int current_group;
   int iteration;
+  int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int stop_requested;
   int call_depth;
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)

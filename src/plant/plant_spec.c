@@ -26,13 +26,73 @@ void vd_plant_spec_destroy(vd_plant_spec* s) {
   vd_free(s->vert, (size_t)s->cap_vert * sizeof *s->vert);
   vd_free(s->tri, (size_t)s->cap_tri * 3 * sizeof *s->tri);
   vd_free(s->label, (size_t)s->cap_label * sizeof *s->label);
+  vd_plant_set_stress(s, NULL, NULL);
   vd_free(s, sizeof *s);
+}
+
+vd_status vd_plant_set_stress(vd_plant_spec* s, const double* node, const double* seg) {
+  vd_free(s->node_stress, (size_t)s->nstress_node * sizeof(double));
+  vd_free(s->seg_stress, (size_t)s->nstress_seg * sizeof(double));
+  s->node_stress = s->seg_stress = NULL;
+  s->nstress_node = s->nstress_seg = 0;
+  if (!node && !seg) return VD_OK;
+  size_t nn = (size_t)(s->nnode ? s->nnode : 1), ns = (size_t)(s->nseg ? s->nseg : 1);
+  double* a = vd_malloc(nn * sizeof(double));
+  double* b = vd_malloc(ns * sizeof(double));
+  if (!a || !b) {
+    vd_free(a, nn * sizeof(double));
+    vd_free(b, ns * sizeof(double));
+    return VD_ERR_NOMEM;
+  }
+  for (int i = 0; i < s->nnode; i++) a[i] = node ? node[i] : NAN;
+  for (int i = 0; i < s->nseg; i++) b[i] = seg ? seg[i] : NAN;
+  s->node_stress = a, s->nstress_node = (int)nn;
+  s->seg_stress = b, s->nstress_seg = (int)ns;
+  return VD_OK;
+}
+
+int vd_plant_has_stress(const vd_plant_spec* s) {
+  return s->node_stress && s->seg_stress && s->nstress_node == (s->nnode ? s->nnode : 1) &&
+         s->nstress_seg == (s->nseg ? s->nseg : 1);
+}
+
+// copy n elements of size esz into a new array of exactly n (capacity n)
+static int copy_array(void** dst, int* cap, const void* src, int n, size_t esz) {
+  *dst = NULL;
+  *cap = 0;
+  if (n <= 0) return 1;
+  *dst = vd_malloc((size_t)n * esz);
+  if (!*dst) return 0;
+  memcpy(*dst, src, (size_t)n * esz);
+  *cap = n;
+  return 1;
+}
+
+vd_plant_spec* vd_plant_spec_copy(const vd_plant_spec* s) {
+  vd_plant_spec* c = vd_plant_spec_create();
+  if (!c) return NULL;
+  int ok = copy_array((void**)&c->node, &c->cap_node, s->node, s->nnode, sizeof *s->node) &&
+           copy_array((void**)&c->seg, &c->cap_seg, s->seg, s->nseg, sizeof *s->seg) &&
+           copy_array((void**)&c->sphere, &c->cap_sphere, s->sphere, s->nsphere, sizeof *s->sphere) &&
+           copy_array((void**)&c->mesh, &c->cap_mesh, s->mesh, s->nmesh, sizeof *s->mesh) &&
+           copy_array((void**)&c->vert, &c->cap_vert, s->vert, s->nvert, sizeof *s->vert) &&
+           copy_array((void**)&c->tri, &c->cap_tri, s->tri, s->ntri, 3 * sizeof *s->tri) &&
+           copy_array((void**)&c->label, &c->cap_label, s->label, s->nlabel, sizeof *s->label);
+  c->nnode = s->nnode, c->nseg = s->nseg, c->nsphere = s->nsphere, c->nmesh = s->nmesh;
+  c->nvert = s->nvert, c->ntri = s->ntri, c->nlabel = s->nlabel, c->ninstance = s->ninstance;
+  if (ok && vd_plant_has_stress(s)) ok = vd_plant_set_stress(c, s->node_stress, s->seg_stress) == VD_OK;
+  if (!ok) {
+    vd_plant_spec_destroy(c);
+    return NULL;
+  }
+  return c;
 }
 
 void vd_plant_spec_clear(vd_plant_spec* s) {
   if (!s) return;
   s->nnode = s->nseg = s->nsphere = s->nmesh = s->nvert = s->ntri = s->nlabel = 0;
   s->ninstance = 0;
+  vd_plant_set_stress(s, NULL, NULL);
 }
 
 // ---------------------------------------------------------------------------------------------
