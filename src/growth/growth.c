@@ -294,7 +294,7 @@ static int uid_reserve(vd_growth* g, int64_t n) {
 static int uid_follow(vd_growth* g, const int64_t* old_uid, const int32_t* old_sym, int64_t n_old,
                       unsigned char* taken) {
   const vd_lstring* s = &g->str;
-  if (!uid_reserve(g, s->n + 1)) return 0;
+  if (!uid_reserve(g, s->n + 1) || !taken) return 0;
   memset(taken, 0, (size_t)(n_old ? n_old : 1));
   for (int64_t j = 0; j < s->n; j++) {
     int64_t o = s->src ? s->src[j] : -1;
@@ -1009,12 +1009,14 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
     int32_t* old_sym = vd_malloc(sizeof(int32_t) * (size_t)(n_old ? n_old : 1));
     unsigned char* taken = vd_malloc((size_t)(n_old ? n_old : 1));
     if (!old_uid || !old_sym || !taken) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-    if (!st) {
-      memcpy(old_uid, g->uid, sizeof(int64_t) * (size_t)n_old);
-      memcpy(old_sym, g->str.sym, sizeof(int32_t) * (size_t)n_old);
+    if (!st && old_uid && old_sym && taken) {
+      if (n_old && g->uid && g->str.sym) {
+        memcpy(old_uid, g->uid, sizeof(int64_t) * (size_t)n_old);
+        memcpy(old_sym, g->str.sym, sizeof(int32_t) * (size_t)n_old);
+      }
       st = vd_lsys_derive_step(g->ls, &g->def.lsys, &g->str, err);
     }
-    if (!st && !uid_follow(g, old_uid, old_sym, n_old, taken))
+    if (!st && (!old_uid || !old_sym || !uid_follow(g, old_uid, old_sym, n_old, taken)))
       st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
     vd_free(old_uid, sizeof(int64_t) * (size_t)(n_old ? n_old : 1));
     vd_free(old_sym, sizeof(int32_t) * (size_t)(n_old ? n_old : 1));
@@ -1147,8 +1149,14 @@ vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err
   // stress per node and per segment (NaN where there is none)
   double* ns = vd_malloc(sizeof(double) * (size_t)(s->nnode ? s->nnode : 1));
   double* ss = vd_malloc(sizeof(double) * (size_t)(s->nseg ? s->nseg : 1));
-  vd_status st = ns && ss ? VD_OK : vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  if (!st) {
+  if (!ns || !ss) {
+    vd_free(ns, sizeof(double) * (size_t)(s->nnode ? s->nnode : 1));
+    vd_free(ss, sizeof(double) * (size_t)(s->nseg ? s->nseg : 1));
+    vd_plant_spec_destroy(p);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  vd_status st = VD_OK;
+  {
     for (int i = 0; i < s->nnode; i++) ns[i] = NAN;
     for (int j = 0; j < s->nseg; j++) ss[j] = NAN;
     if (g->mm) {

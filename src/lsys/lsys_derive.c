@@ -732,13 +732,15 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   }
   // copy the input with its source indices
   lstr_clear(out);
-  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 1, in->par[in->n] + 1) || !lstr_enable_src(&tmp)) {
+  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 1, (in->par ? in->par[in->n] : 0) + 1) || !lstr_enable_src(&tmp)) {
     st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
     goto done;
   }
-  memcpy(out->sym, in->sym, sizeof(int32_t) * (size_t)in->n);
-  memcpy(out->par, in->par, sizeof(int64_t) * (size_t)(in->n + 1));
-  memcpy(out->val, in->val, sizeof(double) * (size_t)in->par[in->n]);
+  if (in->n > 0 && in->sym && in->par && in->val) {
+    memcpy(out->sym, in->sym, sizeof(int32_t) * (size_t)in->n);
+    memcpy(out->par, in->par, sizeof(int64_t) * (size_t)(in->n + 1));
+    memcpy(out->val, in->val, sizeof(double) * (size_t)in->par[in->n]);
+  }
   for (int64_t i = 0; i < in->n; i++) out->src[i] = in->src ? in->src[i] : i;
   out->n = in->n;
   st = apply_section(ls, SEC_INTERPRETATION, out, &tmp, &P);

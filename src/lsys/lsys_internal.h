@@ -211,11 +211,11 @@ struct vd_lsystem {
   // hooks (user function index or -1)
   int hook_start, hook_end, hook_starteach, hook_endeach;
   int has_cut;
+  int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   // runtime
   vd_rng rng;
   int current_group;
   int iteration;
-  int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int stop_requested;
   int call_depth;
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)

@@ -360,7 +360,9 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
       int base = owner[i] < 0;
       int in_soil = has_roots && (((m->node_flags[i] & VD_MSS_ROOT) && depth > 0) ||
                                   (base && z <= soil->ground + def->fix_height));
-      if (in_soil && soil->method == VD_SOIL_CLAMP) {
+      // clamped: in a clamping soil, or a stem base at the ground of a plant without roots
+      int clamp = (in_soil && soil->method == VD_SOIL_CLAMP) || (!has_roots && base && z <= soil->ground + def->fix_height);
+      if (clamp) {
         m->node_flags[i] |= VD_MSS_FIXED;
         nfixed++;
       } else if (in_soil) {
@@ -369,9 +371,6 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
         double area = s >= 0 ? VD_PI * (m->spring_radius[2 * s] + m->spring_radius[2 * s + 1]) * m->spring_l0[s] : 0;
         m->node_soil[i] = vd_soil_max_force(soil, depth, m->node_radius[i], area);
         nsoil++;
-      } else if (!has_roots && base && z <= soil->ground + def->fix_height) {
-        m->node_flags[i] |= VD_MSS_FIXED;
-        nfixed++;
       }
     }
     // a plant held by nothing is clamped at its lowest base
