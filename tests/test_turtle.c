@@ -721,16 +721,16 @@ TEST(turtle, tropism_rule) {
   CHECK_NEAR(vd_dot(P->seg[1].up, vd_sub(seg_b(P, 1), seg_a(P, 1))), 0, TOL);
   vd_plant_spec_destroy(P);
   // full elasticity aligns H with T (normalised); f bends too
-  CHECK_V3(end_of("Tropism(2,0,0) Elasticity(1) F"), 1, 0, 0);
-  REQUIRE(run("Tropism(1,0,0) Elasticity(1) f F", &P) == VD_OK);
+  CHECK_V3(end_of("@Tp(2,0,0) @Ts(1) F"), 1, 0, 0);
+  REQUIRE(run("@Tp(1,0,0) @Ts(1) f F", &P) == VD_OK);
   CHECK_V3(seg_a(P, 0), 1, 0, 0);
   CHECK_V3(seg_b(P, 0), 2, 0, 0);
   vd_plant_spec_destroy(P);
-  // settings from the def; Elasticity() turns it off
+  // settings from the def; @Ts() turns it off
   vd_turtle_def d = vd_turtle_def_default();
   d.tropism = vd_v3(0, 1, 0);
   d.elasticity = 1;
-  REQUIRE(run_def("F Elasticity F", &d, &P) == VD_OK);
+  REQUIRE(run_def("F @Ts F", &d, &P) == VD_OK);
   CHECK_V3(seg_b(P, 0), 0, 1, 0);
   CHECK_V3(seg_b(P, 1), 0, 2, 0);
   vd_plant_spec_destroy(P);

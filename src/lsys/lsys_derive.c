@@ -30,6 +30,41 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
       return NULL;
     }
   }
+  // L-Py's long names of the predefined modules (its predefined module table)
+  static const struct {
+    const char* name;
+    int sym;
+  } aliases[] = {
+      {"SB", VD_SYM_SB},           {"EB", VD_SYM_EB},
+      {"Cut", VD_SYM_CUT},         {"GetPos", VD_SYM_GETPOS},
+      {"GetHead", VD_SYM_GETHEAD}, {"GetUp", VD_SYM_GETUP},
+      {"GetLeft", VD_SYM_GETLEFT}, {"GetRight", VD_SYM_GETRIGHT},
+      {"GetFrame", VD_SYM_GETFRAME}, {"StartGC", VD_SYM_STARTGC},
+      {"EndGC", VD_SYM_ENDGC},     {"BP", VD_SYM_BP},
+      {"EP", VD_SYM_EP},           {"PP", VD_SYM_PP},
+      {"MoveTo", VD_SYM_MOVETO},   {"SetHead", VD_SYM_SETHEAD},
+      {"Left", VD_SYM_LEFT},       {"Right", VD_SYM_RIGHT},
+      {"Up", VD_SYM_UP},           {"Down", VD_SYM_DOWN},
+      {"RollL", VD_SYM_ROLLL},     {"RollR", VD_SYM_ROLLR},
+      {"TurnAround", VD_SYM_TURN}, {"RollToVert", VD_SYM_ROLLTOVERT},
+      {"RollToHorizontal", VD_SYM_ROLLTOHORIZ}, {"Sphere", VD_SYM_SPHERE},
+      {"Box", VD_SYM_BOX},         {"Quad", VD_SYM_QUAD},
+      {"Circle", VD_SYM_CIRCLE},   {"Label", VD_SYM_LABEL},
+      {"IncWidth", VD_SYM_INCWIDTH}, {"DecWidth", VD_SYM_DECWIDTH},
+      {"IncColor", VD_SYM_INCCOLOR}, {"DecColor", VD_SYM_DECCOLOR},
+      {"DivScale", VD_SYM_DIVSCALE}, {"MultScale", VD_SYM_MULTSCALE},
+      {"SetScale", VD_SYM_SETSCALE}, {"PglShape", VD_SYM_PGLSHAPE},
+      {"Elasticity", VD_SYM_ELASTICITY}, {"Tropism", VD_SYM_TROPISM},
+      {"TextureVCoeff", VD_SYM_TEXVSCALE}, {"StartScreenProjection", VD_SYM_2D},
+      {"EndScreenProjection", VD_SYM_3D},
+  };
+  for (size_t i = 0; i < sizeof aliases / sizeof aliases[0]; i++) {
+    if (sym_alias(ls, aliases[i].name, aliases[i].sym) < 0) {
+      vd_lsys_destroy(ls);
+      vd_error_set(err, VD_ERR_NOMEM, name ? name : "", 0, 0, "out of memory");
+      return NULL;
+    }
+  }
   return ls;
 }
 
@@ -38,6 +73,7 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
   vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);
+  vd_free(ls->syms.canon, (size_t)ls->syms.cap_canon * sizeof(int));
   vd_free(ls->syms.hash_slot, (size_t)ls->syms.hcap * sizeof(int));
   for (int i = 0; i < ls->nstr; i++) vd_free(ls->str[i], strlen(ls->str[i]) + 1);
   vd_free(ls->str, (size_t)ls->capstr * sizeof(char*));

@@ -621,6 +621,7 @@ static vd_status assign(vd_lsystem* ls, const stmt* s, value* frame, value v) {
 }
 
 vd_status vm_emit_tmpl(vd_lsystem* ls, const tmpl* t, value* frame, vm_out* out) {
+  if (t->drop) return VD_OK;
   vd_lstring* s = out->s;
   int64_t nparam = 0;
   for (int i = 0; i < t->n; i++) nparam += t->mod[i].nparam;

@@ -81,6 +81,7 @@ typedef struct tmpl {
   int n;
   tmod* mod;
   int has_cut;  // contains %
+  int drop;     // starts with `*`: L-Py discards the whole production (deletes the module)
 } tmpl;
 
 typedef enum sop {
@@ -152,6 +153,8 @@ typedef struct symtab {
   int hcap;
   int maxlen;         // longest predefined or declared name (for longest match)
   unsigned char* declared;  // 1 when the name takes part in longest-match tokenising (n)
+  int* canon;         // the symbol a name stands for: itself, or the short name of an alias (n)
+  int cap_canon;      // capacity of canon
 } symtab;
 
 typedef struct global_def {
@@ -228,6 +231,10 @@ struct vd_lsystem {
 // symbol table
 int sym_intern(vd_lsystem* ls, const char* name, int len, int declared);
 int sym_find(const vd_lsystem* ls, const char* name, int len);
+// Register `alias` (a long name such as "Left") as another spelling of symbol `canon`.
+int sym_alias(vd_lsystem* ls, const char* alias, int canon);
+// The symbol a name id stands for (aliases resolve to their short name).
+static inline int sym_canon(const vd_lsystem* ls, int id) { return ls->syms.canon[id]; }
 #define LSYS_MAX_STR_BYTES (64 << 20)  // all strings of an lsystem together (bytes)
 // Id of a string, added when new; -1 out of memory, -2 over LSYS_MAX_STR_BYTES.
 int str_intern(vd_lsystem* ls, const char* s, int len);

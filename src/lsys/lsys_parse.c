@@ -856,7 +856,7 @@ static int read_module_name(vd_lsystem* ls, const char* s, int len, int* pos, in
     int id = sym_find(ls, s + p, l);
     if (id >= 0 && ls->syms.declared[id]) {
       *pos = p + l;
-      return id;
+      return sym_canon(ls, id);
     }
   }
   if (c == '(' || c == ')' || c == '\'' || c == '"') {
@@ -884,6 +884,15 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     while (pos < len && is_space(s[pos])) pos++;
     if (pos >= len || s[pos] == '#') break;
     int mcol = col0 + pos;
+    if (s[pos] == '*') {
+      // `produce *`, `--> *`: a successor that starts with the any-module `*` produces
+      // nothing (L-Py drops the whole production); a `*` further on has no meaning there
+      if (t->n > 0) {
+        perr(ls, VD_ERR_UNSUPPORTED, lineno, mcol, "unsupported: '*' module inside a successor");
+        goto fail;
+      }
+      t->drop = 1;
+    }
     int sym = read_module_name(ls, s, len, &pos, lineno, col0);
     if (sym < 0) goto fail;
     if (t->n == cap) {
