@@ -804,9 +804,13 @@ TEST(turtle, errors) {
   CHECK_INT(status_of("F ] F"), VD_ERR_SYNTAX);
   // organ modules are ignored; display-only modules are accepted
   vd_plant_spec* P;
-  REQUIRE(run("A B F @L(1) Frame SetGuide(1, 2) % ?P InterpolateColors(1,2) F", &P) == VD_OK);
+  REQUIRE(run("A B F @L(1) Frame SetGuide(1, 2) ?P InterpolateColors(1,2) F", &P) == VD_OK);
   CHECK_INT(P->nseg, 2);
   CHECK_INT(P->seg[0].module, 2);
+  vd_plant_spec_destroy(P);
+  // % drops the rest of its branch
+  REQUIRE(run("F [ F % F [ F ] F ] F", &P) == VD_OK);
+  CHECK_INT(P->nseg, 3);
   vd_plant_spec_destroy(P);
   // the error names the module and its index
   lbuf b = {0};

@@ -255,6 +255,18 @@ int lstr_enable_src(vd_lstring* s) {
   return s->src != NULL;
 }
 
+int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src) {
+  lstr_clear(dst);
+  if (!lstr_reserve(dst, src->n + 1, src->par[src->n] + 1)) return 0;
+  if (src->src && !lstr_enable_src(dst)) return 0;
+  memcpy(dst->sym, src->sym, sizeof(int32_t) * (size_t)src->n);
+  memcpy(dst->par, src->par, sizeof(int64_t) * (size_t)(src->n + 1));
+  memcpy(dst->val, src->val, sizeof(double) * (size_t)src->par[src->n]);
+  if (src->src) memcpy(dst->src, src->src, sizeof(int64_t) * (size_t)src->n);
+  dst->n = src->n;
+  return 1;
+}
+
 void lstr_clear(vd_lstring* s) {
   s->n = 0;
   if (s->par) s->par[0] = 0;

@@ -1257,6 +1257,15 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
   // interpret every predefined module; organ modules have no geometry
   for (int64_t i = 0; i < s->n && st == VD_OK; i++) {
     int sym = s->sym[i];
+    if (sym == VD_SYM_CUT) {
+      // % drops the rest of its branch (the derivation leaves it until the string is read)
+      int depth = 0;
+      while (i + 1 < s->n && !(s->sym[i + 1] == VD_SYM_EB && depth == 0)) {
+        depth += s->sym[i + 1] == VD_SYM_SB ? 1 : s->sym[i + 1] == VD_SYM_EB ? -1 : 0;
+        i++;
+      }
+      continue;
+    }
     if (sym < 0 || sym >= VD_SYM_PREDEFINED_COUNT) {
       // `~x` surfaces other than the predefined leaf `~l` need PlantGL objects
       const char* name = ls ? vd_lsys_symbol_name(ls, sym) : "";
