@@ -482,7 +482,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   }
   if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
   lstr_clear(out);
-  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, in->par[in->n] + 16)) {
+  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16)) {
     st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
     goto done;
   }

@@ -1167,7 +1167,6 @@ static int parse_pattern_re(vd_lsystem* ls, scope* sc, const char* s, int p, int
     if (nargs >= 2 && !rep_bound(ls, s, starts[1], ends[1], lineno, col0, &x->rmin)) return 0;
     if (nargs == 2) x->rmax = x->rmin;
     if (nargs == 3 && !rep_bound(ls, s, starts[2], ends[2], lineno, col0, &x->rmax)) return 0;
-    nargs = 1;
   } else {
     x->nsub = nargs;
   }
@@ -1275,11 +1274,12 @@ static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, in
     int sym = read_module_name(ls, s, b, &pos, lineno, col0);
     if (sym < 0) return 0;
     // x(...) repetition and or(...) alternatives (L-Py's RepExp and Or pattern modules)
+    // (x, all and repexp are the names of the repetition; a longer declared name wins)
     int op = -1, kind = -1;
-    if (pos == sympos + 1 && s[sympos] == 'x' && (op = call_word_at(s, sympos, b, "x")) >= 0) kind = PK_REP;
-    else if (pos - sympos <= 2 && (op = call_word_at(s, sympos, b, "or")) >= 0) kind = PK_OR;
-    else if (pos - sympos <= 1 && (op = call_word_at(s, sympos, b, "all")) >= 0) kind = PK_REP;
-    else if (pos - sympos <= 1 && (op = call_word_at(s, sympos, b, "repexp")) >= 0) kind = PK_REP;
+    static const char* const re_names[] = {"x", "all", "repexp", "or"};
+    for (int k = 0; k < 4 && kind < 0; k++)
+      if (pos - sympos <= (k == 3 ? 2 : 1) && (op = call_word_at(s, sympos, b, re_names[k])) >= 0)
+        kind = k == 3 ? PK_OR : PK_REP;
     if (kind >= 0) {
       int close = close_paren(s, op, b);
       if (close < 0) {

@@ -207,7 +207,7 @@ static int64_t prev_axial(const unsigned char* ign, const vd_lstring* s, const i
   while (j >= 0) {
     int32_t sym = s->sym[j];
     if (sym == VD_SYM_EB) {
-      j = m[j] - 1;
+      j = m[j] - 1;  // NOLINT(clang-analyzer-core.NullDereference): contexts are read with the brackets matched
       continue;
     }
     if (sym == VD_SYM_SB || ign[sym]) {
@@ -224,7 +224,7 @@ static int64_t next_axial(const unsigned char* ign, const vd_lstring* s, const i
   while (j < s->n) {
     int32_t sym = s->sym[j];
     if (sym == VD_SYM_SB) {
-      j = m[j] + 1;
+      j = m[j] + 1;  // NOLINT(clang-analyzer-core.NullDereference): contexts are read with the brackets matched
       continue;
     }
     if (sym == VD_SYM_EB) return -1;
@@ -439,11 +439,11 @@ void lsys_pass_free(lsys_pass* P) {
 // the matching context of a pass over in, writing to out
 static vd_status pass_context(vd_lsystem* ls, lsys_pass* P, int sec, const vd_lstring* in, const vd_lstring* out,
                               int64_t** match, int64_t* match_cap, lsys_mctx* M) {
+  memset(M, 0, sizeof *M);
   if (!vd_grow((void**)&P->ignored, &P->cap_ignored, ls->nfilter + 1, sizeof(unsigned char*)))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
   P->ignored[0] = ls->no_filter;
   for (int f = 0; f < ls->nfilter; f++) P->ignored[f + 1] = ls->filters[f].ignored;
-  memset(M, 0, sizeof *M);
   M->ls = ls;
   M->src = in;
   M->dest = out;
@@ -536,7 +536,7 @@ vd_status lsys_step(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* o
   if (!lstr_reserve(out, in->n + 16, in->par[in->n] + 16))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
   *matched = 0;
-  lsys_mctx M;
+  lsys_mctx M = {0};
   if ((st = pass_context(ls, P, sec, in, out, &P->match, &P->match_cap, &M))) return st;
   int64_t b, e;
   const int* first = ls->rule_first[sec];
@@ -592,7 +592,7 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
     for (int k = P->nlvl; k < level + depth; k++) memset(&P->lvl[k], 0, sizeof P->lvl[k]);
     P->nlvl = level + depth;
   }
-  lsys_mctx M;
+  lsys_mctx M = {0};
   if ((st = pass_context(ls, P, sec, in, out, &P->lvl[level].match, &P->lvl[level].match_cap, &M))) return st;
   M.backward = 0;
   int64_t b, e;
