@@ -1148,7 +1148,7 @@ static int parse_pattern_re(vd_lsystem* ls, scope* sc, const char* s, int p, int
     perr(ls, VD_ERR_NOMEM, lineno, col0 + p, "out of memory");
     return 0;
   }
-  int nargs = 0, starts[64], ends[64];
+  int nargs = 0, starts[64] = {0}, ends[64] = {0};
   for (int q = p + 1; q <= close && nargs < 64;) {
     int c = next_comma(s, q, close);
     starts[nargs] = q;

@@ -440,8 +440,10 @@ void lsys_pass_free(lsys_pass* P) {
 static vd_status pass_context(vd_lsystem* ls, lsys_pass* P, int sec, const vd_lstring* in, const vd_lstring* out,
                               int64_t** match, int64_t* match_cap, lsys_mctx* M) {
   memset(M, 0, sizeof *M);
-  if (!vd_grow((void**)&P->ignored, &P->cap_ignored, ls->nfilter + 1, sizeof(unsigned char*)))
-    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  if (!vd_grow((void**)&P->ignored, &P->cap_ignored, ls->nfilter + 1, sizeof(unsigned char*))) {
+    vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    return VD_ERR_NOMEM;
+  }
   P->ignored[0] = ls->no_filter;
   for (int f = 0; f < ls->nfilter; f++) P->ignored[f + 1] = ls->filters[f].ignored;
   M->ls = ls;
@@ -452,7 +454,10 @@ static vd_status pass_context(vd_lsystem* ls, lsys_pass* P, int sec, const vd_ls
   M->ignored = P->ignored;
   M->nsym = ls->rule_index_nsym;
   if ((ls->has_context[sec] || ls->has_generic[sec]) && in->n) {
-    if (lsys_bracket_match(in, match, match_cap)) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    if (lsys_bracket_match(in, match, match_cap)) {
+      vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+      return VD_ERR_NOMEM;
+    }
     M->match = *match;
   }
   return VD_OK;
