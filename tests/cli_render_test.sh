@@ -44,7 +44,7 @@ fi
 
 # the tomato with masks and depth: five files, masks 16-bit, sidecar names them
 expect "render tomato" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/tomato.png" --masks --depth --size 320x240
-for f in tomato.png tomato.label.png tomato.instance.png tomato.depth.png tomato.json; do
+for f in tomato.png tomato.label.png tomato.instance.png tomato.depth.png tomato.png.json; do
   if [ -s "$T/$f" ]; then ok "wrote $f"; else bad "wrote $f"; fi
 done
 if python3 - "$T" <<'PY'
@@ -78,7 +78,7 @@ def png(path):
         rows.append(line); prev = line
     vals = [v for r in rows for v in (struct.unpack(">%dH" % (len(r) // 2), r) if bits == 16 else r)]
     return w, h, bits, ch, vals
-meta = json.load(open(f"{d}/tomato.json"))
+meta = json.load(open(f"{d}/tomato.png.json"))
 assert meta["version"] == 1 and meta["width"] == 320 and meta["height"] == 240
 assert abs(meta["intrinsics"]["cx"] - 159.5) < 1e-9
 names = {l["id"]: l["name"] for l in meta["labels"]}
@@ -101,6 +101,18 @@ w, h, bits, ch, rgb = png(f"{d}/tomato.png")
 assert (w, h, bits, ch) == (320, 240, 8, 3)
 PY
 then ok "masks, depth and sidecar agree"; else bad "masks, depth and sidecar agree"; fi
+# the sidecar names the OpenGL that drew the picture, as --info does (GPU or llvmpipe)
+expect "render with info" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/info.png" --depth --size 64x48 --info
+if python3 - "$T/info.png.json" "$T/err" <<'PY'
+import json, sys
+gl = json.load(open(sys.argv[1]))["opengl"]
+info = open(sys.argv[2]).read()
+assert gl["vendor"] and gl["renderer"] and gl["version"] and "?" not in (gl["vendor"], gl["renderer"])
+assert gl["renderer"] in info and gl["version"] in info, (gl, info)
+assert gl["egl_platform"] in ("surfaceless", "device", "default display")
+assert gl["software"] == any(s in gl["renderer"] for s in ("llvmpipe", "softpipe", "swrast", "Software"))
+PY
+then ok "sidecar names the OpenGL renderer"; else bad "sidecar names the OpenGL renderer"; fi
 
 # same seed, same bytes; presets and explicit poses; other colourings
 expect "render again" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/again.png" --masks --depth --size 320x240
@@ -115,6 +127,21 @@ done
 expect "explicit pose" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/pose.png" --eye 1.5,-1.5,1.2 --lookat 0,0,0.6 --fov 40 --size 160x120
 expect "color by instance" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/inst.png" --color-by instance --size 160x120
 expect "color by displacement" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/disp.png" --color-by displacement --size 160x120
+# label colours: distinct by default, the label table's with --palette natural (sidecar says which)
+expect "palette natural" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/nat.png" --palette natural --masks --size 64x48
+expect "palette bad" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --palette pastel
+expect "grow for palette" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/labels.json"
+if python3 - "$T/tomato.png.json" "$T/nat.png.json" "$T/labels.json" <<'PY'
+import json, sys
+dist, nat, plant = (json.load(open(p)) for p in sys.argv[1:])
+assert dist["palette"] == "distinct" and nat["palette"] == "natural"
+table = {l["id"]: l["rgb"] for l in plant["labels"]}
+for l in nat["labels"]:
+    assert all(abs(a - b) < 1e-6 for a, b in zip(l["rgb"], table[l["id"]])), (l, table[l["id"]])
+rgb = [tuple(round(c, 3) for c in l["rgb"]) for l in dist["labels"]]
+assert len(set(rgb)) == len(rgb), rgb
+PY
+then ok "palettes in the sidecar"; else bad "palettes in the sidecar"; fi
 expect "plant file" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/tomato.json"
 expect "render plant file" 0 "$V" render "$T/tomato.json" -o "$T/fromjson.png" --size 160x120
 
@@ -126,8 +153,54 @@ expect "render plant file" 0 "$V" render "$T/tomato.json" -o "$T/fromjson.png" -
 } >"$T/cloud.ply"
 expect "render ascii cloud" 0 "$V" render "$T/cloud.ply" -o "$T/cloud.png" --masks --size 160x120
 expect "render cloud by instance" 0 "$V" render "$T/cloud.ply" -o "$T/cloudi.png" --color-by instance --size 160x120
-expect "grow binary ply" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/mesh.ply"
-expect "render binary ply vertices" 0 "$V" render "$T/mesh.ply" -o "$T/meshpts.png" --size 160x120 --point-size 0.003
+# meshes that grow wrote (per-face labels) render as meshes, not as grey points: the same masks as
+# the plant file within edge pixels (float coordinates), the same label names
+expect "grow binary ply" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesh.ply"
+expect "grow obj" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesh.obj"
+expect "grow ascii ply" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesha.ply" --ascii
+expect "grow json" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesh.json"
+for m in mesh.ply mesh.obj mesha.ply mesh.json; do
+  expect "render $m" 0 "$V" render "$T/$m" -o "$T/r_${m%.*}_${m##*.}.png" --masks --size 320x240
+done
+expect "mesh by displacement refused" 2 "$V" render "$T/mesh.obj" -o "$T/x.png" --color-by displacement
+if python3 - "$T" <<'PY'
+import json, struct, sys, zlib
+d = sys.argv[1]
+def png16(path):
+    b = open(path, "rb").read()
+    pos, idat = 8, b""
+    while pos < len(b):
+        n, kind = struct.unpack(">I4s", b[pos:pos + 8])
+        if kind == b"IHDR": w, h = struct.unpack(">II", b[pos + 8:pos + 16])
+        if kind == b"IDAT": idat += b[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    raw, stride, prev, vals = zlib.decompress(idat), 2 * w + 1, bytearray(2 * w), []
+    for y in range(h):
+        f, line = raw[y * stride], bytearray(raw[y * stride + 1:(y + 1) * stride])
+        for i in range(len(line)):
+            a = line[i - 2] if i >= 2 else 0
+            c = prev[i - 2] if i >= 2 else 0
+            if f == 1: line[i] = (line[i] + a) & 255
+            elif f == 2: line[i] = (line[i] + prev[i]) & 255
+            elif f == 3: line[i] = (line[i] + (a + prev[i]) // 2) & 255
+            elif f == 4:
+                p = a + prev[i] - c; pa, pb, pc = abs(p - a), abs(p - prev[i]), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else prev[i] if pb <= pc else c)) & 255
+        vals += struct.unpack(">%dH" % w, line)
+        prev = line
+    return vals
+ref = {k: png16(f"{d}/r_mesh_json.{k}.png") for k in ("label", "instance")}
+names = {l["id"]: l["name"] for l in json.load(open(f"{d}/r_mesh_json.png.json"))["labels"]}
+fg = sum(1 for v in ref["label"] if v)
+for m in ("mesh_ply", "mesh_obj", "mesha_ply"):
+    meta = json.load(open(f"{d}/r_{m}.png.json"))
+    assert {l["id"]: l["name"] for l in meta["labels"]} == names, (m, meta["labels"])
+    for k in ("label", "instance"):
+        got = png16(f"{d}/r_{m}.{k}.png")
+        diff = sum(1 for a, b in zip(got, ref[k]) if a != b)
+        assert fg > 1000 and diff < 0.03 * fg, (m, k, diff, fg)
+PY
+then ok "meshes render like the plant"; else bad "meshes render like the plant"; fi
 expect "cloud by displacement refused" 2 "$V" render "$T/cloud.ply" -o "$T/x.png" --color-by displacement
 printf 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n0 0\n1 1\n' >"$T/noz.ply"
 expect "cloud without z" 2 "$V" render "$T/noz.ply" -o "$T/x.png"
