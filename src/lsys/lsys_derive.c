@@ -337,7 +337,7 @@ static vd_status eval_max_depth(vd_lsystem* ls, int sec) {
 static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, lsys_pass* P,
                                  int* matched) {
   lstr_clear(tmp);
-  if (!lstr_reserve(tmp, cur->n + 16, cur->par[cur->n] + 16) || (cur->src && !lstr_enable_src(tmp)))
+  if (!lstr_reserve(tmp, cur->n + 16, (cur->par ? cur->par[cur->n] : 0) + 16) || (cur->src && !lstr_enable_src(tmp)))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
   vd_status st = lsys_recursive(ls, sec, cur, tmp, P, ls->max_depth[sec], 0, matched);
   if (st) return st;
