@@ -166,6 +166,8 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
     if (r->con.currentBuffer != mjFB_OFFSCREEN)
       st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
                         "no OpenGL context: MuJoCo has no offscreen buffer");
+    else
+      render_measure_font(r);
   }
   vd_mj_trap_end(&trap);
   return st;
@@ -247,6 +249,10 @@ void vd_render_destroy(vd_renderer* r) {
 
 const char* vd_render_info(const vd_renderer* r) {
   return r->gl.info;
+}
+
+const vd_render_gl* vd_render_gl_info(const vd_renderer* r) {
+  return &r->gl.id;
 }
 
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err) {
