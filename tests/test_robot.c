@@ -41,7 +41,7 @@ static vd_model* truss(double r, vd_plant_spec** spec_out) {
 
 // a scene for the truss and the Lite 6 (method and extra JSON fields spliced in)
 static vd_status truss_scene(const char* method, const char* extra, vd_scene* s, vd_error* e) {
-  char text[4096];
+  char text[8192];
   snprintf(text, sizeof text,
            "{\"format\": \"verdant-scene\", \"version\": 1,"
            " \"plant\": {\"file\": \"unused.lpy\"},"
@@ -249,7 +249,7 @@ static void push_rod(int two_way, double kp, double fmax, double young, double* 
   char path[4096];
   snprintf(path, sizeof path, "%s/pusher.xml", vdt_tmpdir());
   pusher_mjcf(path, kp, fmax);
-  char text[4096];
+  char text[8192];
   snprintf(text, sizeof text,
            "{\"format\": \"verdant-scene\", \"version\": 1, \"plant\": {\"file\": \"x.lpy\"},"
            " \"robot\": {\"mjcf\": \"%s\", \"base\": {\"pos\": [0.2, -0.015, 0.3]}},"

@@ -60,7 +60,8 @@ extern "C" {
 typedef enum vd_harvest_method {
   VD_HARVEST_PULL = 0, // retreat along the pedicel axis (Gazebo Plants' stretching)
   VD_HARVEST_BEND,     // rotate the gripper about an axis normal to the pedicel through the
-                       // calyx, swinging the fruit up toward the robot (the paper's bending)
+                       // pedicel's abscission node (else the calyx), swinging the fruit up
+                       // toward the robot (the paper's bending)
   VD_HARVEST_TWIST,    // rotate the gripper about the pedicel axis through the fruit centre
   VD_HARVEST_METHOD_COUNT
 } vd_harvest_method;

@@ -6,6 +6,10 @@
 // hold the detached fruit. Every phase is a stream of end-effector velocities given to the same
 // control step an external controller uses.
 //
+// Bend turns the end-effector, and the fruit with it, about the axis a x p through the pedicel's
+// abscission node (the knuckle; the calyx when the pedicel has none), swinging the fruit up
+// toward the robot.
+//
 // Grasp geometry: the pedicel axis p runs from the calyx (the fruit stalk's start) to the
 // fruit's centre; the approach a is the horizontal direction from the robot's base to the fruit
 // (made normal to p when the calyx would otherwise lie toward the palm); the gripper's z axis is
@@ -174,8 +178,16 @@ void control_after_step(vd_harvest* h) {
         vd_vec3 c = h->sd->node_pos[f->node], calyx = h->sd->node_pos[h->sd->seg_start[f->seg]];
         h->pedicel = unit_or(vd_sub(c, calyx), h->pedicel);
         if (md->method == VD_HARVEST_BEND) {
+          // about the pedicel's abscission node (the knuckle) when the fruit has one, else
+          // about the calyx: the picker's snap
           h->axis = unit_or(vd_cross(h->approach, h->pedicel), vd_v3(0, 0, 1));
           h->pivot = calyx;
+          const vd_sim_model* sm = h->sm;
+          for (int s = f->seg, n = 0; s >= 0 && n < 8; s = sm->seg_parent[s], n++)
+            if (sm->seg_flags[s] & VD_SIM_ABSCISSION) {
+              h->pivot = h->sd->node_pos[h->sd->seg_start[s]];
+              break;
+            }
         } else {
           h->axis = h->pedicel;
           h->pivot = c;

@@ -409,7 +409,8 @@ static vd_status read_materials(rd* r, const cJSON* o, vd_scene* s) {
 static vd_status read_sim(rd* r, const cJSON* o, vd_scene* s) {
   static const char* keys[] = {"dt",       "iterations",     "solver",  "segment_length",
                                "sag_free", "friction",       "ground",  "self_collision",
-                               "drag",     "damping",        "mass_damping", "gravity", NULL};
+                               "drag",     "damping",        "mass_damping", "gravity",
+                               "stake",    NULL};
   const char* w = "sim";
   if (!o) return VD_OK;
   vd_status st = known_keys(r, o, w, keys);
@@ -438,6 +439,8 @@ static vd_status read_sim(rd* r, const cJSON* o, vd_scene* s) {
   if (!st) st = num(r, o, w, "damping", 0, 10, "a time in 0..10 (s)", &s->sim_opt.damping);
   if (!st) st = num(r, o, w, "mass_damping", 0, 1e4, "a rate in 0..1e4 (1/s)", &s->sim_opt.mass_damping);
   if (!st) st = vec(r, o, w, "gravity", 3, 1e4, "[x, y, z] (m/s^2)", g);
+  if (!st)
+    st = num(r, o, w, "stake", 0, 100, "a spacing >= 0 (m; 0: no stake)", &s->sim_def.stake_spacing);
   if (st) return st;
   s->sim_opt.iterations = (int)it;
   s->sim_opt.gravity = s->sim_def.gravity = vd_v3(g[0], g[1], g[2]);
