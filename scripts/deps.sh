@@ -7,9 +7,10 @@ set -eu
 # robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3;
 # headless rendering: EGL and GL headers (libegl-dev, libgl-dev), the EGL loader (libegl1), Mesa's
 # EGL and its software/DRI drivers (libegl-mesa0, libgl1-mesa-dri); dataset checksums (SHA-256):
-# nettle-dev
+# nettle-dev; the L-system Python engine: embedded CPython (libpython3.11-dev) with numpy for the
+# models that import it (python3-numpy)
 need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3
-  libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev)
+  libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev libpython3.11-dev python3-numpy)
 # --dev adds the tools of CI's hardening runs: clang with libFuzzer (make fuzz, fuzz-smoke),
 # clang-tidy and cppcheck (make lint)
 if [ "${1:-}" = "--dev" ]; then

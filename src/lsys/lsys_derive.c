@@ -17,6 +17,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
     return NULL;
   }
   snprintf(ls->file, sizeof ls->file, "%s", name ? name : "");
+  ls->engine = VD_LSYS_NATIVE;
   vd_arena_init(&ls->arena, 1 << 16);
   vm_budget(ls, 0);
   ls->max_depth[SEC_DECOMPOSITION] = 1;
@@ -35,6 +36,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
 
 void vd_lsys_destroy(vd_lsystem* ls) {
   if (!ls) return;
+  lsys_py_free(ls);
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
   vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);
@@ -61,12 +63,15 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   vd_free(ls, sizeof *ls);
 }
 
-vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsystem** out, vd_error* err) {
+// parse with one engine (VD_LSYS_NATIVE or VD_LSYS_PYTHON); lsys_engine.c chooses
+vd_status lsys_parse_with(const char* text, size_t len, const char* name, int engine, vd_lsystem** out,
+                          vd_error* err) {
   *out = NULL;
   vd_error local = {0};
   if (!err) err = &local;
   vd_lsystem* ls = lsys_new(name, err);
   if (!ls) return VD_ERR_NOMEM;
+  ls->engine = engine;
   // a NUL byte inside the text is a binary file, not L-Py
   const char* nul = memchr(text, 0, len);
   if (nul) {
@@ -91,16 +96,6 @@ vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsyst
   return VD_OK;
 }
 
-vd_status vd_lsys_load(const char* path, vd_lsystem** out, vd_error* err) {
-  char* text;
-  size_t len;
-  *out = NULL;
-  vd_status st = vd_file_read(path, &text, &len, err);
-  if (st) return st;
-  st = vd_lsys_parse(text, len, path, out, err);
-  vd_free(text, len + 1);
-  return st;
-}
 
 vd_lsys_def vd_lsys_def_default(void) {
   vd_lsys_def d;
@@ -142,6 +137,13 @@ static int assigned_at_top(const vd_lsystem* ls, int slot) {
 }
 
 vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* text, vd_error* err) {
+  if (ls->py) {
+    vd_error local = {0};
+    ls->err = err ? err : &local;
+    vd_status st = lsys_py_set_global(ls, name, text);
+    ls->err = NULL;
+    return st;
+  }
   int slot = global_slot(ls, name, (int)strlen(name), 0);
   if (slot < 0 || !assigned_at_top(ls, slot))
     return vd_error_set(err, VD_ERR_NAME, ls->file, 0, 0, "--set %s: the file defines no global '%s'", name, name);
@@ -183,6 +185,7 @@ vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* text,
 }
 
 vd_status vd_lsys_get_global(const vd_lsystem* ls, const char* name, double* value_out) {
+  if (ls->py) return lsys_py_get_global((vd_lsystem*)ls, name, value_out);
   int slot = global_slot((vd_lsystem*)ls, name, (int)strlen(name), 0);
   if (slot < 0) return VD_ERR_NAME;
   value v = ls->gval[slot];
@@ -201,6 +204,7 @@ static vd_status run_toplevel(vd_lsystem* ls, uint64_t seed) {
   ls->iteration = 0;
   ls->stop_requested = 0;
   ls->call_depth = 0;
+  if (ls->py) return lsys_py_run_toplevel(ls, seed);
   for (int i = 0; i < ls->nscalar; i++) ls->gval[ls->scalar_slot[i]] = ls->scalar_val[i];
   for (stmt* s = ls->top; s; s = s->next) {
     if (s->op == S_ASSIGN && s->is_global && ls->gdef[s->slot].has_override) {
@@ -219,6 +223,17 @@ static vd_status run_toplevel(vd_lsystem* ls, uint64_t seed) {
 }
 
 int vd_lsys_derivation_length(const vd_lsystem* ls) {
+  if (ls->py) {
+    vd_lsystem* mls = (vd_lsystem*)ls;
+    vd_error local = {0};
+    mls->err = &local;
+    int n = 1;
+    lsys_py_enter(mls);
+    if (run_toplevel(mls, 0) != VD_OK || lsys_py_dlength_eval(mls, &n) != VD_OK) n = 1;
+    lsys_py_leave(mls);
+    mls->err = NULL;
+    return n;
+  }
   if (!ls->derivation_length) return 1;
   value v;
   vd_lsystem* mls = (vd_lsystem*)ls;
@@ -371,7 +386,7 @@ static int64_t next_axial(const vd_lsystem* ls, const vd_lstring* s, const int64
   while (j < s->n) {
     int32_t sym = s->sym[j];
     if (sym == VD_SYM_SB) {
-      j = m[j] + 1;
+      j = m[j] + 1;  // NOLINT(clang-analyzer-core.NullDereference): m holds every module of a non-empty L-string
       continue;
     }
     if (sym == VD_SYM_EB) return -1;
@@ -494,7 +509,9 @@ static vd_status apply_rules(vd_lsystem* ls, int sec, const vd_lstring* in, vd_l
           vo.src = src;
           vo.produced = vo.nproduced = 0;
           vd_status st;
-          if (r->succ) {
+          if (ls->py) {
+            st = lsys_py_apply_rule(ls, r, frame, &vo);
+          } else if (r->succ) {
             st = vm_emit_tmpl(ls, r->succ, frame, &vo);
             vo.produced = 1;
           } else {
@@ -584,6 +601,7 @@ static int find_hook(vd_lsystem* ls, const char* name) {
 }
 
 static vd_status call_hook(vd_lsystem* ls, int fi) {
+  if (ls->py) return VD_OK;  // the Python engine calls its hooks by name (lsys_py_hook)
   if (fi < 0) return VD_OK;
   func* f = ls->funcs[fi];
   if (f->nparam != 0)
@@ -595,6 +613,7 @@ static vd_status call_hook(vd_lsystem* ls, int fi) {
 
 // release a run's scratch, make sure a failure has a message, detach the error sink
 static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, pass_ctx* P) {
+  if (ls->py) lsys_py_leave(ls);
   vd_lstring_free(tmp);
   vd_free(P->match, sizeof(int64_t) * (size_t)P->match_cap);
   if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
@@ -610,6 +629,10 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   vm_budget(ls, d.max_ops);
   vd_lstring tmp = vd_lstring_empty();
   pass_ctx P = {NULL, 0, d.max_modules};
+  if (ls->py) {
+    lsys_py_enter(ls);
+    lsys_py_reset_objects(ls);
+  }
   vd_status st = build_index(ls);
   if (st) {
     vm_error(ls, st, 0, 0, "out of memory");
@@ -621,7 +644,9 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   }
   if ((st = run_toplevel(ls, d.seed))) goto done;
   int steps = d.steps;
-  if (steps < 0) {
+  if (steps < 0 && ls->py) {
+    if ((st = lsys_py_dlength_eval(ls, &steps))) goto done;
+  } else if (steps < 0) {
     steps = 1;
     if (ls->derivation_length) {
       value v;
@@ -645,9 +670,12 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
     goto done;
   }
+  if (ls->py && (st = lsys_py_hook(ls, "Start", out, &tmp, d.max_modules))) goto done;
   {
     vm_out vo = {out, 0, d.max_modules, 0, 0};
-    if (ls->axiom) {
+    if (ls->py) {
+      st = lsys_py_emit_axiom(ls, &vo);
+    } else if (ls->axiom) {
       st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
     } else {
       int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
@@ -666,15 +694,21 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   for (int step = 0; step < steps && !ls->stop_requested; step++) {
     ls->iteration = step;
     if ((st = call_hook(ls, ls->hook_starteach))) goto done;
+    if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, &tmp, d.max_modules))) goto done;
     int fired = 0;
     if ((st = apply_rules(ls, SEC_PRODUCTION, out, &tmp, &P, &fired))) goto done;
     lstr_swap(out, &tmp);
     if (has_cut(out)) apply_cut(out);
     if ((st = apply_section(ls, SEC_DECOMPOSITION, out, &tmp, &P))) goto done;
     if ((st = call_hook(ls, ls->hook_endeach))) goto done;
+    if (ls->py) {
+      if ((st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules))) goto done;
+      lsys_py_gc(ls, out);
+    }
     if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
   }
   if ((st = call_hook(ls, ls->hook_end))) goto done;
+  if (ls->py && (st = lsys_py_hook(ls, "End", out, &tmp, d.max_modules))) goto done;
 done:
   return end_run(ls, st, &tmp, &P);
 }
@@ -689,6 +723,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   pass_ctx P = {NULL, 0, d.max_modules};
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;
+  if (ls->py) lsys_py_enter(ls);
   if (ls->rule_index_nsym != ls->syms.n && (st = build_index(ls))) {
     vm_error(ls, st, 0, 0, "out of memory");
     goto done;
