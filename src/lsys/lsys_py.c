@@ -567,6 +567,9 @@ static PyObject* vd_abort(void) {
   return NULL;
 }
 
+// parameter values in s (an empty string may have no arrays yet)
+static int64_t lstr_nval(const vd_lstring* s) { return s->par ? s->par[s->n] : 0; }
+
 // append the template tid with parameter tuples args[0..nargs) to out
 static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_ssize_t nargs) {
   lsys_py* py = ls->py;
@@ -582,6 +585,7 @@ static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_
              "the L-string would exceed %lld modules (raise --max-modules)", (long long)out->max_modules);
     return 0;
   }
+  if (!nmod) return 1;
   // count the parameters
   int64_t nval = 0;
   Py_ssize_t a = 0;
@@ -593,7 +597,7 @@ static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_
     }
     nval += PyTuple_GET_SIZE(args[a++]);
   }
-  if (!lstr_reserve(s, s->n + nmod, s->par[s->n] + nval)) {
+  if (!lstr_reserve(s, s->n + nmod, lstr_nval(s) + nval)) {
     PyErr_NoMemory();
     return 0;
   }
@@ -720,7 +724,7 @@ static int append_items(vd_lsystem* ls, vd_lstring* s, PyObject* items, int64_t 
       ok = 0;
       break;
     }
-    if (!lstr_reserve(s, s->n + 1, s->par[s->n] + np)) {
+    if (!lstr_reserve(s, s->n + 1, lstr_nval(s) + np)) {
       PyErr_NoMemory();
       ok = 0;
       break;
@@ -1062,6 +1066,11 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   Py_INCREF(f);
   progress();
   vm_out vo = {scratch, 0, max_modules, 0, 0};
+  if (!lstr_reserve(scratch, 16, 16)) {
+    Py_DECREF(f);
+    for (int i = 0; i < n; i++) Py_DECREF(args[i]);
+    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  }
   lstr_clear(scratch);
   vm_out* saved = py->out;
   py->out = &vo;  // an nproduce in a hook has nowhere to go but is not an error
