@@ -11,7 +11,7 @@ ifeq ($(SANITIZE),1)
   CMAKE_FLAGS += -DVD_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 endif
 
-.PHONY: all deps configure test bench demo install clean fuzz fuzz-smoke lint
+.PHONY: all deps configure test bench demo install clean fuzz fuzz-smoke lint python
 
 all: configure
 	cmake --build $(BUILD) -j $(JOBS)
@@ -21,6 +21,10 @@ deps:
 
 configure: deps
 	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null
+
+# the Python package into $(BUILD)/python (PYTHONPATH=$(BUILD)/python /usr/bin/python3; docs/python.md)
+python: configure
+	cmake --build $(BUILD) -j $(JOBS) --target verdant_python verdant_python_files
 
 test: all
 	cd $(BUILD) && ctest -j $(JOBS) --output-on-failure
@@ -54,4 +58,4 @@ lint:
 	@JOBS=$(JOBS) bash scripts/lint.sh
 
 clean:
-	rm -rf build build-sanitize build-lint
+	rm -rf build build-sanitize build-lint python/build python/verdant.egg-info

@@ -28,7 +28,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "mj_trap.h"
+#include "mjtrap/mjtrap.h"
 #include "verdant/verdant.h"
 #include "bench_util.h"
 

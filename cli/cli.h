@@ -90,6 +90,37 @@ double cli_now(void);
 // Does path end with ext (case-insensitive, ext with the dot)?
 int cli_has_ext(const char* path, const char* ext);
 
+// Inputs and outputs (cli_paths.c). Is a the same file as b (both exist, same device and inode)?
+int cli_same_file(const char* a, const char* b);
+// No output may replace an input: when one of the nout outputs is one of the nin inputs (NULL
+// entries skipped) print which and return EXIT_USAGE, else 0.
+int cli_check_outputs(const char* cmd, const char* const* out, int nout, const char* const* in, int nin);
+// Does the folder dir hold the file path (path's parent folder is dir, by inode)?
+int cli_in_folder(const char* dir, const char* path);
+
+// The files of a plant output: path, and for .obj its material library (.mtl); returns the count.
+int cli_plant_files(const char* path, char files[2][4200]);
+// A command's outputs, written together or not at all.
+typedef struct cli_outset {
+  int n, cap;            // outputs
+  char** path;           // the outputs (n)
+  char** backup;         // where the file an output replaces waits, NULL or "" when none (n)
+  unsigned char* fresh;  // 1 when the output did not exist before (n)
+  unsigned char* stale;  // 1 for a file this run does not write, removed when the set completes (n)
+  int slot;              // entry in the signal handler's table, -1 none
+} cli_outset;
+// Before writing: every output must be writable (not a folder, in a folder that exists and takes
+// files: else VD_ERR_IO naming it, nothing touched); the files they replace are kept aside.
+// stale (Nullable, n entries): outputs of an earlier run this one does not write (frames.bin of a
+// run now writing frames.jsonl), removed when the set completes.
+vd_status cli_outset_begin(cli_outset* s, const char* const* paths, int n, const unsigned char* stale,
+                           vd_error* err);
+// After writing: ok drops the kept files; else every output is removed and the files they
+// replaced are put back. Ends the set (cli_outset_begin failed: nothing to end).
+void cli_outset_end(cli_outset* s, int ok);
+// For the signal handler: put back every set in progress (async-signal-safe).
+void cli_outsets_rollback(void);
+
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
 
@@ -186,12 +217,18 @@ typedef struct cli_render_opts {
   int has_time;             // --time given
   double time;              // --time (s)
   double fps;               // --fps of the MP4 (0: the run's frame rate)
+  int disp_from_first;      // --displacement-from first (runs): from frame 0, not the model
 } cli_render_opts;
 
+// --palette NAME (distinct, natural); 1 on success.
+int cli_parse_palette(const char* s, vd_palette* out);
 // The camera of the options: the explicit pose, or the preset fitted to the box lo..hi.
 vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi);
-// Write a frame: OUT.png, and with depth or masks OUT.depth.png, OUT.label.png, OUT.instance.png
-// and the sidecar OUT.json naming them (every file atomic).
+// The files of a frame: OUT.png, and with depth or masks OUT.depth.png, OUT.label.png,
+// OUT.instance.png and the sidecar OUT.png.json naming them (named after the whole image name, so
+// it never takes the name of a plant file OUT.json). Fills path[0..n) and returns n.
+int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]);
+// Write a frame's files (cli_frame_files; every file atomic).
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err);
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);

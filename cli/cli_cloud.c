@@ -485,6 +485,8 @@ int cli_cloud(int argc, char** argv) {
   if (out && vd_cloud_format_of(out) == VD_CLOUD_AUTO)
     return cli_usage_error("cloud", "output '%s': unknown format (use .ply, .pcd, .xyz, .csv or .las)", out);
   if (cli_cloud_check(&co, "cloud")) return EXIT_USAGE;
+  const char* ins[2] = {po.path, co.scanners_file};
+  if (out && cli_check_outputs("cloud", &out, 1, ins, 2)) return EXIT_USAGE;
   vd_error err = {0};
   cli_cloud_result res;
   vd_status st = cli_cloud_make(&po, &co, out, &res, &err);

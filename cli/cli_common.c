@@ -58,6 +58,7 @@ static atomic_int watch_used[CLI_WATCH_SLOTS];
 static void on_signal(int sig) {
   for (int k = 0; k < CLI_WATCH_SLOTS; k++)
     if (atomic_load(&watch_used[k]) == 1) unlink(watch_path[k]);
+  cli_outsets_rollback();  // outputs of a set already in place go, the files they replaced come back
   signal(sig, SIG_DFL);
   raise(sig);
 }

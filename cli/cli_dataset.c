@@ -207,7 +207,8 @@ static cJSON* complete_record(const dataset* ds, int i, int* mismatch) {
 }
 
 // temporary files left by a run of this shard that was killed (SIGKILL, power loss): a name
-// "<item or manifest>.tmp.<pid>" whose process is gone is removed; returns how many
+// "<item or manifest>.tmp.<pid>" (or ".bak.<pid>", an old file kept aside) whose process is gone
+// is removed; returns how many
 static int remove_stale(const dataset* ds) {
   DIR* dir = opendir(ds->dir);
   if (!dir) return 0;
@@ -215,6 +216,7 @@ static int remove_stale(const dataset* ds) {
   struct dirent* e;
   while ((e = readdir(dir)) != NULL) {
     const char* tmp = strstr(e->d_name, ".tmp.");
+    if (!tmp) tmp = strstr(e->d_name, ".bak.");  // a file kept aside while an item was remade
     if (!tmp) continue;
     char* end;
     long pid = strtol(tmp + 5, &end, 10);
@@ -319,7 +321,7 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
     cJSON_AddNumberToObject(e, "azimuth", az);
     cJSON_AddNumberToObject(e, "elevation", el);
     static const char* roles[5][2] = {{"color", "png"}, {"depth", "depth.png"}, {"label", "label.png"},
-                                      {"instance", "instance.png"}, {"camera", "json"}};
+                                      {"instance", "instance.png"}, {"camera", "png.json"}};
     for (int k = 0; k < 5; k++) {
       snprintf(path, sizeof path, "%s.%s", base, roles[k][1]);
       cJSON_AddStringToObject(e, roles[k][0], path);
@@ -336,7 +338,7 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
 
 // *out_failed is set when the failure was writing or reading back the item's files, or drawing
 // its pictures (a failed run, exit 1) rather than bad input (exit 2)
-static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant_opts* po0, const cli_cloud_opts* co,
+static vd_status make_item_files(const dataset* ds, render_pool* pool, const cli_plant_opts* po0, const cli_cloud_opts* co,
                            int i, int64_t* points, int* out_failed, vd_error* err) {
   *out_failed = 0;
   double values[MAX_VARY] = {0};
@@ -596,6 +598,39 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
   return st ? -1 : 0;
 }
 
+// an item's files appear together or not at all: its cloud, its pictures and its record (a
+// failed item leaves nothing, and an item made again over an old one keeps the old one if it fails)
+static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant_opts* po0, const cli_cloud_opts* co,
+                           int i, int64_t* points, int* out_failed, vd_error* err) {
+  int n = 2 + 5 * ds->images;
+  char** path = vd_calloc((size_t)n, sizeof(char*));
+  if (!path) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_status st = VD_OK;
+  char buf[5][4200];
+  item_path(ds, i, ds->ext, buf[0], sizeof buf[0]);
+  item_path(ds, i, "json", buf[1], sizeof buf[1]);
+  for (int k = 0; k < 2 && !st; k++)
+    if (!(path[k] = vd_strdup(buf[k]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  for (int v = 0; v < ds->images && !st; v++) {
+    char png[4200];
+    snprintf(png, sizeof png, "%s/item_%0*d_view%d.png", ds->dir, ds->width, i, v);
+    cli_frame_files(png, 1, 1, buf);
+    for (int k = 0; k < 5 && !st; k++)
+      if (!(path[2 + 5 * v + k] = vd_strdup(buf[k]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  cli_outset set;
+  if (!st && (st = cli_outset_begin(&set, (const char* const*)path, n, NULL, err)) == VD_OK) {
+    st = make_item_files(ds, pool, po0, co, i, points, out_failed, err);
+    cli_outset_end(&set, st == VD_OK);
+  } else {
+    *out_failed = st != VD_ERR_NOMEM;
+  }
+  for (int k = 0; k < n; k++)
+    if (path[k]) vd_free(path[k], strlen(path[k]) + 1);
+  vd_free(path, (size_t)n * sizeof(char*));
+  return st;
+}
+
 // ---------------------------------------------------------------------------------------------
 // the command
 
@@ -707,6 +742,15 @@ int cli_dataset(int argc, char** argv) {
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
   if (image_size_given && !ds.images) return cli_usage_error("dataset", "--image-size goes with --images N");
+  // no output may replace an input: the dataset writes manifest.json and item_* in DIR
+  const char* ins[2] = {po.path, co.scanners_file};
+  for (int k = 0; k < 2; k++) {
+    const char* base = ins[k] ? strrchr(ins[k], '/') : NULL;
+    base = base ? base + 1 : ins[k];
+    if (ins[k] && cli_in_folder(ds.dir, ins[k]) && (!strcmp(base, "manifest.json") || !strncmp(base, "item_", 5)))
+      return cli_usage_error("dataset", "the input '%s' lies in the dataset folder '%s' under a name the dataset "
+                             "writes (manifest.json, item_*); move it or choose another folder", ins[k], ds.dir);
+  }
   ds.master = po.seed;
   ds.instance_labels = co.labels_instance;
   ds.progress = po.progress;

@@ -125,12 +125,25 @@ int cli_grow(int argc, char** argv) {
   if (!out && !stats) return cli_usage_error("grow", "nothing to do: give -o OUT and/or --stats");
   if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
     return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
+  char files[2][4200];
+  const char* outs[2] = {files[0], files[1]};
+  int nf = out ? cli_plant_files(out, files) : 0;
+  if (cli_check_outputs("grow", outs, nf, (const char* const[]){po.path}, 1)) return EXIT_USAGE;
   vd_error err = {0};
   vd_plant_spec* plant;
   cli_grow_info info;
   vd_status st = cli_load_plant(&po, &plant, &info, &err);
   if (st) return cli_report("grow", &err, st);
+  // the file and its material library: together or not at all
+  cli_outset set;
+  if (out && (st = cli_outset_begin(&set, outs, nf, NULL, &err))) {
+    vd_plant_spec_destroy(plant);
+    cli_grow_info_free(&info);
+    cli_report("grow", &err, st);
+    return EXIT_FAIL;
+  }
   if (out) st = cli_write_plant(plant, out, ascii, &err);
+  if (out) cli_outset_end(&set, st == VD_OK);
   cli_blame_input(&err, po.path);  // a plant that does not compile (output errors name the output)
   if (!st && stats && !print_stats(plant, &info)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   vd_plant_spec_destroy(plant);

@@ -23,12 +23,19 @@ static vd_status write_plant(const vd_plant_spec* plant, const char* path, int a
   return st;
 }
 
+int cli_plant_files(const char* path, char files[2][4200]) {
+  size_t n = strlen(path);
+  snprintf(files[0], 4200, "%s", path);
+  if (!cli_has_ext(path, ".obj")) return 1;
+  snprintf(files[1], 4200, "%.*s.mtl", (int)(n - 4), path);
+  return 2;
+}
+
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
   // the file and, for OBJ, its material library: temporary names removed if a signal ends the run
-  char mtl[4200];
-  size_t n = strlen(path);
-  snprintf(mtl, sizeof mtl, "%.*s.mtl", (int)(cli_has_ext(path, ".obj") ? n - 4 : n), path);
-  int w0 = cli_watch(path), w1 = cli_has_ext(path, ".obj") ? cli_watch(mtl) : -1;
+  char files[2][4200];
+  int nf = cli_plant_files(path, files);
+  int w0 = cli_watch(path), w1 = nf > 1 ? cli_watch(files[1]) : -1;
   vd_status st = write_plant(plant, path, ascii, err);
   cli_unwatch(w0);
   cli_unwatch(w1);

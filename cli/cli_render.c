@@ -22,7 +22,7 @@ static const char* render_help =
     "\n"
     "options:\n"
     "  -o, --output OUT.png  colour image; the other files take its name: OUT.depth.png,\n"
-    "                        OUT.label.png, OUT.instance.png, OUT.json\n"
+    "                        OUT.label.png, OUT.instance.png, OUT.png.json\n"
     "      --camera VIEW     front | side | top | orbit[:AZ[:EL]] (degrees, orbit alone is\n"
     "                        orbit:-60:20), fitted to the plant; default orbit\n"
     "      --eye X,Y,Z       explicit camera position (m); with --lookat, replaces --camera\n"
@@ -32,12 +32,17 @@ static const char* render_help =
     "      --size WxH        image size in pixels (default 640x480)\n"
     "      --color-by WHAT   label | instance | stress | displacement (default label); stress\n"
     "                        needs a simulation run, a plant at rest has zero displacement\n"
-    "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the data's\n"
-    "                        (for a run: 0 to the largest value of the whole run)\n"
+    "      --palette P       label colours: distinct (default: every label its own colour, organ-\n"
+    "                        like where it can) or natural (the label table's organ colours, in\n"
+    "                        which labels of one organ look alike)\n"
+    "      --range MIN,MAX   colour scale of stress (Pa) or displacement (m); default: the values\n"
+    "                        of the plant still attached (a fallen fruit or broken branch lies\n"
+    "                        beyond the scale, in its end colour); for a run: 0 to the largest\n"
+    "                        such value of the whole run\n"
     "      --depth           also write OUT.depth.png (16-bit grey, millimetres along the optical\n"
-    "                        axis, 0 = nothing) and OUT.json (intrinsics, pose)\n"
+    "                        axis, 0 = nothing) and OUT.png.json (intrinsics, pose)\n"
     "      --masks           also write OUT.label.png and OUT.instance.png (16-bit ids, 0 =\n"
-    "                        background, exact: no anti-aliasing) and OUT.json\n"
+    "                        background, exact: no anti-aliasing) and OUT.png.json\n"
     "      --supersample K   colour anti-aliasing, K x K samples per pixel (1..4, default 2)\n"
     "      --point-size M    splat half-size of cloud points (m, default 0.4% of the cloud)\n"
     "      --robot FILE.xml  draw a robot from its MJCF (with its own world) beside the plant\n"
@@ -51,10 +56,23 @@ static const char* render_help =
     "      --mp4 OUT.mp4     every frame as an H.264 video (needs Debian's ffmpeg; skipped\n"
     "                        with a message when it is not installed)\n"
     "      --fps N           frame rate of the video (default: the run's, from its frame times)\n"
-    "  Displacement is measured from the first frame; stress is the largest bending stress of\n"
-    "  each segment, 4 |M| / (pi r^3), from its curvature (grey where there is none: leaf\n"
-    "  blades, fruits). The camera and the colour scale stay fixed over the whole run, and\n"
-    "  probes and other colliders are drawn (label 65535 in the masks, as robots).\n";
+    "      --displacement-from model|first\n"
+    "                        displacement from the plant as modelled (default: a settled run\n"
+    "                        shows its sag) or from the run's first frame (the timed motion)\n"
+    "  Stress is the largest bending stress of each segment, 4 |M| / (pi r^3), from its\n"
+    "  curvature (grey where there is none: leaf blades, fruits). The camera and the colour\n"
+    "  scale stay fixed over the whole run, and probes and other colliders are drawn (label\n"
+    "  65535 in the masks, as robots).\n";
+
+int cli_parse_palette(const char* s, vd_palette* out) {
+  if (!strcmp(s, "distinct"))
+    *out = VD_PALETTE_DISTINCT;
+  else if (!strcmp(s, "natural"))
+    *out = VD_PALETTE_NATURAL;
+  else
+    return 0;
+  return 1;
+}
 
 // three comma-separated numbers
 static int parse_vec(const char* s, vd_vec3* v) {
@@ -130,7 +148,8 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
     static const char* with_value[] = {"-o",         "--output",      "--camera",     "--eye",
                                        "--lookat",   "--up",          "--fov",        "--size",
                                        "--color-by", "--supersample", "--point-size", "--robot",
-                                       "--time",     "--mp4",         "--fps",        "--range"};
+                                       "--time",     "--mp4",         "--fps",        "--range",
+                                       "--palette",  "--displacement-from"};
     for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++)
       if (!strcmp(a, with_value[k])) {
         if (i + 1 >= argc) return cli_usage_error("render", "%s needs a value", a);
@@ -172,6 +191,14 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
       else
         return cli_usage_error(
             "render", "--color-by expects label, instance, stress or displacement, got '%s'", val);
+    } else if (!strcmp(a, "--displacement-from")) {
+      if (strcmp(val, "model") != 0 && strcmp(val, "first") != 0)
+        return cli_usage_error("render", "--displacement-from expects model or first, got '%s'",
+                               val);
+      o->disp_from_first = !strcmp(val, "first");
+    } else if (!strcmp(a, "--palette")) {
+      if (!cli_parse_palette(val, &o->style.palette))
+        return cli_usage_error("render", "--palette expects distinct or natural, got '%s'", val);
     } else if (!strcmp(a, "--range")) {
       char* end;
       errno = 0;
@@ -259,16 +286,32 @@ vd_camera cli_render_camera(const cli_render_opts* o, vd_vec3 lo, vd_vec3 hi) {
   return cam;
 }
 
+int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]) {
+  int n = 0;
+  snprintf(path[n++], 4200, "%s", out);
+  if (depth) sibling(out, "depth.png", path[n++], 4200);
+  if (masks) sibling(out, "label.png", path[n++], 4200), sibling(out, "instance.png", path[n++], 4200);
+  if (depth || masks) snprintf(path[n++], 4200, "%s.json", out);
+  return n;
+}
+
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err) {
   char p_depth[4200], p_label[4200], p_inst[4200], p_json[4200];
   sibling(out, "depth.png", p_depth, sizeof p_depth);
   sibling(out, "label.png", p_label, sizeof p_label);
   sibling(out, "instance.png", p_inst, sizeof p_inst);
-  sibling(out, "json", p_json, sizeof p_json);
-  // an interrupt removes the temporary files of these outputs
+  snprintf(p_json, sizeof p_json, "%s.json", out);
+  // the files appear together or not at all; an interrupt removes their temporary files
+  char set_path[5][4200];
+  const char* set_out[5];
+  int nset = cli_frame_files(out, depth, masks, set_path);
+  for (int k = 0; k < nset; k++) set_out[k] = set_path[k];
+  cli_outset set;
+  vd_status st = cli_outset_begin(&set, set_out, nset, NULL, err);
+  if (st) return st;
   int watch[5] = {cli_watch(out), cli_watch(p_depth), cli_watch(p_label), cli_watch(p_inst), cli_watch(p_json)};
   // colour, then depth and masks, then the sidecar naming them
-  vd_status st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
+  st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
   if (!st && depth) st = vd_render_write_png(f, VD_LAYER_DEPTH, p_depth, err);
   if (!st && masks) st = vd_render_write_png(f, VD_LAYER_LABEL, p_label, err);
   if (!st && masks) st = vd_render_write_png(f, VD_LAYER_INSTANCE, p_inst, err);
@@ -285,6 +328,7 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
     st = vd_render_write_json(f, files, p_json, err);
   }
   for (int k = 0; k < 5; k++) cli_unwatch(watch[k]);
+  cli_outset_end(&set, st == VD_OK);
   return st;
 }
 
@@ -314,10 +358,18 @@ int cli_render(int argc, char** argv) {
   if (!o.out) return cli_usage_error("render", "missing -o OUT.png");
   if (!cli_has_ext(o.out, ".png"))
     return cli_usage_error("render", "output '%s' must end in .png", o.out);
-  if (o.has_time || o.mp4 || o.fps > 0)
-    return cli_usage_error(
-        "render",
-        "--time, --mp4 and --fps apply to simulation runs (a folder of 'verdant sim -o')");
+  if (o.has_time || o.mp4 || o.fps > 0 || o.disp_from_first)
+    return cli_usage_error("render", "--time, --mp4, --fps and --displacement-from first apply to "
+                                     "simulation runs (a folder of 'verdant sim -o')");
+  {
+    // no output may replace an input (the plant file, the robot)
+    char files[5][4200];
+    const char* outs[5];
+    int nout = cli_frame_files(o.out, o.depth, o.masks, files);
+    for (int k = 0; k < nout; k++) outs[k] = files[k];
+    const char* ins[2] = {o.po.path, o.def.robot_mjcf};
+    if (cli_check_outputs("render", outs, nout, ins, 2)) return EXIT_USAGE;
+  }
   // point clouds in any format the cloud module reads; everything else is a plant
   int is_cloud = cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") ||
                  cli_has_ext(o.po.path, ".xyz") || cli_has_ext(o.po.path, ".csv") ||

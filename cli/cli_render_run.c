@@ -60,20 +60,6 @@ static void box_frame(box* b, const vd_model* m, const vd_data* d, const vd_sim_
   }
 }
 
-// largest distance of the state's points from the reference's (m)
-static double max_moved(const vd_model* m, const vd_data* d, const vd_data* ref) {
-  double best = 0;
-  const double* a[3] = {d->node_pos, d->sphere_pos, d->vert_pos};
-  const double* b[3] = {ref->node_pos, ref->sphere_pos, ref->vert_pos};
-  int n[3] = {m->nnode, m->nsphere, m->nvert};
-  for (int k = 0; k < 3; k++)
-    for (int i = 0; i < 3 * n[k]; i += 3) {
-      double dx = a[k][i] - b[k][i], dy = a[k][i + 1] - b[k][i + 1], dz = a[k][i + 2] - b[k][i + 2];
-      best = fmax(best, sqrt(dx * dx + dy * dy + dz * dz));
-    }
-  return best;
-}
-
 // copy a plant state (same model)
 static void copy_state(const vd_model* m, const vd_data* src, vd_data* dst) {
   memcpy(dst->node_pos, src->node_pos, sizeof(double) * 3 * (size_t)m->nnode);
@@ -81,6 +67,7 @@ static void copy_state(const vd_model* m, const vd_data* src, vd_data* dst) {
   memcpy(dst->sphere_pos, src->sphere_pos, sizeof(double) * 3 * (size_t)m->nsphere);
   memcpy(dst->vert_pos, src->vert_pos, sizeof(double) * 3 * (size_t)m->nvert);
   memcpy(dst->seg_broken, src->seg_broken, sizeof(int) * (size_t)m->nseg);
+  memcpy(dst->seg_cut, src->seg_cut, sizeof(double) * 7 * (size_t)m->nseg);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -225,7 +212,7 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
       cJSON_AddStringToObject(e, "instance", name);
     }
     if (o->depth || o->masks)
-      snprintf(name, sizeof name, "frame_%05d.json", k), cJSON_AddStringToObject(e, "camera", name);
+      snprintf(name, sizeof name, "frame_%05d.png.json", k), cJSON_AddStringToObject(e, "camera", name);
     cJSON_AddItemToArray(frames, e);
   }
   char* text = cJSON_Print(root);
@@ -246,6 +233,39 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
 
 // ---------------------------------------------------------------------------------------------
 // the command
+
+// the set of every file the command writes: one frame (and its siblings) or every frame of the
+// folder and its index, the video
+static vd_status begin_outputs(const cli_render_opts* o, const cli_run* run, const char* folder, const char* mp4,
+                               int single, cli_outset* set, vd_error* err) {
+  int per = 1 + (o->depth || o->masks) + o->depth + 2 * o->masks;
+  int cap = (folder ? run->nframe * per + 1 : 0) + (single ? per : 0) + 1, n = 0;
+  char** path = vd_calloc((size_t)cap, sizeof(char*));
+  if (!path) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_status st = VD_OK;
+  char files[5][4200];
+  for (int k = 0; !st && folder && k <= run->nframe; k++) {
+    int nf = 1;
+    if (k < run->nframe) {
+      char png[4200];
+      snprintf(png, sizeof png, "%s/frame_%05d.png", folder, k);
+      nf = cli_frame_files(png, o->depth, o->masks, files);
+    } else {
+      snprintf(files[0], sizeof files[0], "%s/frames.json", folder);
+    }
+    for (int i = 0; i < nf && !st; i++)
+      if (!(path[n++] = vd_strdup(files[i]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  int nf = !st && single ? cli_frame_files(o->out, o->depth, o->masks, files) : 0;
+  if (!st && mp4) snprintf(files[nf++], sizeof files[0], "%s", mp4);
+  for (int i = 0; i < nf && !st; i++)
+    if (!(path[n++] = vd_strdup(files[i]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (!st) st = cli_outset_begin(set, (const char* const*)path, n, NULL, err);
+  for (int i = 0; i < n; i++)
+    if (path[i]) vd_free(path[i], strlen(path[i]) + 1);
+  vd_free(path, (size_t)cap * sizeof(char*));
+  return st;
+}
 
 // the colliders of a frame as solids (planes are the floor's business)
 static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int ncol,
@@ -277,6 +297,23 @@ int cli_render_run(const cli_render_opts* o) {
   if (o->po.steps >= 0 || o->po.seed || o->po.nset || o->po.nlabel)
     return cli_usage_error(
         cmd, "-n, --seed, --set and --label apply to .lpy plants; a run holds its plant");
+  {
+    // no output may replace a file of the run or the robot
+    static const char* run_files[] = {"rod.json", "plant_initial.json", "frames.bin", "frames.jsonl",
+                                      "colliders.jsonl", "plant.json", "events.csv"};
+    char ipath[8][4200], opath[7][4200];
+    const char* ins[8];
+    const char* outs[7];
+    int nin = 0, nout = 0;
+    for (size_t k = 0; k < sizeof run_files / sizeof *run_files; k++, nin++)
+      snprintf(ipath[nin], sizeof ipath[nin], "%s/%s", o->po.path, run_files[k]), ins[nin] = ipath[nin];
+    ins[nin++] = o->def.robot_mjcf;
+    if (single) nout = cli_frame_files(o->out, o->depth, o->masks, opath);
+    if (folder) snprintf(opath[nout++], sizeof opath[0], "%s/frames.json", folder);
+    if (o->mp4) snprintf(opath[nout++], sizeof opath[0], "%s", o->mp4);
+    for (int k = 0; k < nout; k++) outs[k] = opath[k];
+    if (cli_check_outputs(cmd, outs, nout, ins, nin)) return EXIT_USAGE;
+  }
   const char* mp4 = o->mp4;
   if (mp4 && !on_path("ffmpeg")) {
     fprintf(stderr,
@@ -297,6 +334,8 @@ int cli_render_run(const cli_render_opts* o) {
   memset(&vid, 0, sizeof vid);
   int progress = o->po.progress;
   int writing = 0; // the failure, if any, is in writing the outputs
+  int made_dir = 0, has_set = 0;
+  cli_outset set;
   if ((st = cli_run_open(o->po.path, &run, &err))) return cli_report(cmd, &err, st);
   const vd_model* pm = run.plant;
   int want = o->has_time ? vd_sim_frames_nearest(run.frames, o->time) : run.nframe - 1;
@@ -311,6 +350,10 @@ int cli_render_run(const cli_render_opts* o) {
     goto fail;
   }
   box bx = {vd_v3(0, 0, 0), vd_v3(0, 0, 0), 0, o->def.floor};
+  // displacement from the plant as modelled (its rest shape: a settled run shows its sag), or
+  // from the first frame (--displacement-from first: the motion of the timed run only)
+  style.ref = o->disp_from_first ? ref : NULL;
+  style.seg_stress = stress;
   double vmax = 0;
   for (int k = 0; k < run.nframe; k++) {
     if ((st = cli_run_load(&run, k, &err))) goto fail;
@@ -318,17 +361,16 @@ int cli_render_run(const cli_render_opts* o) {
     const vd_sim_collider* col;
     int ncol = cli_run_colliders(&run, k, &col);
     box_frame(&bx, pm, run.pstate, col, ncol);
-    if (style.color_by == VD_COLOR_DISPLACEMENT) vmax = fmax(vmax, max_moved(pm, run.pstate, ref));
-    if (style.color_by == VD_COLOR_STRESS) {
-      vd_sim_plant_stress(run.sim, run.state, pm, stress);
-      for (int j = 0; j < pm->nseg; j++)
-        if (isfinite(stress[j])) vmax = fmax(vmax, stress[j]);
+    // the scale of the plant still attached in this frame (a fallen fruit lies beyond it)
+    if (value) {
+      double lo, hi;
+      if (style.color_by == VD_COLOR_STRESS) vd_sim_plant_stress(run.sim, run.state, pm, stress);
+      if ((st = vd_render_value_range(pm, run.pstate, &style, &lo, &hi, &err))) goto fail;
+      vmax = fmax(vmax, hi);
     }
   }
   if (value && !(style.range_max > style.range_min) && vmax > 0)
     style.range_min = 0, style.range_max = vmax;
-  style.ref = ref;
-  style.seg_stress = stress;
   // the renderer, with room for every organ instance and collider
   vd_render_def def = o->def;
   if (pm->ninstance + VD_SIM_MAX_COLLIDERS + 16 > def.max_geoms)
@@ -351,11 +393,16 @@ int cli_render_run(const cli_render_opts* o) {
     cam = cli_render_camera(o, lo, hi);
   }
   writing = 1;
-  if (folder && mkdir(folder, 0777) != 0 && errno != EEXIST) {
+  if (folder && mkdir(folder, 0777) == 0)
+    made_dir = 1;
+  else if (folder && errno != EEXIST) {
     st = vd_error_set(&err, VD_ERR_IO, folder, 0, 0, "cannot create the folder: %s",
                       strerror(errno));
     goto fail;
   }
+  // every file of the command appears together or not at all
+  if ((st = begin_outputs(o, &run, folder, mp4, single, &set, &err))) goto fail;
+  has_set = 1;
   // frames: one, or every one into the folder and the video
   unsigned layers = VD_LAYER_COLOR | (o->depth ? VD_LAYER_DEPTH : 0) |
                     (o->masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
@@ -408,6 +455,8 @@ fail:
   if (writing) code = EXIT_FAIL;
 done:
   if (vid.pid) video_finish(&vid, mp4, 0, NULL);
+  if (has_set) cli_outset_end(&set, code == EXIT_OK);
+  if (made_dir && code != EXIT_OK) rmdir(folder);  // only when empty
   vd_render_destroy(r);
   vd_free(stress, sizeof(double) * (size_t)(pm->nseg ? pm->nseg : 1));
   vd_data_destroy(ref);

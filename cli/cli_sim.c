@@ -724,6 +724,39 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
   return EXIT_OK;
 }
 
+// the outputs of a run: the run folder's files (those of another --frames choice stale: an
+// earlier run's, removed when this one completes) and --final; returns the count
+#define SIM_MAX_OUT 9
+static int run_outputs(const sim_opts* o, char path[SIM_MAX_OUT][4200], unsigned char stale[SIM_MAX_OUT]) {
+  static const char* run_files[] = {"frames.bin", "frames.jsonl", "colliders.jsonl", "rod.json",
+                                    "plant_initial.json", "events.csv", "plant.json"};
+  int n = 0, dn = o->out ? (int)strlen(o->out) : 0;
+  while (dn > 1 && o->out[dn - 1] == '/') dn--;
+  const char* frames = o->frames ? o->frames : "bin";
+  for (size_t k = 0; o->out && k < sizeof run_files / sizeof *run_files; k++) {
+    snprintf(path[n], sizeof path[0], "%.*s/%s", dn, o->out, run_files[k]);
+    stale[n++] = (k == 0 && strcmp(frames, "bin") != 0) || (k == 1 && strcmp(frames, "jsonl") != 0) ||
+                 (k == 2 && !strcmp(frames, "none"));
+  }
+  if (o->final) {
+    int nf = cli_plant_files(o->final, path + n);
+    for (int k = 0; k < nf; k++) stale[n++] = 0;
+  }
+  return n;
+}
+
+// no output may replace an input (the plant, the wind series, collider meshes)
+static int check_clash(const sim_opts* o) {
+  char opath[SIM_MAX_OUT][4200];
+  unsigned char stale[SIM_MAX_OUT];
+  const char* outs[SIM_MAX_OUT];
+  const char* ins[10] = {o->po.path, o->wind_file};
+  int nin = 2, nout = run_outputs(o, opath, stale);
+  for (int k = 0; k < o->nmesh; k++) ins[nin++] = o->mesh_path[k];
+  for (int k = 0; k < nout; k++) outs[k] = opath[k];
+  return cli_check_outputs("sim", outs, nout, ins, nin);
+}
+
 int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
@@ -745,6 +778,7 @@ int cli_sim(int argc, char** argv) {
   if (rc) return rc;
   if (!o.po.path) return cli_usage_error("sim", "missing PLANT (an .lpy or plant .json file)");
   if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
+  if (check_clash(&o)) return EXIT_USAGE;
   if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
   if (!o.frames) o.frames = "bin";
   // the run's steps, counted (a time sum stalls once time + dt == time): at most --max-steps
@@ -765,7 +799,8 @@ int cli_sim(int argc, char** argv) {
   memset(&out, 0, sizeof out);
   out.watch = out.cwatch = -1;
   cli_grow_info info;
-  int code = EXIT_OK;
+  int code = EXIT_OK, made_dir = 0, has_set = 0;
+  cli_outset set;
   vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
   if (!st) cli_grow_info_free(&info);
   if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
@@ -810,11 +845,30 @@ int cli_sim(int argc, char** argv) {
     code = cli_report("sim", &err, st);
     goto done;
   }
-  // output folder: failing to write is a failed run (exit 1), not bad input
+  // output folder: failing to write is a failed run (exit 1), not bad input; the run's files
+  // appear together or not at all (a folder made for a failed run goes too)
   if (o.out) {
-    if (mkdir(o.out, 0777) && errno != EEXIST)
+    if (mkdir(o.out, 0777) == 0)
+      made_dir = 1;
+    else if (errno != EEXIST)
       st = vd_error_set(&err, VD_ERR_IO, o.out, 0, 0, "cannot create the output folder: %s", strerror(errno));
-    if (!st) st = write_rod_json(m, plant, &o.def, o.out, &err);
+  }
+  if (!st && (o.out || o.final)) {
+    char opath[SIM_MAX_OUT][4200];
+    unsigned char stale[SIM_MAX_OUT];
+    const char* outs[SIM_MAX_OUT];
+    int nout = run_outputs(&o, opath, stale);
+    for (int k = 0; k < nout; k++) outs[k] = opath[k];
+    st = cli_outset_begin(&set, outs, nout, stale, &err);
+    has_set = !st;
+  }
+  if (st) {
+    cli_report("sim", &err, st);
+    code = EXIT_FAIL;
+    goto done;
+  }
+  if (o.out) {
+    st = write_rod_json(m, plant, &o.def, o.out, &err);
     if (!st) {
       char path[4096];
       snprintf(path, sizeof path, "%s/plant_initial.json", o.out);
@@ -921,8 +975,9 @@ int cli_sim(int argc, char** argv) {
     }
     if (!st && o.out) st = write_events(d, plant, o.out, &err);
     if (!st && (o.out || o.final)) {
-      vd_sim_to_spec(m, d, spec);
-      if (o.out) {
+      st = vd_sim_to_spec(m, d, spec);
+      if (st) vd_error_set(&err, st, "", 0, 0, "out of memory writing the final plant");
+      if (!st && o.out) {
         char path[4096];
         snprintf(path, sizeof path, "%s/plant.json", o.out);
         st = cli_write_plant(spec, path, 0, &err);
@@ -939,6 +994,8 @@ int cli_sim(int argc, char** argv) {
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);
   if (out.colliders_open) vd_outfile_abort(&out.colliders);
+  if (has_set) cli_outset_end(&set, code == EXIT_OK);
+  if (made_dir && code != EXIT_OK) rmdir(o.out);  // only when empty
   cli_unwatch(out.watch);
   cli_unwatch(out.cwatch);
   vd_free(out.bbuf, out.fbuf_n);

@@ -7,10 +7,12 @@ set -eu
 # robot simulation: libmujoco-dev (+ libqhull-dev, which its CMake package names); tests: python3;
 # headless rendering: EGL and GL headers (libegl-dev, libgl-dev), the EGL loader (libegl1), Mesa's
 # EGL and its software/DRI drivers (libegl-mesa0, libgl1-mesa-dri); dataset checksums (SHA-256):
-# nettle-dev; the L-system Python engine: embedded CPython (libpython3.11-dev) with numpy for the
-# models that import it (python3-numpy)
+# nettle-dev; the Python package (python/): python3-dev, python3-numpy, python3-pytest for its
+# tests, python3-setuptools and python3-venv for `pip install ./python` (offline); the L-system
+# Python engine: embedded CPython (libpython3.11-dev), numpy for the models that import it
 need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3
-  libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev libpython3.11-dev python3-numpy)
+  libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev
+  python3-dev python3-numpy python3-pytest python3-setuptools python3-venv libpython3.11-dev)
 # --dev adds the tools of CI's hardening runs: clang with libFuzzer (make fuzz, fuzz-smoke),
 # clang-tidy and cppcheck (make lint)
 if [ "${1:-}" = "--dev" ]; then

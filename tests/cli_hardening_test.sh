@@ -305,7 +305,7 @@ expect_err "validate: --plant error names file:line:col" "syntax.lpy:3:[0-9]+: "
 if mkdir -p "$T/ro" "$T/full" && mount -t tmpfs -o ro,size=1m tmpfs "$T/ro" 2>/dev/null; then
   MOUNTS+=("$T/ro")
   expect "read-only: grow" 1 "$V" grow "$P" -o "$T/ro/p.json"
-  expect_err "read-only: grow says why" "ro/p.json: cannot write: Read-only file system"
+  expect_err "read-only: grow says why" "ro/p.json: cannot write.*Read-only file system"
   expect "read-only: cloud" 1 "$V" cloud "$P" -N 100 -o "$T/ro/c.ply"
   expect "read-only: dataset" 1 "$V" dataset "$P" --count 2 -N 100 -o "$T/ro/ds"
   expect_err "read-only: dataset says why" "cannot create the folder: Read-only file system"

@@ -174,6 +174,43 @@ assert b["color_by"] == "stress" and b["unit"] == "Pa" and b["range"][1] > 1e3, 
 EOF
 if cmp -s "$T/disp/frame_00000.png" "$T/disp/frame_00006.png"; then bad "frames differ"; else ok "frames differ"; fi
 
+# scales follow what the picture shows: a settled plant shows its sag from the plant as modelled
+# (it showed "0 ... 0", measured from its only frame); --displacement-from first gives the
+# timed motion alone; a fruit pulled off lies beyond the scale of the plant still attached
+cat >"$T/sag.lpy" <<'EOF'
+LABELS = {1: "stem", 2: "leaf"}
+module I, B, Leaf
+Axiom: SetWidth(0.004) I(0.1) [ +(90) B(0.3) Leaf(0.08) ] I(0.1)
+interpretation:
+I(l) --> ;(1) F(l, 0.004)
+B(l) --> ;(1) F(l, 0.0012)
+Leaf(s) --> ;(2) ~l(s)
+endlsystem
+EOF
+expect "sim settle" 0 "$V" sim "$T/sag.lpy" --settle --no-progress -o "$T/settle" --stats
+cp "$T/out" "$T/settle.stats"
+expect "render settled sag" 0 "$V" render "$T/settle" -o "$T/sag.png" --color-by displacement --depth --size 96x72
+expect "render settled from first" 0 "$V" render "$T/settle" -o "$T/sag0.png" --color-by displacement --depth --size 96x72 \
+  --displacement-from first
+expect "displacement-from on a plant" 2 "$V" render "$T/sag.lpy" -o "$T/x.png" --displacement-from first
+expect "displacement-from bad" 2 "$V" render "$T/settle" -o "$T/x.png" --displacement-from last
+expect "sim pull a fruit off" 0 "$V" sim "$T/p.lpy" --sag-free --duration 0.4 --pull fruit=0,0,-3 --no-progress -o "$T/pull"
+expect "render pulled by displacement" 0 "$V" render "$T/pull" -o "$T/pull.png" --color-by displacement --masks --size 200x150 --camera front
+check "scales follow the attached plant" - "$T" <<'EOF'
+import json, sys
+d = sys.argv[1]
+stats = json.load(open(d + "/settle.stats"))
+sag = json.load(open(d + "/sag.png.json"))["range"]
+first = json.load(open(d + "/sag0.png.json"))["range"]
+assert stats["max_displacement"] > 0.005, stats["max_displacement"]
+assert 0.5 * stats["max_displacement"] < sag[1] <= 1.5 * stats["max_displacement"], (sag, stats["max_displacement"])
+assert first[1] < 1e-9, first
+events = open(d + "/pull/events.csv").read().splitlines()
+assert len(events) >= 2, events
+pull = json.load(open(d + "/pull.png.json"))["range"]
+assert pull[1] < 0.02, pull
+EOF
+
 # an MP4 when ffmpeg is there; a clear message and no video when it is not
 if command -v ffmpeg >/dev/null 2>&1; then
   expect "render mp4" 0 "$V" render "$T/run" --mp4 "$T/run.mp4" --size 161x121 --supersample 1 --no-progress

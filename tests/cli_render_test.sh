@@ -44,7 +44,7 @@ fi
 
 # the tomato with masks and depth: five files, masks 16-bit, sidecar names them
 expect "render tomato" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/tomato.png" --masks --depth --size 320x240
-for f in tomato.png tomato.label.png tomato.instance.png tomato.depth.png tomato.json; do
+for f in tomato.png tomato.label.png tomato.instance.png tomato.depth.png tomato.png.json; do
   if [ -s "$T/$f" ]; then ok "wrote $f"; else bad "wrote $f"; fi
 done
 if python3 - "$T" <<'PY'
@@ -78,7 +78,7 @@ def png(path):
         rows.append(line); prev = line
     vals = [v for r in rows for v in (struct.unpack(">%dH" % (len(r) // 2), r) if bits == 16 else r)]
     return w, h, bits, ch, vals
-meta = json.load(open(f"{d}/tomato.json"))
+meta = json.load(open(f"{d}/tomato.png.json"))
 assert meta["version"] == 1 and meta["width"] == 320 and meta["height"] == 240
 assert abs(meta["intrinsics"]["cx"] - 159.5) < 1e-9
 names = {l["id"]: l["name"] for l in meta["labels"]}
@@ -101,6 +101,18 @@ w, h, bits, ch, rgb = png(f"{d}/tomato.png")
 assert (w, h, bits, ch) == (320, 240, 8, 3)
 PY
 then ok "masks, depth and sidecar agree"; else bad "masks, depth and sidecar agree"; fi
+# the sidecar names the OpenGL that drew the picture, as --info does (GPU or llvmpipe)
+expect "render with info" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/info.png" --depth --size 64x48 --info
+if python3 - "$T/info.png.json" "$T/err" <<'PY'
+import json, sys
+gl = json.load(open(sys.argv[1]))["opengl"]
+info = open(sys.argv[2]).read()
+assert gl["vendor"] and gl["renderer"] and gl["version"] and "?" not in (gl["vendor"], gl["renderer"])
+assert gl["renderer"] in info and gl["version"] in info, (gl, info)
+assert gl["egl_platform"] in ("surfaceless", "device", "default display")
+assert gl["software"] == any(s in gl["renderer"] for s in ("llvmpipe", "softpipe", "swrast", "Software"))
+PY
+then ok "sidecar names the OpenGL renderer"; else bad "sidecar names the OpenGL renderer"; fi
 
 # same seed, same bytes; presets and explicit poses; other colourings
 expect "render again" 0 "$V" render "$SRC/data/tomato.lpy" --seed 2 -o "$T/again.png" --masks --depth --size 320x240
@@ -115,6 +127,21 @@ done
 expect "explicit pose" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/pose.png" --eye 1.5,-1.5,1.2 --lookat 0,0,0.6 --fov 40 --size 160x120
 expect "color by instance" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/inst.png" --color-by instance --size 160x120
 expect "color by displacement" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/disp.png" --color-by displacement --size 160x120
+# label colours: distinct by default, the label table's with --palette natural (sidecar says which)
+expect "palette natural" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/nat.png" --palette natural --masks --size 64x48
+expect "palette bad" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --palette pastel
+expect "grow for palette" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/labels.json"
+if python3 - "$T/tomato.png.json" "$T/nat.png.json" "$T/labels.json" <<'PY'
+import json, sys
+dist, nat, plant = (json.load(open(p)) for p in sys.argv[1:])
+assert dist["palette"] == "distinct" and nat["palette"] == "natural"
+table = {l["id"]: l["rgb"] for l in plant["labels"]}
+for l in nat["labels"]:
+    assert all(abs(a - b) < 1e-6 for a, b in zip(l["rgb"], table[l["id"]])), (l, table[l["id"]])
+rgb = [tuple(round(c, 3) for c in l["rgb"]) for l in dist["labels"]]
+assert len(set(rgb)) == len(rgb), rgb
+PY
+then ok "palettes in the sidecar"; else bad "palettes in the sidecar"; fi
 expect "plant file" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/tomato.json"
 expect "render plant file" 0 "$V" render "$T/tomato.json" -o "$T/fromjson.png" --size 160x120
 

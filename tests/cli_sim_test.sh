@@ -96,6 +96,27 @@ expect "sim pull fracture" 0 "$V" sim "$T/p.lpy" --duration 0.5 --pull fruit=0,0
 json_check "one fracture" "d['nevents'] == 1 and d['events'][0]['label'] in ('fruit', 'pedicel')"
 if [ "$(wc -l <"$T/runp/events.csv")" -eq 2 ]; then ok "events csv row"; else bad "events csv row"; fi
 
+# the README's pull in wind breaks a pedicel at its abscission node: in the final plant the part
+# that came off is a piece of its own, no segment spans the gap, labels and instances kept
+expect "tomato pull in wind" 0 "$V" sim "$SRC/data/tomato.lpy" --sag-free --duration 1 --pull fruit=0,0.5,-3 --wind 5,0,0 -o "$T/runw"
+if python3 - "$T/runw" <<'PY'
+import csv, json, math, sys
+d = sys.argv[1]
+a, b = json.load(open(d + "/plant_initial.json")), json.load(open(d + "/plant.json"))
+events = list(csv.DictReader(open(d + "/events.csv")))
+assert len(events) >= 1, events
+def lengths(p):
+    n, s = p["nodes"], p["segments"]
+    return [math.dist(n[3 * i:3 * i + 3], n[3 * k:3 * k + 3]) for i, k in zip(s["node0"], s["node1"])]
+la, lb = lengths(a), lengths(b)
+assert max(l1 - 1.5 * l0 for l0, l1 in zip(la, lb)) < 1e-3, max(l1 / l0 for l0, l1 in zip(la, lb) if l0 > 0)
+roots = lambda p: sum(1 for q in p["segments"]["parent"] if q < 0)
+assert roots(b) == roots(a) + len(events), (roots(a), roots(b), len(events))
+pairs = lambda p: {(l, i) for k in ("segments", "spheres") for l, i in zip(p[k]["label"], p[k]["instance"])}
+assert pairs(a) == pairs(b)
+PY
+then ok "fracture pieces in plant.json"; else bad "fracture pieces in plant.json"; fi
+
 # probes and wind run; a probe through the plant leaves no penetration
 expect "sim probe" 0 "$V" sim "$T/p.lpy" --duration 0.3 --probe 0.03:0.1,0.1,0.15:-0.1,-0.1,0.15 --wind 3,0,0 --gust 0.3,0.5 --stats
 json_check "probe no penetration" "d['max_penetration'] < 1e-4"

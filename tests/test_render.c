@@ -5,48 +5,12 @@
 // splats, a robot from MJCF, identical images for a seed, PNG round trips, bad input.
 #include <stdlib.h>
 
+#include "render_helpers.h"
 #include "test.h"
 #include "verdant/verdant.h"
 
 // ---------------------------------------------------------------------------------------------
 // helpers
-
-// a renderer, or NULL after printing why the test is skipped
-static vd_renderer* renderer(vd_render_def* def) {
-  vd_renderer* r = NULL;
-  vd_error err = {0};
-  vd_status st = vd_render_create(def, &r, &err);
-  if (st == VD_ERR_UNSUPPORTED) {
-    char buf[1024];
-    fprintf(stderr, "  skip: %s\n", vd_error_format(&err, buf, sizeof buf));
-    return NULL;
-  }
-  CHECK_STATUS(st, VD_OK, err);
-  return r;
-}
-
-// small, fast settings: no shadows, no legend, no supersampling
-static vd_render_def small_def(int w, int h) {
-  vd_render_def d = vd_render_def_default();
-  d.width = w, d.height = h, d.supersample = 1, d.shadows = 0, d.legend = 0;
-  return d;
-}
-
-// a plant of one quad (two triangles) with the given corners, label and instance
-static vd_model* quad_plant(const vd_vec3 v[4], int label, int instance) {
-  vd_plant_spec* s = vd_plant_spec_create();
-  if (!s) return NULL;
-  vd_mesh_spec m = {0};
-  m.label = label, m.instance = instance, m.node = -1, m.parent = -1, m.module = -1;
-  int t[6] = {0, 1, 2, 0, 2, 3};
-  vd_plant_add_mesh(s, &m, v, 4, t, 2);
-  vd_plant_set_label(s, label, "leaf");
-  vd_model* model = NULL;
-  vd_error err = {0};
-  vd_plant_compile(s, &model, &err);
-  vd_plant_spec_destroy(s);
-  return model;
-}
 
 // a camera at eye looking along +Y with Z up
 static vd_camera cam_y(vd_vec3 eye, double fovy_deg) {
@@ -58,21 +22,6 @@ static vd_camera cam_y(vd_vec3 eye, double fovy_deg) {
   c.znear = 0.05;
   c.zfar = 50;
   return c;
-}
-
-// the bundled tomato for a seed, compiled
-static vd_model* tomato(uint64_t seed) {
-  vd_lsystem* ls = NULL;
-  vd_error err = {0};
-  if (vd_lsys_load(vdt_path("data/tomato.lpy"), &ls, &err)) return NULL;
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_lsys_def def = vd_lsys_def_default();
-  def.seed = seed;
-  vd_model* m = NULL;
-  if (s && !vd_lsys_grow(ls, &def, NULL, s, &err)) vd_plant_compile(s, &m, &err);
-  vd_plant_spec_destroy(s);
-  vd_lsys_destroy(ls);
-  return m;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -149,13 +98,13 @@ TEST(render, bad_settings) {
 // masks and depth
 
 TEST(render, one_leaf_mask) {
-  vd_render_def d = small_def(200, 150);
+  vd_render_def d = vdt_small_def(200, 150);
   d.floor = 0;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
   // a leaf 0.4 x 0.3 m facing the camera 2 m away, label 2, instance 5
   vd_vec3 v[4] = {{-0.2, 0, 0.35}, {0.2, 0, 0.35}, {0.2, 0, 0.65}, {-0.2, 0, 0.65}};
-  vd_model* m = quad_plant(v, 2, 5);
+  vd_model* m = vdt_quad_plant(v, 2, 5);
   REQUIRE(m);
   vd_error err = {0};
   CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
@@ -207,9 +156,9 @@ static double ray_plane(const vd_intrinsics* K, double u, double v, vd_vec3 p0, 
 }
 
 TEST(render, depth_of_planes) {
-  vd_render_def d = small_def(160, 120);
+  vd_render_def d = vdt_small_def(160, 120);
   d.floor = 0;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
   vd_error err = {0};
   // a plane facing the camera at 1.2345 m, and a plane tilted by 50 degrees
@@ -223,7 +172,7 @@ TEST(render, depth_of_planes) {
   vd_vec3 nb = vd_normalize(vd_cross(vd_sub(b[1], b[0]), vd_sub(b[3], b[0])));
   for (int k = 0; k < 2; k++) {
     vd_render_clear(r);
-    vd_model* m = quad_plant(k ? b : a, 1, 1);
+    vd_model* m = vdt_quad_plant(k ? b : a, 1, 1);
     REQUIRE(m);
     CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
     vd_camera c = cam_y(vd_v3(0, 0, 0), 50);
@@ -267,10 +216,10 @@ TEST(render, depth_of_planes) {
 }
 
 TEST(render, tomato_masks_consistent) {
-  vd_render_def d = small_def(320, 240);
-  vd_renderer* r = renderer(&d);
+  vd_render_def d = vdt_small_def(320, 240);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
-  vd_model* m = tomato(4);
+  vd_model* m = vdt_tomato(4);
   REQUIRE(m);
   vd_error err = {0};
   CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
@@ -324,9 +273,9 @@ TEST(render, deterministic) {
   for (int k = 0; k < 3; k++) {
     vd_render_def d = vd_render_def_default();
     d.width = 240, d.height = 180;
-    vd_renderer* r = renderer(&d);
+    vd_renderer* r = vdt_renderer(&d);
     if (!r) break;
-    vd_model* m = tomato(seeds[k]);
+    vd_model* m = vdt_tomato(seeds[k]);
     vd_error err = {0};
     if (m) CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
     vd_vec3 lo, hi;
@@ -352,11 +301,11 @@ TEST(render, deterministic) {
 }
 
 TEST(render, colour_modes_and_legend) {
-  vd_render_def d = small_def(160, 120);
+  vd_render_def d = vdt_small_def(160, 120);
   d.legend = 1;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
-  vd_model* m = tomato(1);
+  vd_model* m = vdt_tomato(1);
   REQUIRE(m);
   vd_data* st = vd_data_create(m);
   REQUIRE(st);
@@ -423,9 +372,9 @@ TEST(render, colour_modes_and_legend) {
 }
 
 TEST(render, point_splats) {
-  vd_render_def d = small_def(200, 150);
+  vd_render_def d = vdt_small_def(200, 150);
   d.floor = 0;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
   // two clusters of points: label 3 instance 7 on the left, label 4 instance 9 on the right
   enum { N = 200 };
@@ -499,9 +448,9 @@ TEST(render, robot_from_mjcf) {
   REQUIRE(fp);
   fputs(robot_xml, fp);
   fclose(fp);
-  vd_render_def d = small_def(160, 120);
+  vd_render_def d = vdt_small_def(160, 120);
   d.robot_mjcf = path;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
   vd_camera c = cam_y(vd_v3(0, -3, 0.5), 40);
   vd_frame f;
@@ -582,10 +531,10 @@ TEST(render, out_of_memory) {
   // every allocation failing in turn: NOMEM (or success), never a crash, nothing leaked; first
   // while creating a renderer, then while adding a plant and drawing with one
   vd_vec3 v[4] = {{-0.2, 0, 0.35}, {0.2, 0, 0.35}, {0.2, 0, 0.65}, {-0.2, 0, 0.65}};
-  vd_model* m = quad_plant(v, 2, 5);
+  vd_model* m = vdt_quad_plant(v, 2, 5);
   REQUIRE(m);
-  vd_render_def d = small_def(32, 24);
-  vd_renderer* r = renderer(&d);
+  vd_render_def d = vdt_small_def(32, 24);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) {
     vd_model_destroy(m);
     return;
@@ -625,9 +574,9 @@ TEST(render, out_of_memory) {
 // solids, displacement from a reference state, a simulation state
 
 TEST(render, shapes) {
-  vd_render_def d = small_def(200, 150);
+  vd_render_def d = vdt_small_def(200, 150);
   d.floor = 0;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
   vd_error err = {0};
   // a sphere of 10 cm, 2 m in front of the camera: robot label, instance 0, its disc's area
@@ -693,10 +642,10 @@ TEST(render, shapes) {
 }
 
 TEST(render, displacement_from_reference) {
-  vd_render_def d = small_def(120, 90);
-  vd_renderer* r = renderer(&d);
+  vd_render_def d = vdt_small_def(120, 90);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
-  vd_model* m = tomato(1);
+  vd_model* m = vdt_tomato(1);
   REQUIRE(m);
   vd_data* st = vd_data_create(m);
   vd_data* ref = vd_data_create(m);
@@ -731,7 +680,7 @@ TEST(render, displacement_from_reference) {
   CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
   CHECK_NEAR(f.range_min, 0.03, 1e-9);
   // a reference of another model is refused
-  vd_model* q = quad_plant((vd_vec3[4]){{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}, 2, 1);
+  vd_model* q = vdt_quad_plant((vd_vec3[4]){{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}, 2, 1);
   vd_data* qd = q ? vd_data_create(q) : NULL;
   REQUIRE(qd);
   s.ref = qd;
@@ -747,9 +696,9 @@ TEST(render, displacement_from_reference) {
 TEST(render, masks_follow_the_simulated_state) {
   // a stem with a fruit pushed sideways by a growing force (statics): in every state drawn, the
   // pixel of the fruit's centre carries the fruit's label and instance, and the fruit moves
-  vd_render_def d = small_def(240, 180);
+  vd_render_def d = vdt_small_def(240, 180);
   d.floor = 0;
-  vd_renderer* r = renderer(&d);
+  vd_renderer* r = vdt_renderer(&d);
   if (!r) return;
   vd_plant_spec* sp = vd_plant_spec_create();
   REQUIRE(sp);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// verdant collide: collision geometry for the plant simulation (part of the sim module).
+// verdant collide: collision geometry shared by the plant simulation (sim) and the robot coupling.
 //
 // Geometry only, no response: the solver projects the contacts this module finds. Three parts:
 //

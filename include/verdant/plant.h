@@ -122,6 +122,8 @@ typedef struct vd_plant_spec {
 vd_plant_spec* vd_plant_spec_create(void);
 // Free a spec (NULL is fine).
 void vd_plant_spec_destroy(vd_plant_spec* s);
+// Deep copy of a spec (every element and the label table); NULL when out of memory.
+vd_plant_spec* vd_plant_spec_copy(const vd_plant_spec* s);
 // Remove every element, keeping the memory.
 void vd_plant_spec_clear(vd_plant_spec* s);
 // Segment with defaults: nodes -1, radii 0.1 m, up +X, parent -1, label 0, instance 0,
@@ -212,6 +214,11 @@ typedef struct vd_data {
   double* sphere_pos;  // centre (m) (nsphere x 3)
   double* vert_pos;    // mesh vertex position (m) (nvert x 3)
   int* seg_broken;     // 1 when the segment has fractured (nseg x 1)
+  double* seg_cut;     // where a broken segment broke (nseg x 7): the fraction f of its length
+                       // from node0 (0: at node0, 1: at node1; < 0: not known, the segment is
+                       // only severed from its parent), the end A of the part still attached
+                       // and the start B of the part that came off (m); drawn as node0 -> A
+                       // (when f > 0) and B -> node1 (when f < 1). Read where seg_broken is 1.
   int64_t nwarning;    // count of numerical warnings raised by steps
   vd_arena arena;      // scratch memory, reset by each step
   size_t nbytes;       // size of the single allocation

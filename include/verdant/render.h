@@ -122,8 +122,21 @@ void vd_render_destroy(vd_renderer* r);
 // Let go of the renderer's OpenGL context on this thread, so that another thread may use the
 // renderer next (a pool of renderers shared by worker threads, one thread at a time).
 void vd_render_release(vd_renderer* r);
+// The OpenGL implementation a renderer draws with: pictures from a GPU and from Mesa's software
+// rasteriser can differ in their last bits, so sidecars record it.
+typedef struct vd_render_gl {
+  char platform[32];  // EGL display used: "surfaceless" (Mesa), "device" (a GPU driver's EGL)
+                      // or "default display"
+  char vendor[128];   // GL_VENDOR: "Mesa", "NVIDIA Corporation", ...
+  char renderer[128]; // GL_RENDERER: "llvmpipe (LLVM 15.0.6, 256 bits)", a GPU's name, ...
+  char version[128];  // GL_VERSION
+  int software;       // 1: a software rasteriser (llvmpipe, softpipe, swrast), 0: hardware
+} vd_render_gl;
+
 // Text describing the OpenGL context ("EGL 1.5 surfaceless, Mesa llvmpipe ..."), for logs.
 const char* vd_render_info(const vd_renderer* r);
+// The OpenGL implementation of the renderer (valid while it lives).
+const vd_render_gl* vd_render_gl_info(const vd_renderer* r);
 // Set the robot's joint positions (MuJoCo qpos, nq values) for the next frames.
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err);
 
@@ -138,20 +151,37 @@ typedef enum vd_color_by {
   VD_COLOR_DISPLACEMENT, // a colour scale of the distance from the rest shape (m)
 } vd_color_by;
 
+// Colours of labels (colour by label, and the legend).
+typedef enum vd_palette {
+  VD_PALETTE_DISTINCT = 0, // every label its own colour, at least 29 CIE76 units apart in L*a*b*
+                           // for 15 labels, organ-like where it can (leaf green, fruit red, stem
+                           // brown, flower yellow; a second stem or leaf label gets another)
+  VD_PALETTE_NATURAL,      // the label table's colours (by organ kind: labels of one organ, such
+                           // as trunk and branch or peduncle and pedicel, look alike)
+} vd_palette;
+
+// Colours of a label table (sorted by id, as a model's) in a palette into rgb (nlabel x 3): the
+// distinct palette hands its colours out in id order, each label taking the first free colour its
+// organ prefers, then the first free one; beyond 15 labels, hues by the golden ratio.
+void vd_render_label_colors(const vd_label* labels, int nlabel, vd_palette palette,
+                            float (*rgb)[3]);
+
 // Look of one plant or cloud.
 typedef struct vd_render_style {
   vd_color_by color_by;     // default VD_COLOR_LABEL
+  vd_palette palette;       // label colours; default VD_PALETTE_DISTINCT
   const double* seg_stress; // Nullable: stress per segment (Pa) (nseg), needed by VD_COLOR_STRESS;
                             // NaN: no value (drawn grey), infinite: refused
   double range_min;         // colour scale minimum (Pa or m); with range_max <= range_min the
-  double range_max;         // scale spans the data; default 0, 0
+  double range_max;         // scale spans the attached plant's values (vd_render_value_range);
+                            // default 0, 0
   int slices;               // tessellation sides (>= 3), or 0 for each primitive's own; default 0
   const vd_data* ref;       // Nullable: state displacement is measured from (a run's first
                             // frame); NULL: the model's rest shape; default NULL
 } vd_render_style;
 
-// Defaults: colour by label, no stress, automatic range, slices 0, displacement from the rest
-// shape (ref NULL).
+// Defaults: colour by label in the distinct palette, no stress, automatic range, slices 0,
+// displacement from the rest shape (ref NULL).
 vd_render_style vd_render_style_default(void);
 
 // Remove every plant and cloud added since the last clear.
@@ -159,6 +189,15 @@ void vd_render_clear(vd_renderer* r);
 // Add plant model m in state d (Nullable: its rest shape) with style s (Nullable: defaults).
 vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* d,
                               const vd_render_style* s, vd_error* err);
+
+// The colour scale vd_render_add_plant gives plant m in state d (Nullable: at rest) under style
+// (Nullable: defaults) when the style fixes none: the smallest and largest stress (Pa) or
+// displacement (m) of the primitives still joined to the root (a segment that broke and what
+// lies beyond it, a fruit that left its attachment node are left out and drawn in the end
+// colour; all primitives when none is left); 0, 0 for other colourings or no values. A caller
+// drawing many states (the frames of a run) takes the union for one scale.
+vd_status vd_render_value_range(const vd_model* m, const vd_data* d, const vd_render_style* style,
+                                double* lo, double* hi, vd_error* err);
 
 // A point cloud to splat: arrays owned by the caller.
 typedef struct vd_points {
@@ -225,9 +264,11 @@ typedef struct vd_frame {
   vd_intrinsics K;          // camera intrinsics and pose
   vd_camera camera;         // the camera drawn from
   vd_color_by color_by;     // colouring of the first plant or cloud
+  vd_palette palette;       // its label colours
   int nlegend;              // labels present, by id, with names and label colours (the mask key)
   const vd_legend_entry* legend; // (nlegend)
   double range_min, range_max;   // colour scale of stress (Pa) or displacement (m)
+  const vd_render_gl* gl;        // Nullable: the OpenGL implementation that drew it
 } vd_frame;
 
 // Render the scene from camera c; layers is a mask of VD_LAYER_*.
@@ -240,8 +281,9 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* c, unsigned layers, vd
 // Write one layer as PNG: colour RGB 8-bit; depth 16-bit grey in millimetres (0 = nothing,
 // saturating at 65535); label or instance 16-bit grey ids.
 vd_status vd_render_write_png(const vd_frame* f, unsigned layer, const char* path, vd_error* err);
-// Write the sidecar JSON: format version, intrinsics, pose, depth scale, legend, files named in
-// files (Nullable; NULL-terminated pairs "role", "path").
+// Write the sidecar JSON: format version, intrinsics, pose, depth scale, legend, the OpenGL
+// implementation that drew it, files named in files (Nullable; NULL-terminated pairs "role",
+// "path").
 vd_status vd_render_write_json(const vd_frame* f, const char* const* files, const char* path,
                                vd_error* err);
 // Read a PNG (grey or RGB, 8 or 16 bits; alpha dropped) into *pix (w x h x channels values, row 0

@@ -362,12 +362,17 @@ double vd_sim_kinetic_energy(const vd_sim_model* m, const vd_sim_data* d);
 double vd_sim_max_displacement(const vd_sim_model* m, const vd_sim_data* d, int* node);
 
 // Write the deformed plant into a plant state (node, segment frames, spheres, mesh vertices,
-// broken segments); plant must be the model m was built from.
+// broken segments: a segment spanning a broken joint is marked in seg_broken with where it broke
+// in seg_cut, so it is drawn as two parts); plant must be the model m was built from.
 void vd_sim_to_plant(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant,
                      vd_data* out);
 // Same into an editable spec (positions, sphere centres, mesh vertices, segment up vectors);
-// spec must be the one plant was compiled from.
-void vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec);
+// spec must be the one plant was compiled from. Parts that broke off become separate pieces: a
+// segment spanning a broken joint is split there (new nodes at both faces of the break, the
+// stump marked VD_SEG_TIP), and parents and attachment nodes across a break are removed (-1);
+// labels and instances are kept. VD_ERR_NOMEM when the new elements do not fit (the spec then
+// holds the positions, pieces partly cut).
+vd_status vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec);
 
 // ---------------------------------------------------------------------------------------------
 // stress from a state (geometry only: works on any state, frames read back included)

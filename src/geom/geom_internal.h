@@ -12,7 +12,15 @@ static inline int geom_seg_slices(const vd_model* m, int slices, int i) {
 }
 
 // Fill cont[i] (the segment continuing i through a shared ring, or -1) and joined[i] (1 when i's
-// start ring is its parent's end ring) for every segment; broken (Nullable) severs segments.
-void geom_joints(const vd_model* m, const int* broken, int slices, int* cont, int* joined);
+// start ring is its parent's end ring) for every segment; the broken segments of d (Nullable)
+// are severed from their parents, and a segment cut at a known point (geom_seg_cut) from its
+// children too.
+void geom_joints(const vd_model* m, const vd_data* d, int slices, int* cont, int* joined);
+
+// The parts of segment i drawn in state d (Nullable): GEOM_WHOLE for a segment that is not cut
+// at a known point; else GEOM_PART_OFF (B -> node1, when f < 1) and GEOM_PART_STUB (node0 -> A,
+// when f > 0) of a broken segment, *f the fraction where it broke (vd_data::seg_cut).
+enum { GEOM_WHOLE = 0, GEOM_PART_OFF = 1, GEOM_PART_STUB = 2 };
+int geom_seg_cut(const vd_data* d, int i, double* f);
 
 #endif

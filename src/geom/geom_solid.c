@@ -46,6 +46,26 @@ static void solid_init(vd_solid* s, int kind, int prim, int label, int instance)
     s->lo[k] = INFINITY, s->hi[k] = -INFINITY;
 }
 
+// solid k: the frustum of segment i from c0 to c1 (radii r0, r1) in the segment's frame
+static void seg_solid(vd_solids* out, int k, const vd_model* m, int slices, int i, const double* seg_quat, vd_vec3 c0,
+                      vd_vec3 c1, double r0, double r1) {
+  vd_solid* s = &out->solid[k];
+  solid_init(s, VD_PRIM_SEGMENT, i, m->seg_label[i], m->seg_instance[i]);
+  vd_quat q = {seg_quat[4 * i], seg_quat[4 * i + 1], seg_quat[4 * i + 2], seg_quat[4 * i + 3]};
+  vd_vec3 axis = vd_quat_rotate(q, vd_v3(0, 0, 1));
+  s->c = c0;
+  s->q = q;
+  vd_vec3 ax[3] = {vd_quat_rotate(q, vd_v3(1, 0, 0)), vd_quat_rotate(q, vd_v3(0, 1, 0)), axis};
+  for (int r = 0; r < 3; r++)
+    s->rot[3 * r] = ax[r].x, s->rot[3 * r + 1] = ax[r].y, s->rot[3 * r + 2] = ax[r].z;
+  s->len = vd_dot(vd_sub(c1, c0), axis);
+  s->r0 = r0, s->r1 = r1;
+  s->slices = geom_seg_slices(m, slices, i);
+  s->cos_half = cos(VD_PI / s->slices);
+  box_disc(s, c0, axis, s->r0, out->eps);
+  box_disc(s, c1, axis, s->r1, out->eps);
+}
+
 vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def* def,
                           vd_solids* out, vd_error* err) {
   if (!out) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "solids: null output");
@@ -68,7 +88,13 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
   int nclosed = 0, ntri = 0;
   for (int i = 0; i < m->nmesh; i++)
     if (m->mesh_closed[i]) nclosed++, ntri += m->mesh_tri[2 * i + 1];
-  int ns = m->nseg + m->nsphere + nclosed;
+  // a segment broken at a known point into two parts has a second solid (its stump)
+  int nstump = 0;
+  for (int i = 0; i < m->nseg; i++) {
+    double f;
+    nstump += geom_seg_cut(d, i, &f) == (GEOM_PART_OFF | GEOM_PART_STUB);
+  }
+  int ns = m->nseg + nstump + m->nsphere + nclosed;
   size_t nbytes = (size_t)ns * sizeof(vd_solid) + (size_t)ntri * 9 * sizeof(double) +
                   ((size_t)m->nseg * 3 + (size_t)m->nsphere + (size_t)m->nmesh) * sizeof(int);
   char* block = nbytes ? vd_malloc(nbytes) : NULL;
@@ -106,27 +132,33 @@ vd_status vd_solids_build(const vd_model* m, const vd_data* d, const vd_mesh_def
   out->eps = eps;
 
   // frustums, in the frame and with the sides the tessellation uses
-  int k = 0;
-  if (m->nseg) geom_joints(m, d ? d->seg_broken : NULL, md.slices, cont, joined);
+  int k = 0, kstump = m->nseg;
+  if (m->nseg) geom_joints(m, d, md.slices, cont, joined);
   for (int i = 0; i < m->nseg; i++, k++) {
-    vd_solid* s = &out->solid[k];
-    solid_init(s, VD_PRIM_SEGMENT, i, m->seg_label[i], m->seg_instance[i]);
     out->seg_solid[i] = k;  // NOLINT(clang-analyzer-core.NullDereference): arrays carved from one block sized by these counts
     vd_vec3 c0 = get3(node_pos, m->seg_node[2 * i]), c1 = get3(node_pos, m->seg_node[2 * i + 1]);
-    vd_quat q = {seg_quat[4 * i], seg_quat[4 * i + 1], seg_quat[4 * i + 2], seg_quat[4 * i + 3]};
-    vd_vec3 axis = vd_quat_rotate(q, vd_v3(0, 0, 1));
-    s->c = c0;
-    s->q = q;
-    vd_vec3 ax[3] = {vd_quat_rotate(q, vd_v3(1, 0, 0)), vd_quat_rotate(q, vd_v3(0, 1, 0)), axis};
-    for (int r = 0; r < 3; r++)
-      s->rot[3 * r] = ax[r].x, s->rot[3 * r + 1] = ax[r].y, s->rot[3 * r + 2] = ax[r].z;
-    s->len = vd_dot(vd_sub(c1, c0), axis);
-    s->r0 = m->seg_radius[2 * i], s->r1 = m->seg_radius[2 * i + 1];
-    s->slices = geom_seg_slices(m, md.slices, i);
-    s->cos_half = cos(VD_PI / s->slices);
-    box_disc(s, c0, axis, s->r0, eps);
-    box_disc(s, c1, axis, s->r1, eps);
+    double r0 = m->seg_radius[2 * i], r1 = m->seg_radius[2 * i + 1], f;
+    int parts = geom_seg_cut(d, i, &f);
+    if (parts == GEOM_WHOLE) {
+      seg_solid(out, k, m, md.slices, i, seg_quat, c0, c1, r0, r1);
+      continue;
+    }
+    // broken at a known point: the part that came off, and the stump (a second solid when both
+    // exist, each the other's neighbour so that neither removes the other's points)
+    const double* cut = d->seg_cut + 7 * i;  // NOLINT(clang-analyzer-core.NullDereference): d exists when a segment is cut
+    double rf = r0 + f * (r1 - r0);
+    vd_vec3 a = vd_v3(cut[1], cut[2], cut[3]), b = vd_v3(cut[4], cut[5], cut[6]);
+    if (parts & GEOM_PART_OFF)
+      seg_solid(out, k, m, md.slices, i, seg_quat, b, c1, rf, r1);
+    else
+      seg_solid(out, k, m, md.slices, i, seg_quat, c0, a, r0, rf);
+    if (parts == (GEOM_PART_OFF | GEOM_PART_STUB)) {
+      seg_solid(out, kstump, m, md.slices, i, seg_quat, c0, a, r0, rf);
+      out->solid[k].joined[0] = kstump, out->solid[kstump].joined[0] = k;
+      kstump++;
+    }
   }
+  k = kstump;
   // tube neighbours: a segment and the one continuing it through a shared ring
   for (int i = 0; i < m->nseg; i++)
     if (cont[i] >= 0) {

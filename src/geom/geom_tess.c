@@ -25,7 +25,7 @@ typedef struct plan {
   const double* seg_quat;   // (nseg x 4)
   const double* sphere_pos; // (nsphere x 3)
   const double* vert_pos;   // (nvert x 3)
-  const int* broken;        // (nseg) or NULL
+  const vd_data* d;         // the state, or NULL for the rest shape
   vd_mesh_def def;
   int* cont;   // segment continuing this one through a shared ring, or -1 (nseg)
   int* joined; // 1 when the start ring is the parent's end ring (nseg)
@@ -47,21 +47,31 @@ static int sphere_stacks(const plan* p, int i) {
 // a child continues its parent when both are generalised-cylinder segments meeting at a node with
 // the same section, the child is not broken off (seg_broken severs a segment from its parent),
 // and no earlier child continues the parent already
-void geom_joints(const vd_model* m, const int* broken, int slices, int* cont, int* joined) {
+int geom_seg_cut(const vd_data* d, int i, double* f) {
+  *f = 0;
+  if (!d || !d->seg_broken[i] || !(d->seg_cut[7 * i] >= 0)) return GEOM_WHOLE;
+  double x = d->seg_cut[7 * i] > 1 ? 1 : d->seg_cut[7 * i];
+  *f = x;
+  // a break within 1e-9 of an end leaves no part on that side
+  return (x < 1 - 1e-9 ? GEOM_PART_OFF : 0) | (x > 1e-9 ? GEOM_PART_STUB : 0);
+}
+
+void geom_joints(const vd_model* m, const vd_data* d, int slices, int* cont, int* joined) {
   for (int i = 0; i < m->nseg; i++)
     cont[i] = -1, joined[i] = 0;
   for (int i = 0; i < m->nseg; i++) {
     int q = m->seg_parent[i];
+    double f;
     if (q < 0 || !(m->seg_flags[i] & VD_SEG_GC) || !(m->seg_flags[q] & VD_SEG_GC)) continue;
     if (m->seg_node[2 * i] != m->seg_node[2 * q + 1]) continue;
     if (geom_seg_slices(m, slices, i) != geom_seg_slices(m, slices, q) || cont[q] >= 0) continue;
-    if (broken && broken[i]) continue;
+    if (d && (d->seg_broken[i] || geom_seg_cut(d, q, &f) != GEOM_WHOLE)) continue;
     cont[q] = i;
     joined[i] = 1;
   }
 }
 
-static void plan_joints(plan* p) { geom_joints(p->m, p->broken, p->def.slices, p->cont, p->joined); }
+static void plan_joints(plan* p) { geom_joints(p->m, p->d, p->def.slices, p->cont, p->joined); }
 
 // vertex and triangle counts of every primitive, in output order
 static void plan_counts(plan* p) {
@@ -71,6 +81,15 @@ static void plan_counts(plan* p) {
   for (int i = 0; i < m->nseg; i++) {
     int64_t s = seg_slices(p, i);
     p->vbase[i] = nv > INT_MAX ? INT_MAX : (int)nv;
+    double f;
+    int parts = geom_seg_cut(p->d, i, &f);
+    if (parts != GEOM_WHOLE) {
+      // a broken segment: each part a closed frustum of its own
+      int np = (parts & GEOM_PART_OFF ? 1 : 0) + (parts & GEOM_PART_STUB ? 1 : 0);
+      nv += np * (2 * s + caps * 2 * (s + 1));
+      nt += np * (2 * s + caps * 2 * s);
+      continue;
+    }
     int start_cap = caps && !p->joined[i], end_cap = caps && p->cont[i] < 0;
     nv += (p->joined[i] ? 0 : s) + s + (start_cap + end_cap) * (s + 1);
     nt += 2 * s + (start_cap + end_cap) * s;
@@ -107,7 +126,7 @@ static vd_status plan_make(plan* p, const vd_model* m, const vd_data* d, const v
   p->seg_quat = d ? d->seg_quat : m->seg_quat0;
   p->sphere_pos = d ? d->sphere_pos : m->sphere_pos0;
   p->vert_pos = d ? d->vert_pos : m->vert_pos0;
-  p->broken = d ? d->seg_broken : NULL;
+  p->d = d;
   if (m->nseg > 0) {
     p->cont = vd_malloc((size_t)m->nseg * 3 * sizeof(int));
     if (!p->cont) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory tessellating");
@@ -225,6 +244,36 @@ static void put_cap(out* o, int vc, int ring0, int n, vd_vec3 c, vd_vec3 normal,
   }
 }
 
+// a closed frustum of segment i on its own (a part of a broken segment): two rings from vertex v,
+// then the caps; returns the next free vertex
+static int tess_part(const plan* p, out* o, int i, int v, vd_vec3 c0, vd_vec3 c1, double r0, double r1) {
+  const vd_model* m = p->m;
+  vd_mesh* mesh = o->mesh;
+  int n = seg_slices(p, i), label = m->seg_label[i], inst = m->seg_instance[i];
+  vd_quat q = getq(p->seg_quat, i);
+  vd_vec3 axis = vd_quat_rotate(q, vd_v3(0, 0, 1));
+  double len = vd_norm(vd_sub(c1, c0));
+  int start = v, end = v + n;
+  put_ring(mesh, start, c0, r0, q, n);
+  put_ring(mesh, end, c1, r1, q, n);
+  for (int k = 0; k < n; k++) {
+    add_normal(mesh, start + k, side_normal(ring_dir(q, k, n), axis, len, r0, r1));
+    add_normal(mesh, end + k, side_normal(ring_dir(q, k, n), axis, len, r0, r1));
+  }
+  for (int k = 0; k < n; k++) {
+    int a0 = start + k, b0 = start + (k + 1) % n, a1 = end + k, b1 = end + (k + 1) % n;
+    put_tri(o, a0, b0, b1, label, inst, i, VD_PRIM_SEGMENT);
+    put_tri(o, a0, b1, a1, label, inst, i, VD_PRIM_SEGMENT);
+  }
+  v += 2 * n;
+  if (p->def.caps) {
+    put_cap(o, v, start, n, c0, vd_scale(axis, -1), 0, label, inst, i);
+    put_cap(o, v + n + 1, end, n, c1, axis, 1, label, inst, i);
+    v += 2 * (n + 1);
+  }
+  return v;
+}
+
 static void tess_segment(const plan* p, out* o, int i) {
   const vd_model* m = p->m;
   vd_mesh* mesh = o->mesh;
@@ -233,6 +282,17 @@ static void tess_segment(const plan* p, out* o, int i) {
   int n0 = m->seg_node[2 * i], n1 = m->seg_node[2 * i + 1];
   vd_vec3 c0 = get3(p->node_pos, n0), c1 = get3(p->node_pos, n1);
   double r0 = m->seg_radius[2 * i], r1 = m->seg_radius[2 * i + 1];
+  double f;
+  int parts = geom_seg_cut(p->d, i, &f);
+  if (parts != GEOM_WHOLE) {
+    // broken at a known point: the part that came off (B -> node1), then the stump (node0 -> A)
+    const double* cut = p->d->seg_cut + 7 * i;
+    double rf = r0 + f * (r1 - r0);
+    int v = p->vbase[i];  // NOLINT(clang-analyzer-core.NullDereference): arrays sized by the counts vd_geom_count gave
+    if (parts & GEOM_PART_OFF) v = tess_part(p, o, i, v, vd_v3(cut[4], cut[5], cut[6]), c1, rf, r1);
+    if (parts & GEOM_PART_STUB) tess_part(p, o, i, v, c0, vd_v3(cut[1], cut[2], cut[3]), r0, rf);
+    return;
+  }
   vd_quat q = getq(p->seg_quat, i);
   vd_vec3 axis = vd_quat_rotate(q, vd_v3(0, 0, 1));
   double len = vd_norm(vd_sub(c1, c0));

@@ -374,6 +374,7 @@ vd_data* vd_data_create(const vd_model* m) {
   size_t o_sphere_pos = take(&top, (size_t)m->nsphere * 3 * D);
   size_t o_vert_pos = take(&top, (size_t)m->nvert * 3 * D);
   size_t o_seg_broken = take(&top, (size_t)m->nseg * sizeof(int));
+  size_t o_seg_cut = take(&top, (size_t)m->nseg * 7 * D);
   char* block = vd_malloc(top);
   if (!block) return NULL;
   memset(block, 0, top);
@@ -384,6 +385,7 @@ vd_data* vd_data_create(const vd_model* m) {
   d->sphere_pos = (double*)(block + o_sphere_pos);
   d->vert_pos = (double*)(block + o_vert_pos);
   d->seg_broken = (int*)(block + o_seg_broken);
+  d->seg_cut = (double*)(block + o_seg_cut);
   d->nbytes = top;
   vd_arena_init(&d->arena, 0);
   vd_data_reset(m, d);
@@ -401,6 +403,11 @@ void vd_data_reset(const vd_model* m, vd_data* d) {
   memcpy(d->sphere_pos, m->sphere_pos0, (size_t)m->nsphere * 3 * D);
   memcpy(d->vert_pos, m->vert_pos0, (size_t)m->nvert * 3 * D);
   memset(d->seg_broken, 0, (size_t)m->nseg * sizeof(int));
+  for (int i = 0; i < m->nseg; i++) {
+    double* c = d->seg_cut + 7 * i;
+    c[0] = -1;  // no known break point
+    for (int k = 0; k < 3; k++) c[1 + k] = c[4 + k] = m->node_pos0[3 * m->seg_node[2 * i] + k];
+  }
   d->nwarning = 0;
   vd_arena_reset(&d->arena);
 }

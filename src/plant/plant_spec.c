@@ -29,6 +29,39 @@ void vd_plant_spec_destroy(vd_plant_spec* s) {
   vd_free(s, sizeof *s);
 }
 
+// copy n elements of size elem into a new block of exactly n (capacity n); 1 on success
+static int copy_array(void** dst, int* cap, const void* src, int n, size_t elem) {
+  *dst = NULL;
+  *cap = 0;
+  if (n <= 0) return 1;
+  *dst = vd_malloc((size_t)n * elem);
+  if (!*dst) return 0;
+  memcpy(*dst, src, (size_t)n * elem);
+  *cap = n;
+  return 1;
+}
+
+vd_plant_spec* vd_plant_spec_copy(const vd_plant_spec* s) {
+  if (!s) return NULL;
+  vd_plant_spec* c = vd_plant_spec_create();
+  if (!c) return NULL;
+  // each array at its exact size; capacities say so, so destroy frees the right sizes
+  int ok = copy_array((void**)&c->node, &c->cap_node, s->node, s->nnode, sizeof *s->node) &&
+           copy_array((void**)&c->seg, &c->cap_seg, s->seg, s->nseg, sizeof *s->seg) &&
+           copy_array((void**)&c->sphere, &c->cap_sphere, s->sphere, s->nsphere, sizeof *s->sphere) &&
+           copy_array((void**)&c->mesh, &c->cap_mesh, s->mesh, s->nmesh, sizeof *s->mesh) &&
+           copy_array((void**)&c->vert, &c->cap_vert, s->vert, s->nvert, sizeof *s->vert) &&
+           copy_array((void**)&c->tri, &c->cap_tri, s->tri, s->ntri, 3 * sizeof *s->tri) &&
+           copy_array((void**)&c->label, &c->cap_label, s->label, s->nlabel, sizeof *s->label);
+  if (!ok) {
+    vd_plant_spec_destroy(c);
+    return NULL;
+  }
+  c->nnode = s->nnode, c->nseg = s->nseg, c->nsphere = s->nsphere, c->nmesh = s->nmesh;
+  c->nvert = s->nvert, c->ntri = s->ntri, c->nlabel = s->nlabel, c->ninstance = s->ninstance;
+  return c;
+}
+
 void vd_plant_spec_clear(vd_plant_spec* s) {
   if (!s) return;
   s->nnode = s->nseg = s->nsphere = s->nmesh = s->nvert = s->ntri = s->nlabel = 0;

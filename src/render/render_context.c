@@ -155,13 +155,10 @@ static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
 
 // MuJoCo part of create, under the error guard
 static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
-  jmp_buf jb;
-  jmp_buf* prev = mjguard_push(&jb);
-  if (setjmp(jb)) {
-    mjguard_pop(prev);
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap))
     return vd_error_set(err, VD_ERR_FORMAT, r->def.robot_mjcf ? r->robot_path : "", 0, 0,
-                        "MuJoCo: %s", mjguard_message());
-  }
+                        "MuJoCo: %s", trap.error);
   vd_status st = VD_OK;
   r->m = load_model(r, &st, err);
   if (r->m) {
@@ -188,8 +185,10 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
     if (r->con.currentBuffer != mjFB_OFFSCREEN)
       st = vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0,
                         "no OpenGL context: MuJoCo has no offscreen buffer");
+    else
+      render_measure_font(r);
   }
-  mjguard_pop(prev);
+  vd_mj_trap_end(&trap);
   return st;
 }
 
@@ -207,7 +206,7 @@ vd_status vd_render_create(const vd_render_def* def, vd_renderer** out, vd_error
     snprintf(r->robot_path, sizeof r->robot_path, "%s", d.robot_mjcf);
     r->def.robot_mjcf = r->robot_path;
   }
-  mjguard_install();
+  vd_mj_trap_install();
   // the context first: without one nothing else can be made
   st = gl_create(&r->gl, err);
   r->have_gl = r->gl.api != NULL;
@@ -271,6 +270,10 @@ const char* vd_render_info(const vd_renderer* r) {
   return r->gl.info;
 }
 
+const vd_render_gl* vd_render_gl_info(const vd_renderer* r) {
+  return &r->gl.id;
+}
+
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err) {
   if (!r->def.robot_mjcf)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the renderer has no robot");
@@ -280,14 +283,11 @@ vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, v
   for (int i = 0; i < nq; i++)
     if (!isfinite(qpos[i]))
       return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "robot qpos[%d] is not finite", i);
-  jmp_buf jb;
-  jmp_buf* prev = mjguard_push(&jb);
-  if (setjmp(jb)) {
-    mjguard_pop(prev);
-    return vd_error_set(err, VD_ERR_VALUE, r->robot_path, 0, 0, "MuJoCo: %s", mjguard_message());
-  }
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap))
+    return vd_error_set(err, VD_ERR_VALUE, r->robot_path, 0, 0, "MuJoCo: %s", trap.error);
   memcpy(r->d->qpos, qpos, sizeof(double) * (size_t)nq);
   mj_forward(r->m, r->d);
-  mjguard_pop(prev);
+  vd_mj_trap_end(&trap);
   return VD_OK;
 }

@@ -138,6 +138,56 @@ static void text_at(const mjrContext* con, const char* s, int x, int y, int lh) 
   mjr_label(rect, mjFONT_NORMAL, s, 1, 1, 1, 0, 0.1f, 0.1f, 0.1f, con);
 }
 
+void render_measure_font(vd_renderer* r) {
+  // draw '0' black on white in a cell at the corner of the offscreen buffer and read it back
+  const mjrContext* con = &r->con;
+  int w = con->charWidth['0'], h = con->charHeight;
+  r->digit_base = 0, r->dot_size = 2;
+  if (w <= 0 || h <= 0) return;
+  uint8_t* px = vd_malloc((size_t)w * (size_t)h * 3);
+  if (!px) return;
+  mjrRect cell = {0, 0, w, h};
+  mjr_label(cell, mjFONT_NORMAL, "0", 1, 1, 1, 1, 0, 0, 0, con);
+  mjr_readPixels(px, NULL, cell, con);
+  // rows come bottom first: the first with ink is the baseline; the stroke is the run of ink
+  // at mid-height from the left edge of the glyph
+  int base = -1, stroke = 0;
+  for (int y = 0; y < h && base < 0; y++)
+    for (int x = 0; x < w; x++)
+      if (px[3 * ((size_t)y * w + x)] < 128) base = y;
+  if (base >= 0) {
+    int y = base + (h - base) / 4, x = 0;
+    while (x < w && px[3 * ((size_t)y * w + x)] >= 128) x++;
+    while (x < w && px[3 * ((size_t)y * w + x)] < 128) x++, stroke++;
+  }
+  vd_free(px, (size_t)w * (size_t)h * 3);
+  r->digit_base = base > 0 ? base : 0;
+  r->dot_size = stroke > 0 ? (3 * stroke + 1) / 2 : 2;
+}
+
+// a number at pixel x, on a row of height lh from y. MuJoCo's bitmap fonts at 150-250 % put
+// the full stop a row below the digits' baseline and make it taller than wide, which reads as
+// a decimal comma once the image is averaged down; we draw it as a square on the baseline.
+static void number_at(const vd_renderer* r, const char* s, int x, int y, int lh) {
+  const mjrContext* con = &r->con;
+  const char* dot = strchr(s, '.');
+  if (!dot) {
+    text_at(con, s, x, y, lh);
+    return;
+  }
+  char head[48];
+  size_t n = (size_t)(dot - s) < sizeof head - 1 ? (size_t)(dot - s) : sizeof head - 1;
+  memcpy(head, s, n);
+  head[n] = 0;
+  text_at(con, head, x, y, lh);
+  int xd = x + text_width(con, head), adv = con->charWidth['.'];
+  // the glyph cell sits (lh - charHeight) / 2 above y (mjr_label centres it)
+  int yb = y + (lh - con->charHeight) / 2 + r->digit_base;
+  mjrRect sq = {xd + (adv - r->dot_size + 1) / 2, yb, r->dot_size, r->dot_size};
+  mjr_rectangle(sq, 0.1f, 0.1f, 0.1f, 1);
+  text_at(con, dot + 1, xd + adv, y, lh);
+}
+
 // a legend panel in the top right corner of the w x h viewport (pixel scale k)
 static void draw_legend(vd_renderer* r, int w, int h, int k) {
   const mjrContext* con = &r->con;
@@ -195,13 +245,22 @@ static void draw_legend(vd_renderer* r, int w, int h, int k) {
       mjrRect seg = {x0 + pad + i * bw / 64, yb, (i + 1) * bw / 64 - i * bw / 64, bh};
       mjr_rectangle(seg, c[0], c[1], c[2], 1);
     }
-    text_at(con, lo_txt, x0 + pad, y0 + pad, lh);
-    text_at(con, hi_txt, x0 + pw - pad - text_width(con, hi_txt), y0 + pad, lh);
+    number_at(r, lo_txt, x0 + pad, y0 + pad, lh);
+    number_at(r, hi_txt, x0 + pw - pad - text_width(con, hi_txt), y0 + pad, lh);
   }
 }
 
 // ---------------------------------------------------------------------------------------------
 // drawing
+
+// shadow map: the half-width of the key light's view, a multiple of the bounding sphere's radius;
+// the depth offset, in depth slopes per texel and in steps of the depth buffer. A texel's depth
+// varies by tan(angle of incidence) texels across it and a fragment sits up to sqrt(2)/2 of a
+// texel from the texel centre, so a slope factor of 2 keeps a lit face clear of its own shadow
+// up to the incidence where the light grazes it (docs/render.md)
+#define SHADOW_CLIP 1.02
+#define SHADOW_SLOPE_BIAS 2.0f
+#define SHADOW_UNIT_BIAS 4.0f
 
 // set every light: a light at the camera (with the ambient term) and the key light
 static void set_lights(vd_renderer* r, const vd_camera* c, vd_vec3 ctr, double reach) {
@@ -356,18 +415,17 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   if (!vd_render_bounds(r, &lo, &hi)) lo = hi = cam->lookat;
   vd_vec3 ctr = vd_scale(vd_add(lo, hi), 0.5);
   double reach = fmax(0.5 * vd_norm(vd_sub(hi, lo)), 0.05);
-  jmp_buf jb;
-  jmp_buf* prev = mjguard_push(&jb);
-  if (setjmp(jb)) {
-    mjguard_pop(prev);
-    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "MuJoCo: %s", mjguard_message());
-  }
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap))
+    return vd_error_set(err, VD_ERR_UNSUPPORTED, "", 0, 0, "MuJoCo: %s", trap.error);
   st = fill_scene(r, err);
   if (!st) {
     mjvScene* scn = &r->scn;
     set_lights(r, cam, ctr, reach);
     set_camera(r, cam);
-    r->con.shadowClip = (float)(1.5 * reach);
+    // the key light's shadow map covers the bounding sphere of what is drawn (the light looks at
+    // its centre), no more: every texel spent where shadows can fall
+    r->con.shadowClip = (float)(SHADOW_CLIP * reach);
     scn->flags[mjRND_CULL_FACE] = 1;
     scn->flags[mjRND_REFLECTION] = 0;
     mjr_setBuffer(mjFB_OFFSCREEN, &r->con);
@@ -378,7 +436,14 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
       scn->flags[mjRND_SKYBOX] = 1;
       set_lists(r, 1);
       mjrRect vp = {0, 0, w * k, h * k};
+      // depth bias of the shadow map (shadow acne, docs/render.md): MuJoCo 2.2.2 keeps the
+      // back faces (as seen from the light) and compares without a bias, so a lit face
+      // shadows itself wherever a texel's depth slope exceeds the thickness behind it; the
+      // offset applies to every pass of this draw alike, so the lit and the shadow passes
+      // still meet depth for depth
+      gl_polygon_offset(&r->gl, SHADOW_SLOPE_BIAS, SHADOW_UNIT_BIAS);
       mjr_render(vp, scn, &r->con);
+      gl_polygon_offset(&r->gl, 0, 0);
       if (r->def.legend && r->nadded) draw_legend(r, w * k, h * k, k);
       mjr_readPixels(r->big, NULL, vp, &r->con);
       downsample(r->big, r->rgb, w, h, k);
@@ -396,7 +461,7 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
     }
     mjr_finish();
   }
-  mjguard_pop(prev);
+  vd_mj_trap_end(&trap);
   if (st) return st;
   out->width = w;
   out->height = h;
@@ -408,9 +473,11 @@ vd_status vd_render_draw(vd_renderer* r, const vd_camera* cam, unsigned layers, 
   out->K = vd_camera_intrinsics(cam, w, h);
   out->camera = *cam;
   out->color_by = r->color_by;
+  out->palette = r->palette;
   out->nlegend = r->nlegend;
   out->legend = r->legend;
   out->range_min = r->range_min;
   out->range_max = r->range_max;
+  out->gl = &r->gl.id;
   return VD_OK;
 }

@@ -43,6 +43,10 @@ struct gl_api {
   void (*Color3fv)(const GLfloat*);
   const GLubyte* (*GetString)(GLenum);
   GLenum (*GetErrorGL)(void);
+  // the shadow map's depth bias
+  void (*Enable)(GLenum);
+  void (*Disable)(GLenum);
+  void (*PolygonOffset)(GLfloat, GLfloat);
 };
 
 // a symbol of libEGL
@@ -112,6 +116,7 @@ static int try_display(gl_ctx* g, EGLDisplay dpy, const char* platform, char* tr
   }
   g->dpy = dpy;
   snprintf(g->info, sizeof g->info, "EGL %d.%d (%s)", maj, min, platform);
+  snprintf(g->id.platform, sizeof g->id.platform, "%s", platform);
   return 1;
 }
 
@@ -206,12 +211,21 @@ vd_status gl_create(gl_ctx* g, vd_error* err) {
   GLFN(Color3fv, "glColor3fv");
   GLFN(GetString, "glGetString");
   GLFN(GetErrorGL, "glGetError");
+  GLFN(Enable, "glEnable");
+  GLFN(Disable, "glDisable");
+  GLFN(PolygonOffset, "glPolygonOffset");
 #undef GLFN
   const char* ver = (const char*)a->GetString(GL_VERSION);
   const char* ren = (const char*)a->GetString(GL_RENDERER);
+  const char* ven = (const char*)a->GetString(GL_VENDOR);
+  snprintf(g->id.version, sizeof g->id.version, "%s", ver ? ver : "?");
+  snprintf(g->id.renderer, sizeof g->id.renderer, "%s", ren ? ren : "?");
+  snprintf(g->id.vendor, sizeof g->id.vendor, "%s", ven ? ven : "?");
+  // Mesa's software rasterisers name themselves in GL_RENDERER
+  g->id.software = strstr(g->id.renderer, "llvmpipe") || strstr(g->id.renderer, "softpipe") ||
+                   strstr(g->id.renderer, "swrast") || strstr(g->id.renderer, "Software");
   size_t len = strlen(g->info);
-  snprintf(g->info + len, sizeof g->info - len, ", OpenGL %s, %s", ver ? ver : "?",
-           ren ? ren : "?");
+  snprintf(g->info + len, sizeof g->info - len, ", OpenGL %s, %s", g->id.version, g->id.renderer);
   return VD_OK;
 }
 
@@ -265,4 +279,14 @@ unsigned gl_list(gl_ctx* g, const gl_tris* t) {
 
 void gl_list_free(gl_ctx* g, unsigned list) {
   if (list && g->api) g->api->DeleteLists(list, 1);
+}
+
+void gl_polygon_offset(gl_ctx* g, float factor, float units) {
+  gl_api* a = g->api;
+  if (factor == 0 && units == 0) {
+    a->Disable(GL_POLYGON_OFFSET_FILL);
+    return;
+  }
+  a->PolygonOffset(factor, units);
+  a->Enable(GL_POLYGON_OFFSET_FILL);
 }

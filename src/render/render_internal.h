@@ -6,6 +6,7 @@
 #include <mujoco/mujoco.h>
 #include <setjmp.h>
 
+#include "mjtrap/mjtrap.h"
 #include "verdant/geom.h"
 #include "verdant/render.h"
 
@@ -20,6 +21,7 @@ typedef struct gl_ctx {
   void* ctx;      // EGLContext
   void* surf;     // EGLSurface (1x1 pbuffer) or NULL when surfaceless
   char info[256]; // "EGL 1.5 (surfaceless), GL 4.5 ..., llvmpipe ..."
+  vd_render_gl id; // which OpenGL implementation this is (platform, vendor, renderer)
 } gl_ctx;
 
 // Create a compatibility-profile context with depth and stencil and make it current.
@@ -41,20 +43,11 @@ typedef struct gl_tris {
 
 // Compile a display list of triangles; returns its name, 0 on failure.
 unsigned gl_list(gl_ctx* g, const gl_tris* t);
+// Offset the depth of filled polygons by factor x their depth slope + units x the depth
+// resolution (glPolygonOffset); 0, 0 turns the offset off.
+void gl_polygon_offset(gl_ctx* g, float factor, float units);
 // Delete a display list (0 is fine).
 void gl_list_free(gl_ctx* g, unsigned list);
-
-// ---------------------------------------------------------------------------------------------
-// MuJoCo guard (render_mujoco.c): MuJoCo errors longjmp back to the innermost guard of the thread
-
-// Install the MuJoCo error and warning hooks (once per process).
-void mjguard_install(void);
-// Push a jump target for MuJoCo errors on this thread; returns the previous one.
-jmp_buf* mjguard_push(jmp_buf* jb);
-// Restore the previous jump target.
-void mjguard_pop(jmp_buf* prev);
-// The message of the last MuJoCo error on this thread.
-const char* mjguard_message(void);
 
 // ---------------------------------------------------------------------------------------------
 // the renderer
@@ -95,6 +88,8 @@ struct vd_renderer {
   mjvCamera mjcam;
   mjVFS* vfs;      // stage file system (owned)
   int nmodel_geom; // geoms mjv_updateScene adds for the model
+  int digit_base;  // font: lowest ink row of '0' above the bottom of its cell (pixels)
+  int dot_size;    // font: side of the decimal point we draw (pixels)
   // what is drawn
   item* items; // scene items (nitem)
   int nitem, cap_item;
@@ -105,6 +100,7 @@ struct vd_renderer {
   vd_legend_entry* legend; // labels in use, sorted by id (nlegend)
   int nlegend, cap_legend;
   vd_color_by color_by;        // colouring of the first plant or cloud
+  vd_palette palette;          // its label colours
   int nadded;                  // plants and clouds added
   double range_min, range_max; // colour scale of the last value-coloured plant
   vd_vec3 lo, hi;              // bounds of everything added
@@ -126,6 +122,8 @@ void render_items_free(vd_renderer* r);
 // Rebuild the splat lists of the clouds for a camera at eye looking along fwd with axes right/up.
 vd_status render_clouds_update(vd_renderer* r, const double eye[3], const double fwd[3],
                                const double right[3], const double up[3], vd_error* err);
+// Measure the font's digit baseline and stroke (once, after the MuJoCo context is made).
+void render_measure_font(vd_renderer* r);
 // Colour map from t in [0, 1] (viridis) into rgb.
 void render_colormap(double t, float rgb[3]);
 

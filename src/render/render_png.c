@@ -222,6 +222,7 @@ vd_status vd_render_write_json(const vd_frame* f, const char* const* files, cons
   cJSON_AddNumberToObject(root, "depth_scale", 0.001);
   cJSON_AddStringToObject(root, "depth_unit", "mm, 0 = no surface");
   cJSON_AddStringToObject(root, "color_by", color_by_name(f->color_by));
+  cJSON_AddStringToObject(root, "palette", f->palette == VD_PALETTE_NATURAL ? "natural" : "distinct");
   if (f->color_by == VD_COLOR_STRESS || f->color_by == VD_COLOR_DISPLACEMENT) {
     double rg[2] = {f->range_min, f->range_max};
     cJSON_AddItemToObject(root, "range", cJSON_CreateDoubleArray(rg, 2));
@@ -237,6 +238,15 @@ vd_status vd_render_write_json(const vd_frame* f, const char* const* files, cons
     cJSON_AddItemToArray(leg, e);
   }
   cJSON_AddNumberToObject(root, "robot_label", VD_RENDER_ROBOT_LABEL);
+  if (f->gl) {
+    // which OpenGL drew it: a GPU's and Mesa's software pictures differ in their last bits
+    cJSON* gl = cJSON_AddObjectToObject(root, "opengl");
+    cJSON_AddStringToObject(gl, "vendor", f->gl->vendor);
+    cJSON_AddStringToObject(gl, "renderer", f->gl->renderer);
+    cJSON_AddStringToObject(gl, "version", f->gl->version);
+    cJSON_AddStringToObject(gl, "egl_platform", f->gl->platform);
+    cJSON_AddBoolToObject(gl, "software", f->gl->software);
+  }
   cJSON* fl = cJSON_AddObjectToObject(root, "files");
   for (int i = 0; files && files[i] && files[i + 1]; i += 2)
     cJSON_AddStringToObject(fl, files[i], files[i + 1]);

@@ -220,6 +220,87 @@ static void prim_values(const vd_model* m, const vd_data* d, const vd_render_sty
   }
 }
 
+// 1 for each primitive still joined to the plant's root, 0 for parts that came off (att:
+// nseg + nsphere + nmesh; stack: nseg scratch). A broken segment and everything beyond it are
+// off; so is a sphere or mesh whose parent is off, or a sphere that moved away from its
+// attachment node or its parent's end (a fruit fallen at its calyx: the joint is not one of the
+// plant's segments)
+static void prim_attached(const vd_model* m, const vd_data* d, unsigned char* att, int* stack) {
+  int ns = m->nseg;
+  memset(att, 0, (size_t)ns); // 0 unknown, 1 attached, 2 off
+  for (int i = 0; i < ns; i++) {
+    // walk up to a known segment or the root, then set the path from the top down
+    int n = 0, j = i, state = 1;
+    while (j >= 0 && !att[j] && n < ns) {
+      if (d && d->seg_broken[j]) {
+        att[j] = 2;
+        break;
+      }
+      stack[n++] = j;
+      j = m->seg_parent[j];
+    }
+    if (j >= 0 && att[j]) state = att[j];
+    while (n > 0)
+      att[stack[--n]] = (unsigned char)state;
+  }
+  for (int i = 0; i < ns; i++)
+    att[i] = att[i] == 1;
+  unsigned char* sph = att + ns;
+  unsigned char* msh = sph + m->nsphere;
+  for (int k = 0; k < m->nsphere; k++) {
+    // its attachment node, or the end of its parent segment
+    int par = m->sphere_parent[k], node = m->sphere_node[k];
+    if (node < 0 && par >= 0) node = m->seg_node[2 * par + 1];
+    sph[k] = par < 0 || att[par];
+    if (sph[k] && d && node >= 0) {
+      // still as near its node as at rest, give or take its radius
+      double rest = moved(m->sphere_pos0 + 3 * k, m->node_pos0 + 3 * node);
+      double now = moved(d->sphere_pos + 3 * k, d->node_pos + 3 * node);
+      sph[k] = now <= rest + m->sphere_radius[k] + 1e-3;
+    }
+  }
+  for (int k = 0; k < m->nmesh; k++)
+    msh[k] = m->mesh_parent[k] < 0 || att[m->mesh_parent[k]];
+}
+
+// colour scale of values (nseg + nsphere + nmesh; NaN: none) over the attached primitives (the
+// whole plant when none of them has a value); 0, 0 when nothing has one
+static void value_range(const vd_model* m, const double* val, const unsigned char* att, double* lo,
+                        double* hi) {
+  int n = m->nseg + m->nsphere + m->nmesh;
+  for (int pass = 0; pass < 2; pass++) {
+    *lo = INFINITY, *hi = -INFINITY;
+    for (int i = 0; i < n; i++)
+      if (isfinite(val[i]) && (pass || att[i])) *lo = fmin(*lo, val[i]), *hi = fmax(*hi, val[i]);
+    if (*hi >= *lo) return;
+  }
+  *lo = *hi = 0;
+}
+
+vd_status vd_render_value_range(const vd_model* m, const vd_data* d, const vd_render_style* style,
+                                double* lo, double* hi, vd_error* err) {
+  *lo = *hi = 0;
+  vd_render_style s = style ? *style : vd_render_style_default();
+  vd_status st = check_style(&s, m->nseg, err);
+  if (st) return st;
+  if (s.color_by != VD_COLOR_STRESS && s.color_by != VD_COLOR_DISPLACEMENT) return VD_OK;
+  size_t n = (size_t)m->nseg + (size_t)m->nsphere + (size_t)m->nmesh + 1;
+  double* val = vd_malloc(sizeof(double) * n);
+  unsigned char* att = vd_malloc(n);
+  int* stack = vd_malloc(sizeof(int) * ((size_t)m->nseg + 1));
+  if (val && att && stack) {
+    prim_values(m, d, &s, val, val + m->nseg, val + m->nseg + m->nsphere);
+    prim_attached(m, d, att, stack);
+    value_range(m, val, att, lo, hi);
+  } else {
+    st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  vd_free(val, sizeof(double) * n);
+  vd_free(att, n);
+  vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
+  return st;
+}
+
 // half thickness given to open surfaces (leaves) drawn from both sides (m): the two faces lie
 // apart, so neither shadows nor depth-tests the other (real leaves are 0.1-0.5 mm thick)
 #define LEAF_HALF_THICKNESS 1e-4
@@ -238,6 +319,165 @@ static void put_tri(const vd_mesh* mesh, int t, int side, const float* rgb, floa
       if (col) col[9 * k + 3 * c + x] = rgb[x];
     }
   }
+}
+
+// label table order
+static int cmp_label(const void* a, const void* b) {
+  const vd_label *x = a, *y = b;
+  return (x->id > y->id) - (x->id < y->id);
+}
+
+// label id in a table sorted by id; an unnamed entry of the default colour (*spare) when the
+// table lacks it
+static const vd_label* find_label(const vd_label* l, int n, int id, vd_label* spare) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (l[mid].id < id)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  if (lo < n && l[lo].id == id) return &l[lo];
+  vd_label_init(spare, id, "");
+  return spare;
+}
+
+// the label table of what is added, coloured by the palette: the table given (Nullable, any
+// order, the first entry of an id kept) and an unnamed entry for each id of ids (nid, ascending)
+// it lacks, sorted by id; free *out with vd_free(*out, *n * sizeof(vd_label))
+static vd_status palette_table(const vd_label* tab, int ntab, const int* ids, int nid,
+                               vd_palette palette, vd_label** out, int* n) {
+  *out = NULL, *n = 0;
+  size_t cap = (size_t)ntab + (size_t)nid + 1;
+  vd_label* l = vd_malloc(sizeof(vd_label) * cap);
+  float(*rgb)[3] = vd_malloc(sizeof *rgb * cap);
+  if (!l || !rgb) {
+    vd_free(l, sizeof(vd_label) * cap);
+    vd_free(rgb, sizeof *rgb * cap);
+    return VD_ERR_NOMEM;
+  }
+  int k = 0;
+  for (int i = 0; i < ntab; i++) {
+    int dup = 0;
+    for (int j = 0; j < k && !dup; j++)
+      dup = l[j].id == tab[i].id;
+    if (!dup) l[k++] = tab[i];
+  }
+  qsort(l, (size_t)k, sizeof *l, cmp_label);
+  int known = k;
+  for (int j = 0; j < nid; j++)
+    if (find_label(l, known, ids[j], &l[k]) == &l[k]) k++;
+  qsort(l, (size_t)k, sizeof *l, cmp_label);
+  vd_render_label_colors(l, k, palette, rgb);
+  for (int i = 0; i < k; i++)
+    memcpy(l[i].rgb, rgb[i], sizeof l[i].rgb);
+  vd_free(rgb, sizeof *rgb * cap);
+  // give back the unused tail (the caller frees n entries)
+  vd_label* fit = vd_realloc(l, sizeof(vd_label) * cap, sizeof(vd_label) * (size_t)(k ? k : 1));
+  if (!fit) {
+    vd_free(l, sizeof(vd_label) * cap);
+    return VD_ERR_NOMEM;
+  }
+  *out = fit, *n = k ? k : 1;
+  if (!k) memset(fit, 0, sizeof *fit), fit->id = -1;
+  return VD_OK;
+}
+
+// Add labelled triangles as one item per (label, instance), coloured by s (label colours from the
+// table tab of ntab entries, Nullable, in s's palette): tri_rgb (Nullable) gives a colour per
+// triangle for the value colourings, open (Nullable) marks the triangles of open surfaces, drawn
+// as two faces apart, each facing its own side.
+static vd_status add_triangles(vd_renderer* r, const vd_mesh* mesh, const unsigned char* open,
+                               const float* tri_rgb, const vd_label* tab, int ntab,
+                               const vd_render_style* s, vd_error* err) {
+  for (int t = 0; t < mesh->ntri; t++)
+    if (mesh->tri_label[t] < 0 || mesh->tri_label[t] >= VD_RENDER_ROBOT_LABEL ||
+        mesh->tri_instance[t] < 0 || mesh->tri_instance[t] > 65535)
+      return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
+                          "label %d / instance %d do not fit the 16-bit masks (labels 0..65534, "
+                          "instances 0..65535)",
+                          mesh->tri_label[t], mesh->tri_instance[t]);
+  // scratch: triangle order, label ids present, one group's vertex arrays (x2 for back faces)
+  vd_status st = VD_OK;
+  size_t nt = (size_t)mesh->ntri;
+  key* order = vd_malloc(nt ? nt * sizeof(key) : 1);
+  int* ids = vd_malloc(nt ? nt * sizeof(int) : 1);
+  float* buf = vd_malloc(nt ? sizeof(float) * 2 * nt * 27 : 1);
+  vd_label* lab = NULL;
+  int nlab = 0, nid = 0;
+  if (!order || !ids || !buf) {
+    st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    goto done;
+  }
+  for (size_t t = 0; t < nt; t++)
+    order[t] = (key){mesh->tri_label[t], mesh->tri_instance[t], (int)t};
+  if (nt) qsort(order, nt, sizeof(key), cmp_key);
+  for (size_t t = 0; t < nt; t++)
+    if (!nid || ids[nid - 1] != order[t].label) ids[nid++] = order[t].label;
+  if (palette_table(tab, ntab, ids, nid, s->palette, &lab, &nlab)) {
+    st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    goto done;
+  }
+  for (int v = 0; v < mesh->nvert; v++)
+    bounds_add(r, vd_v3(mesh->pos[3 * v], mesh->pos[3 * v + 1], mesh->pos[3 * v + 2]));
+  if (r->nadded == 0) r->color_by = s->color_by, r->palette = s->palette;
+  // one item per (label, instance)
+  for (size_t g0 = 0, g1; g0 < nt; g0 = g1) {
+    int label = order[g0].label, inst = order[g0].instance;
+    for (g1 = g0 + 1; g1 < nt && order[g1].label == label && order[g1].instance == inst; g1++) {
+    }
+    item* it = new_item(r);
+    if (!it) {
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+      goto done;
+    }
+    it->kind = ITEM_PLANT;
+    it->label = label;
+    it->instance = inst;
+    vd_label spare;
+    const vd_label* l = find_label(lab, nlab, label, &spare);
+    if (s->color_by == VD_COLOR_LABEL)
+      memcpy(it->rgba, l->rgb, sizeof l->rgb);
+    else if (s->color_by == VD_COLOR_INSTANCE)
+      instance_rgb(inst, it->rgba);
+    else
+      it->rgba[0] = it->rgba[1] = it->rgba[2] = 1;
+    if (legend_add(r, label, l->name[0] ? l->name : NULL, l->rgb)) {
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+      goto done;
+    }
+    // the group's triangles; open surfaces twice, the second copy facing back
+    size_t cap = 2 * (g1 - g0);
+    float* pos = buf;
+    float* nrm = buf + 9 * cap;
+    float* col = tri_rgb ? buf + 18 * cap : NULL;
+    int k = 0;
+    for (size_t j = g0; j < g1; j++) {
+      int t = order[j].index;
+      const float* rgb = tri_rgb ? tri_rgb + 3 * t : NULL;
+      int two = open && open[t];
+      put_tri(mesh, t, two, rgb, pos, nrm, col, k++);
+      if (two) put_tri(mesh, t, -1, rgb, pos, nrm, col, k++);
+    }
+    gl_tris tris = {k, pos, nrm, NULL};
+    it->list = gl_list(&r->gl, &tris);
+    if (tri_rgb) {
+      tris.rgb = col;
+      it->list_rgb = gl_list(&r->gl, &tris);
+    }
+    if (!it->list || (tri_rgb && !it->list_rgb)) {
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the geometry");
+      goto done;
+    }
+  }
+  r->nadded++;
+done:
+  vd_free(order, nt ? nt * sizeof(key) : 1);
+  vd_free(ids, nt ? nt * sizeof(int) : 1);
+  vd_free(buf, nt ? sizeof(float) * 2 * nt * 27 : 1);
+  vd_free(lab, sizeof(vd_label) * (size_t)nlab);
+  return st;
 }
 
 vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* d,
@@ -263,113 +503,59 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
   vd_mesh_def md = vd_mesh_def_default();
   md.slices = s.slices;
   if ((st = vd_geom_tessellate(m, d, &md, &mesh, err))) return st;
-  for (int t = 0; t < mesh.ntri; t++)
-    if (mesh.tri_label[t] < 0 || mesh.tri_label[t] >= VD_RENDER_ROBOT_LABEL ||
-        mesh.tri_instance[t] < 0 || mesh.tri_instance[t] > 65535) {
-      vd_mesh_free(&mesh);
-      return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
-                          "label %d / instance %d do not fit the 16-bit masks (labels 0..65534, "
-                          "instances 0..65535)",
-                          mesh.tri_label[t], mesh.tri_instance[t]);
-    }
-  // scratch: triangle order, per-primitive values, one group's vertex arrays (x2 for back faces)
-  size_t nt = (size_t)mesh.ntri;
-  key* order = vd_malloc(nt ? nt * sizeof(key) : 1);
-  double* val = vd_malloc(sizeof(double) * (size_t)(m->nseg + m->nsphere + m->nmesh + 1));
-  float* buf = vd_malloc(nt ? sizeof(float) * 2 * nt * 27 : 1);
-  if (!order || !val || !buf) {
+  // scratch: per-primitive values, per-triangle colours and open-surface flags
+  size_t nt = (size_t)mesh.ntri, nval = (size_t)m->nseg + (size_t)m->nsphere + (size_t)m->nmesh + 1;
+  int value_mode = s.color_by == VD_COLOR_STRESS || s.color_by == VD_COLOR_DISPLACEMENT;
+  double* val = vd_malloc(sizeof(double) * nval);
+  float* tri_rgb = value_mode ? vd_malloc(sizeof(float) * 3 * (nt + 1)) : NULL;
+  unsigned char* open = vd_malloc(nt + 1);
+  if (!val || !open || (value_mode && !tri_rgb)) {
     st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
     goto done;
   }
-  int value_mode = s.color_by == VD_COLOR_STRESS || s.color_by == VD_COLOR_DISPLACEMENT;
   double* vseg = val;
   double* vsph = val + m->nseg;
   double* vmsh = vsph + m->nsphere;
   double lo = s.range_min, hi = s.range_max;
   if (value_mode) {
     prim_values(m, d, &s, vseg, vsph, vmsh);
+    // without a fixed range, the scale spans the plant still attached: a fruit that fell or a
+    // branch that broke off lies beyond it (in the end colour) instead of washing out the plant
     if (!(hi > lo)) {
-      lo = INFINITY, hi = -INFINITY;
-      for (int i = 0; i < m->nseg + m->nsphere + m->nmesh; i++)
-        if (isfinite(val[i])) lo = fmin(lo, val[i]), hi = fmax(hi, val[i]);
-      if (!(hi >= lo)) lo = hi = 0;
+      unsigned char* att = vd_malloc(nval);
+      int* stack = vd_malloc(sizeof(int) * ((size_t)m->nseg + 1));
+      if (!att || !stack) {
+        vd_free(att, nval);
+        vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
+        st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+        goto done;
+      }
+      prim_attached(m, d, att, stack);
+      value_range(m, val, att, &lo, &hi);
+      vd_free(att, nval);
+      vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
     }
     r->range_min = lo;
     r->range_max = hi;
   }
-  for (size_t t = 0; t < nt; t++)
-    order[t] = (key){mesh.tri_label[t], mesh.tri_instance[t], (int)t};
-  if (nt) qsort(order, nt, sizeof(key), cmp_key);
-  for (int v = 0; v < mesh.nvert; v++)
-    bounds_add(r, vd_v3(mesh.pos[3 * v], mesh.pos[3 * v + 1], mesh.pos[3 * v + 2]));
-  if (r->nadded == 0) r->color_by = s.color_by;
-  // one item per (label, instance)
-  for (size_t g0 = 0, g1; g0 < nt; g0 = g1) {
-    int label = order[g0].label, inst = order[g0].instance;
-    for (g1 = g0 + 1; g1 < nt && order[g1].label == label && order[g1].instance == inst; g1++) {
-    }
-    item* it = new_item(r);
-    if (!it) {
-      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-      goto done;
-    }
-    it->kind = ITEM_PLANT;
-    it->label = label;
-    it->instance = inst;
-    const vd_label* lab = vd_model_find_label(m, label);
-    float lrgb[3];
-    if (lab)
-      memcpy(lrgb, lab->rgb, sizeof lrgb);
+  for (size_t t = 0; t < nt; t++) {
+    int prim = mesh.tri_prim[t], kind = mesh.tri_kind[t];
+    // leaves are open surfaces: two faces 0.2 mm apart, each lit from its side
+    open[t] = kind == VD_PRIM_MESH && !m->mesh_closed[prim];
+    if (!value_mode) continue;
+    double v = kind == VD_PRIM_SEGMENT  ? vseg[prim]
+               : kind == VD_PRIM_SPHERE ? vsph[prim]
+                                        : vmsh[prim];
+    if (isfinite(v))
+      render_colormap(hi > lo ? (v - lo) / (hi - lo) : 0, tri_rgb + 3 * t);
     else
-      vd_plant_default_rgb(label, lrgb);
-    if (s.color_by == VD_COLOR_LABEL)
-      memcpy(it->rgba, lrgb, sizeof lrgb);
-    else if (s.color_by == VD_COLOR_INSTANCE)
-      instance_rgb(inst, it->rgba);
-    else
-      it->rgba[0] = it->rgba[1] = it->rgba[2] = 1;
-    if (legend_add(r, label, lab ? lab->name : NULL, lrgb)) {
-      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-      goto done;
-    }
-    // the group's triangles; open surfaces (leaves) twice, the second copy facing back
-    size_t cap = 2 * (g1 - g0);
-    float* pos = buf;
-    float* nrm = buf + 9 * cap;
-    float* col = value_mode ? buf + 18 * cap : NULL;
-    int k = 0;
-    for (size_t j = g0; j < g1; j++) {
-      int t = order[j].index, prim = mesh.tri_prim[t], kind = mesh.tri_kind[t];
-      float rgb[3];
-      if (value_mode) {
-        double v = kind == VD_PRIM_SEGMENT  ? vseg[prim]
-                   : kind == VD_PRIM_SPHERE ? vsph[prim]
-                                            : vmsh[prim];
-        if (isfinite(v))
-          render_colormap(hi > lo ? (v - lo) / (hi - lo) : 0, rgb);
-        else
-          memcpy(rgb, no_value_rgb, sizeof rgb);
-      }
-      int open = kind == VD_PRIM_MESH && !m->mesh_closed[prim];
-      put_tri(&mesh, t, open, rgb, pos, nrm, col, k++);
-      if (open) put_tri(&mesh, t, -1, rgb, pos, nrm, col, k++);
-    }
-    gl_tris tris = {k, pos, nrm, NULL};
-    it->list = gl_list(&r->gl, &tris);
-    if (value_mode) {
-      tris.rgb = col;
-      it->list_rgb = gl_list(&r->gl, &tris);
-    }
-    if (!it->list || (value_mode && !it->list_rgb)) {
-      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "OpenGL could not store the plant's geometry");
-      goto done;
-    }
+      memcpy(tri_rgb + 3 * t, no_value_rgb, sizeof no_value_rgb);
   }
-  r->nadded++;
+  st = add_triangles(r, &mesh, open, tri_rgb, m->labels, m->nlabel, &s, err);
 done:
-  vd_free(order, nt ? nt * sizeof(key) : 1);
-  vd_free(val, sizeof(double) * (size_t)(m->nseg + m->nsphere + m->nmesh + 1));
-  vd_free(buf, nt ? sizeof(float) * 2 * nt * 27 : 1);
+  vd_free(val, sizeof(double) * nval);
+  vd_free(tri_rgb, value_mode ? sizeof(float) * 3 * (nt + 1) : 0);
+  vd_free(open, nt + 1);
   vd_mesh_free(&mesh);
   return st;
 }
@@ -552,10 +738,20 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
   }
   c->radius = p->radius > 0 ? p->radius : fmax(0.004 * vd_norm(vd_sub(hi, lo)), 1e-4);
   if (n) qsort(keys, n, sizeof(key), cmp_key);
-  for (int i = 0; i < p->n; i++)
+  // the label ids present, ascending, and their colours
+  int nid = 0, nlab = 0;
+  int* ids = vd_malloc(sizeof(int) * (n + 1));
+  for (int i = 0; i < p->n; i++) {
     c->order[i] = keys[i].index;
+    if (ids && (!nid || ids[nid - 1] != keys[i].label)) ids[nid++] = keys[i].label;
+  }
   vd_free(keys, n * sizeof(key));
-  if (r->nadded == 0) r->color_by = s.color_by;
+  vd_label* lab = NULL;
+  vd_status pst =
+      ids ? palette_table(p->labels, p->nlabel, ids, nid, s.palette, &lab, &nlab) : VD_ERR_NOMEM;
+  vd_free(ids, sizeof(int) * (n + 1));
+  if (pst) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (r->nadded == 0) r->color_by = s.color_by, r->palette = s.palette;
   // one item per (label, instance); the order keeps the labels and instances
   for (int g0 = 0, g1; g0 < p->n; g0 = g1) {
     int i0 = c->order[g0];
@@ -566,28 +762,28 @@ vd_status vd_render_add_points(vd_renderer* r, const vd_points* p, const vd_rend
         break;
     }
     item* it = new_item(r);
-    if (!it) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (!it) {
+      vd_free(lab, sizeof(vd_label) * (size_t)nlab);
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    }
     it->kind = ITEM_POINTS;
     it->label = label;
     it->instance = inst;
     it->cloud = r->ncloud - 1;
     it->start = g0;
     it->count = g1 - g0;
-    const vd_label* lab = NULL;
-    for (int k = 0; k < p->nlabel; k++)
-      if (p->labels[k].id == label) lab = &p->labels[k];
-    float lrgb[3];
-    if (lab)
-      memcpy(lrgb, lab->rgb, sizeof lrgb);
-    else
-      vd_plant_default_rgb(label, lrgb);
+    vd_label spare;
+    const vd_label* l = find_label(lab, nlab, label, &spare);
     if (s.color_by == VD_COLOR_INSTANCE)
       instance_rgb(inst, it->rgba);
     else
-      memcpy(it->rgba, lrgb, sizeof lrgb);
-    if (legend_add(r, label, lab ? lab->name : NULL, lrgb))
+      memcpy(it->rgba, l->rgb, sizeof l->rgb);
+    if (legend_add(r, label, l->name[0] ? l->name : NULL, l->rgb)) {
+      vd_free(lab, sizeof(vd_label) * (size_t)nlab);
       return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    }
   }
+  vd_free(lab, sizeof(vd_label) * (size_t)nlab);
   r->cloud_lists_valid = 0;
   r->nadded++;
   return VD_OK;

@@ -274,10 +274,7 @@ void vd_sim_to_plant(const vd_sim_model* m, const vd_sim_data* d, const vd_model
     vd_quat q = plant_seg_quat(m, d, j, (vd_quat){q0[0], q0[1], q0[2], q0[3]});
     out->seg_quat[4 * j] = q.w, out->seg_quat[4 * j + 1] = q.x, out->seg_quat[4 * j + 2] = q.y;
     out->seg_quat[4 * j + 3] = q.z;
-    out->seg_broken[j] = 0;
   }
-  for (int t = 0; t < m->nseg; t++)
-    if (d->seg_broken[t] && m->seg_plant[t] >= 0) out->seg_broken[m->seg_plant[t]] = 1;
   for (int k = 0; k < plant->nsphere; k++) {
     int n = m->bind_sphere_node[k];
     if (n < 0) continue;
@@ -290,9 +287,10 @@ void vd_sim_to_plant(const vd_sim_model* m, const vd_sim_data* d, const vd_model
     vd_vec3 p = bound_point(m, d, t, m->bind_vert_local[v]);
     out->vert_pos[3 * v] = p.x, out->vert_pos[3 * v + 1] = p.y, out->vert_pos[3 * v + 2] = p.z;
   }
+  sim_plant_cuts(m, d, plant, out);  // broken segments and where they broke (sim_pieces.c)
 }
 
-void vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec) {
+vd_status vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec) {
   VD_ASSERT(spec->nnode == m->nbind_node && spec->nseg == m->nbind_seg);
   for (int i = 0; i < spec->nnode; i++) spec->node[i] = plant_node_pos(m, d, i, spec->node[i]);
   for (int j = 0; j < spec->nseg; j++) {
@@ -306,4 +304,5 @@ void vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* 
     if (m->bind_sphere_node[k] >= 0) spec->sphere[k].center = d->node_pos[m->bind_sphere_node[k]];
   for (int v = 0; v < spec->nvert; v++)
     if (m->bind_vert_seg[v] >= 0) spec->vert[v] = bound_point(m, d, m->bind_vert_seg[v], m->bind_vert_local[v]);
+  return sim_spec_pieces(m, d, spec);  // parts that broke off become pieces of their own
 }

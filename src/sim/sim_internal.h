@@ -127,6 +127,12 @@ void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double
 // Detach segment t from its parent (a fracture): its start moves to its spare node, which takes
 // half the segment's mass; the joint is marked broken (sim_step.c).
 void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t);
+// Pieces after fracture (sim_pieces.c): mark the plant segments of state out that span a broken
+// joint, with where they broke (vd_data::seg_cut).
+void sim_plant_cuts(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant, vd_data* out);
+// Cut the spec (positions already written back) into separate pieces at the broken joints:
+// segments spanning a break split with new nodes at its faces, links across pieces removed.
+vd_status sim_spec_pieces(const vd_sim_model* m, const vd_sim_data* d, vd_plant_spec* spec);
 
 // ---------------------------------------------------------------------------------------------
 // self-collision primitives (sim_self.c): capsule k is segment cap_seg[k], sphere k is the

@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: MIT
-// MuJoCo error trap: MuJoCo reports fatal errors through the process-wide hook mju_user_error,
-// and without one it prints and exits. vd_mj_trap_install points the hooks at handlers that
-// longjmp back to the innermost open trap of the calling thread, so a MuJoCo error becomes a
-// status, never an exit (DESIGN.md). Warnings are counted in the open trap, never printed.
+// MuJoCo error trap, the one process-wide MuJoCo error hook of verdant (private: never
+// installed). MuJoCo reports fatal errors through the global hook mju_user_error, and without
+// one it prints and exits. vd_mj_trap_install points MuJoCo's error and warning hooks at
+// handlers that longjmp back to the innermost open trap of the calling thread, so a MuJoCo error
+// becomes a vd_status of the verdant call that made it, never an exit (DESIGN.md). Warnings are
+// counted in the open trap and passed to the log hook (vd_log), never printed.
 //
-// For the bench now and the robot module next (only robot may include MuJoCo headers). The
-// one piece of global state is MuJoCo's own: its hooks take no user pointer, so the open traps
-// are kept per thread (thread-local), and the hooks are set once per process. render's mjguard
-// (src/render/render_mujoco.c) sets the same hooks: never use both in one process.
+// Shared by every piece of verdant that calls MuJoCo: render, robot and the benchmarks (the
+// dependency table in docs/architecture.md lets render and robot include it; it includes core
+// and MuJoCo only). MuJoCo's hooks take no user pointer, so the open traps are kept per thread
+// (thread-local) and the hooks are set once per process (call_once).
 //
 // Usage (locals changed inside the trap and read after an error must be volatile):
 //   vd_mj_trap trap;
@@ -19,8 +21,8 @@
 //     st = vd_mj_trap_status(&trap, err);   // VD_ERR_VALUE, "MuJoCo: <message>"; trap closed
 //   }
 // After an error the mjData is in an unknown state: reset it (mj_resetData) or delete it.
-#ifndef VERDANT_MJ_TRAP_H
-#define VERDANT_MJ_TRAP_H
+#ifndef VERDANT_MJTRAP_H
+#define VERDANT_MJTRAP_H
 
 #include <setjmp.h>
 
@@ -35,7 +37,7 @@ typedef struct vd_mj_trap {
   struct vd_mj_trap* outer; // the trap that was open before this one
 } vd_mj_trap;
 
-// Point MuJoCo's error and warning hooks at the trap handlers (idempotent).
+// Point MuJoCo's error and warning hooks at the trap handlers (once per process, thread-safe).
 void vd_mj_trap_install(void);
 // Open trap t on this thread (use VD_MJ_TRY, which also sets the jump point).
 void vd_mj_trap_begin(vd_mj_trap* t);

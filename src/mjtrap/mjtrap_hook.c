@@ -1,20 +1,23 @@
 // SPDX-License-Identifier: MIT
-// MuJoCo error trap (mj_trap.h): hooks that longjmp to the innermost open trap of the thread.
-#include "mj_trap.h"
+// MuJoCo error trap (mjtrap.h): hooks that longjmp to the innermost open trap of the thread.
+#include "mjtrap.h"
 
 #include <mujoco/mujoco.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <threads.h>
 
 // open traps of this thread, innermost first (MuJoCo's hooks take no user pointer)
 static _Thread_local vd_mj_trap* open_trap;
+static once_flag install_once = ONCE_FLAG_INIT;
 
 static void on_error(const char* msg) {
   vd_mj_trap* t = open_trap;
   if (!t) {
     // a MuJoCo call outside any trap: a programmer error, never a return into MuJoCo
     vd_assert_fail("MuJoCo error outside a vd_mj_trap", __FILE__, __LINE__);
-    return;
+    abort();
   }
   snprintf(t->error, sizeof t->error, "%s", msg ? msg : "unknown MuJoCo error");
   open_trap = t->outer; // closed: an error in the caller's recovery goes to the outer trap
@@ -22,15 +25,20 @@ static void on_error(const char* msg) {
 }
 
 static void on_warning(const char* msg) {
+  vd_log(1, "MuJoCo: %s", msg ? msg : "warning");
   vd_mj_trap* t = open_trap;
-  if (!t) return; // outside a trap a warning is dropped (mjData counts it in d->warning)
+  if (!t) return; // outside a trap a warning is only logged (mjData counts it in d->warning)
   t->nwarning++;
   snprintf(t->warning, sizeof t->warning, "%s", msg ? msg : "");
 }
 
-void vd_mj_trap_install(void) {
+static void install(void) {
   mju_user_error = on_error;
   mju_user_warning = on_warning;
+}
+
+void vd_mj_trap_install(void) {
+  call_once(&install_once, install);
 }
 
 void vd_mj_trap_begin(vd_mj_trap* t) {

@@ -13,15 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "verdant/collide.h"
+#include "collide_internal.h"
 
 // bisection steps: 2^-52 of the axis is at double round-off
 #define BISECT_STEPS 52
-
-// Euclidean length (inline: the queries below are the inner loop of every step)
-static inline double len3(vd_vec3 a) {
-  return sqrt(vd_dot(a, a));
-}
 
 vd_pose vd_pose_identity(void) {
   vd_pose p = {{0, 0, 0}, {1, 0, 0, 0}};

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "verdant/collide.h"
+#include "collide_internal.h"
 
 vd_sdf_def vd_sdf_def_default(void) {
   vd_sdf_def d;
