@@ -1209,7 +1209,7 @@ void lsys_py_free(vd_lsystem* ls) {
   lsys_py* py = ls->py;
   if (!py) return;
   if (g_state == 1) {
-    lsys_py_enter(ls);
+    lsys_py_enter(NULL);  // the lock and the GIL only: no random state to swap in or keep
     lsys_py_reset_objects(ls);
     for (int k = 0; k < py->nfn; k++) {
       Py_CLEAR(py->fn[k].code);
@@ -1223,7 +1223,7 @@ void lsys_py_free(vd_lsystem* ls) {
     Py_CLEAR(py->rstate);
     Py_CLEAR(py->npstate);
     if (g_last == ls) g_last = NULL;
-    lsys_py_leave(ls);
+    lsys_py_leave(NULL);
   }
   for (int k = 0; k < py->nfn; k++) vd_free(py->fn[k].src, py->fn[k].len + 1);
   vd_free(py->fn, sizeof(pychunk) * (size_t)py->capfn);
