@@ -14,9 +14,11 @@ need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-d
   libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev
   python3-dev python3-numpy python3-pytest python3-setuptools python3-venv libpython3.11-dev)
 # --dev adds the tools of CI's hardening runs: clang with libFuzzer (make fuzz, fuzz-smoke),
-# clang-tidy and cppcheck (make lint)
+# clang-tidy and cppcheck (make lint); and the Python package's optional peers, so that CI runs
+# their tests: python3-torch (verdant.torch's DataLoader test) and python3-open3d (to_open3d, the
+# Open3D peer of make bench); about 3 minutes of installing on 2 busy cores, 0.5 GB
 if [ "${1:-}" = "--dev" ]; then
-  need+=(clang libclang-rt-14-dev clang-tidy cppcheck)
+  need+=(clang libclang-rt-14-dev clang-tidy cppcheck python3-torch python3-open3d)
 fi
 missing=()
 for p in "${need[@]}"; do

@@ -43,3 +43,24 @@ def test_docs_tour_runs(tmp_path):
             exec(compile(b, "docs/python.md", "exec"), env)
     finally:
         os.chdir(os.path.dirname(__file__))
+
+
+def test_every_public_name_has_a_docstring():
+    import inspect
+
+    import verdant
+    import verdant.torch as vt
+
+    missing = []
+    for mod, names in ((verdant, verdant.__all__), (vt, ["PlantCloudDataset", "collate_ragged"])):
+        for name in names:
+            obj = getattr(mod, name)
+            if not (obj.__doc__ or "").strip():
+                missing.append(name)
+            if inspect.isclass(obj) and not issubclass(obj, BaseException):
+                for attr in dir(obj):
+                    if attr.startswith("_"):
+                        continue
+                    if not (getattr(getattr(obj, attr), "__doc__", None) or "").strip():
+                        missing.append(f"{name}.{attr}")
+    assert not missing, missing

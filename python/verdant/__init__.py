@@ -163,9 +163,10 @@ class Mesh(_verdant.Mesh):
         import numpy as np
 
         o3d = _open3d()
-        m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(self.vertices),
-                                      o3d.utility.Vector3iVector(self.triangles))
-        m.vertex_normals = o3d.utility.Vector3dVector(self.normals)
+        # (Open3D takes writable arrays only: copies of the read-only views)
+        m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(np.array(self.vertices)),
+                                      o3d.utility.Vector3iVector(np.array(self.triangles)))
+        m.vertex_normals = o3d.utility.Vector3dVector(np.array(self.normals))
         vlabel = np.zeros(len(self.vertices), np.int32)
         vlabel[self.triangles.reshape(-1)] = np.repeat(self.label, 3)
         m.vertex_colors = o3d.utility.Vector3dVector(_label_colors(self.plant.label_table, vlabel))
@@ -184,9 +185,12 @@ class Cloud(_verdant.Cloud):
 
     def to_open3d(self):
         """An open3d.geometry.PointCloud with normals, coloured by label."""
+        import numpy as np
+
         o3d = _open3d()
-        pc = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(self.pos))
-        pc.normals = o3d.utility.Vector3dVector(self.normals)
+        # (Open3D takes writable arrays only: copies of the read-only views)
+        pc = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(np.array(self.pos)))
+        pc.normals = o3d.utility.Vector3dVector(np.array(self.normals))
         pc.colors = o3d.utility.Vector3dVector(_label_colors(self.label_table, self.label))
         return pc
 
