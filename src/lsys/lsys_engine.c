@@ -56,6 +56,19 @@ static int native_names_resolved(const vd_lsystem* ls, const char** missing) {
   return 1;
 }
 
+// hooks that take the L-string (End(lstring)) are for the Python engine: the native one calls
+// hooks without arguments
+static int native_hooks(const vd_lsystem* ls, const char** which) {
+  static const char* hooks[] = {"Start", "End", "StartEach", "EndEach", "StartInterpretation", "EndInterpretation"};
+  for (int f = 0; f < ls->nfunc; f++)
+    for (size_t h = 0; h < sizeof hooks / sizeof hooks[0]; h++)
+      if (!strcmp(ls->funcs[f]->name, hooks[h]) && ls->funcs[f]->nparam > 0) {
+        *which = hooks[h];
+        return 0;
+      }
+  return 1;
+}
+
 vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name, vd_lsys_engine engine,
                                vd_lsystem** out, vd_error* err) {
   if (engine == VD_LSYS_NATIVE || engine == VD_LSYS_PYTHON) return lsys_parse_with(text, len, name, (int)engine, out, err);
@@ -63,7 +76,7 @@ vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name, v
   vd_error nerr = {0};
   vd_status st = lsys_parse_with(text, len, name, VD_LSYS_NATIVE, out, &nerr);
   const char* missing = NULL;
-  if (st == VD_OK && native_names_resolved(*out, &missing)) return VD_OK;
+  if (st == VD_OK && native_names_resolved(*out, &missing) && native_hooks(*out, &missing)) return VD_OK;
   if (st == VD_OK) {
     vd_lsys_destroy(*out);
     *out = NULL;
@@ -77,8 +90,8 @@ vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name, v
     // no CPython here: the native engine's verdict stands
     if (st == VD_OK)
       return vd_error_set(err, VD_ERR_UNSUPPORTED, name ? name : "", 0, 0,
-                          "unsupported: name '%s' is not defined in the file and the Python engine is not "
-                          "available (%s)",
+                          "unsupported: '%s' needs the Python engine (a name the file does not define, or a "
+                          "hook with parameters), which is not available (%s)",
                           missing, why);
     if (err) *err = nerr;
     return st;

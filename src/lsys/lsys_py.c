@@ -578,7 +578,7 @@ static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_
     return 0;
   }
   const tmpl* t = py->tp[tid];
-  int nmod = t ? t->n : 0;
+  int nmod = t && !t->drop ? t->n : 0;  // `produce * ...` deletes the module (L-Py)
   vd_lstring* s = out->s;
   if (s->n + nmod > out->max_modules) {
     vm_error(ls, VD_ERR_LIMIT, nmod ? t->mod[0].line : 0, nmod ? t->mod[0].col : 0,
@@ -1026,6 +1026,36 @@ vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, 
   st = call_rule(ls, py->fobj[r->pyfn], args, n, out);
   for (int i = 0; i < n; i++) Py_DECREF(args[i]);
   return st;
+}
+
+vd_status lsys_py_eval(vd_lsystem* ls, const expr* e, value* out) {
+  vd_status st = need_ns(ls);
+  if (st) return st;
+  PyObject* code = Py_CompileStringExFlags(ls->str[(int)e->k.n], ls->file, Py_eval_input, NULL, -1);
+  PyObject* r = code ? PyEval_EvalCode(code, ls->py->ns, ls->py->ns) : NULL;
+  Py_XDECREF(code);
+  if (!r) return py_error(ls);
+  if (PyBool_Check(r)) {
+    *out = (value){V_BOOL, r == Py_True};
+  } else if (PyLong_Check(r) || PyFloat_Check(r)) {
+    double d = PyFloat_Check(r) ? PyFloat_AS_DOUBLE(r) : PyLong_AsDouble(r);
+    *out = PyFloat_Check(r) ? v_num(d) : v_int(d);
+  } else if (PyUnicode_Check(r)) {
+    const char* t = PyUnicode_AsUTF8(r);
+    int id = t ? str_intern(ls, t, (int)strlen(t)) : -1;
+    if (id < 0) {
+      Py_DECREF(r);
+      PyErr_Clear();
+      return vm_error(ls, VD_ERR_NOMEM, e->line, e->col, "out of memory");
+    }
+    *out = (value){V_STR, id};
+  } else {
+    Py_DECREF(r);
+    return vm_error(ls, VD_ERR_TYPE, e->line, e->col, "expected a number or a string");
+  }
+  Py_DECREF(r);
+  if (PyErr_Occurred()) return py_error(ls);
+  return VD_OK;
 }
 
 // number of positional parameters a hook declares (0 when unknown)

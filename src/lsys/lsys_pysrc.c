@@ -193,6 +193,46 @@ int lsys_py_params(vd_lsystem* ls, const char* s, int len, int* pos, int lineno,
   return -1;
 }
 
+expr* lsys_py_expr(vd_lsystem* ls, const char* s, int len, int lineno, int col) {
+  // the text up to a comment outside strings, trimmed
+  char q = 0;
+  int b = len;
+  for (int i = 0; i < len; i++) {
+    if (q) {
+      if (s[i] == '\\') i++;
+      else if (s[i] == q) q = 0;
+    } else if (s[i] == '\'' || s[i] == '"') {
+      q = s[i];
+    } else if (s[i] == '#') {
+      b = i;
+      break;
+    }
+  }
+  int a = 0;
+  while (a < b && isspace((unsigned char)s[a])) a++;
+  while (b > a && isspace((unsigned char)s[b - 1])) b--;
+  if (a == b) {
+    vm_error(ls, VD_ERR_SYNTAX, lineno, col, "expected an expression");
+    return NULL;
+  }
+  int id = str_intern(ls, s + a, b - a);
+  if (id < 0) {
+    str_intern_error(ls, id, lineno, col + a);
+    return NULL;
+  }
+  expr* e = vd_arena_alloc(&ls->arena, sizeof(expr));
+  if (!e) {
+    nomem(ls, lineno);
+    return NULL;
+  }
+  memset(e, 0, sizeof *e);
+  e->op = E_PYSRC;
+  e->line = lineno;
+  e->col = col + a;
+  e->k = (value){V_STR, id};
+  return e;
+}
+
 // ---------------------------------------------------------------------------------------------
 // produce statements
 
