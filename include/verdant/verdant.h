@@ -22,5 +22,6 @@
 #include "verdant/sim.h"
 #include "verdant/collide.h"
 #include "verdant/growth.h"
+#include "verdant/robot.h"
 
 #endif
