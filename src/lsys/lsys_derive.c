@@ -448,14 +448,14 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
 
 // one derivation step up to EndEach (excluded): StartEach, productions, decomposition; *matching
 // tells whether a rule matched
-static vd_status run_step(vd_lsystem* ls, const vd_lsys_def* d, int step, int last, vd_lstring* out,
-                          vd_lstring* tmp, lsys_pass* P, int* matching) {
+static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
+                          int* matching) {
   ls->iteration = step;
   ls->steps_done = step + 1;
   ls->frame_displayed = last;
   vd_status st = call_hook(ls, ls->hook_starteach);
   if (st) return st;
-  if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, tmp, d->max_modules))) return st;
+  if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, tmp, P->max_modules))) return st;
   // useGroup() and backward() take effect at the next step
   if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
   if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
@@ -486,7 +486,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
                 (ls->hook_endeach < 0 || ls->funcs[ls->hook_endeach]->discard_wrapped);
   int has_saved = 0;
   for (; (matching || !ls->opt_early_return) && step < steps; step++) {
-    if ((st = run_step(ls, &d, step, step == steps - 1, out, &tmp, &P, &matching))) goto done;
+    if ((st = run_step(ls, step, step == steps - 1, out, &tmp, &P, &matching))) goto done;
     if (!(discard && ls->discard_requested) && (st = call_hook(ls, ls->hook_endeach))) goto done;
     if (ls->py && (st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules))) goto done;
     if (discard) {
@@ -519,12 +519,7 @@ vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstrin
   vd_lsys_def d = run_def(ls, def, &P);
   vd_lstring tmp = vd_lstring_empty();
   int early = 0;
-  vd_status st = VD_OK;
-  if (ls->py)
-    st = vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0,
-                  "unsupported: a step-by-step derivation (growth) of a file that runs on the Python engine");
-  else
-    st = run_setup(ls, &d, out, &tmp, &P, NULL, &early);
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, NULL, &early);
   return end_run(ls, st, &tmp, &P);
 }
 
@@ -536,18 +531,17 @@ vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;
   int matching = 1;
-  if (ls->py)
-    st = vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0,
-                  "unsupported: a step-by-step derivation (growth) of a file that runs on the Python engine");
-  else if (global_slot(ls, "DiscardNewString", 16, 0) >= 0)
+  if (ls->py) lsys_py_enter(ls);
+  if (global_slot(ls, "DiscardNewString", 16, 0) >= 0)
     st = vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0, "unsupported: DiscardNewString() in a step-by-step derivation");
   else if (ls->stop_requested)
     st = vm_error(ls, VD_ERR_VALUE, 0, 0, "the L-system has stopped (Stop() was called): no more steps");
   // every module names itself as its source; the passes carry that to what it becomes
   if (!st && (!lstr_enable_src(s) || !lstr_enable_src(&tmp))) st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
   for (int64_t i = 0; !st && s->src && i < s->n; i++) s->src[i] = i;
-  if (!st) st = run_step(ls, &d, ls->steps_done, 0, s, &tmp, &P, &matching);
+  if (!st) st = run_step(ls, ls->steps_done, 0, s, &tmp, &P, &matching);
   if (!st) st = call_hook(ls, ls->hook_endeach);
+  if (!st && ls->py) st = lsys_py_hook(ls, "EndEach", s, &tmp, d.max_modules);
   if (!st && d.progress) d.progress(d.progress_user, ls->steps_done, ls->steps_done, s->n);
   return end_run(ls, st, &tmp, &P);
 }
