@@ -216,7 +216,16 @@ typedef struct cli_render_opts {
   double time;              // --time (s)
   double fps;               // --fps of the MP4 (0: the run's frame rate)
   int disp_from_first;      // --displacement-from first (runs): from frame 0, not the model
+  int has_sky, has_floor;   // --sky-rgb, --floor-rgb given
+  float sky[2][3];          // --sky-rgb: zenith and horizon colours in [0, 1]
+  float floor[2][3];        // --floor-rgb: checker colours in [0, 1]
 } cli_render_opts;
+
+// Parse an option of the look of pictures (--light AZ,EL[,KEY[,HEAD[,AMBIENT]]] into def,
+// --sky-rgb, --floor-rgb into o) at argv[*i]: 1 consumed, 0 not one, -1 bad value (printed).
+int cli_look_opt(cli_render_opts* o, const char* cmd, int argc, char** argv, int* i);
+// Apply --sky-rgb and --floor-rgb to a renderer made from o->def.
+vd_status cli_apply_look(const cli_render_opts* o, vd_renderer* r, vd_error* err);
 
 // --palette NAME (distinct, natural); 1 on success.
 int cli_parse_palette(const char* s, vd_palette* out);
@@ -230,6 +239,50 @@ int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]);
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err);
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);
+
+// The pictures of `verdant dataset --images N` (cli_views.c): render options and what varies
+// from view to view.
+typedef struct cli_view_opts {
+  int shadows, floor, sky;  // 0 with --no-shadows, --no-floor, --no-sky
+  int supersample;          // --supersample K
+  vd_palette palette;       // --palette
+  double el[2];             // --view-elevation A:B (degrees)
+  double dist[2];           // --view-distance A:B (times the fitted distance)
+  double jitter;            // --view-jitter F (fraction of the plant's half-size)
+  int vary_light;           // --vary-light
+  int vary_background;      // --vary-background
+  int given;                // any of these given (they need --images)
+} cli_view_opts;
+
+// One view: its angles (degrees), distance factor, camera, look, lights as render --light takes.
+typedef struct cli_view {
+  double az, el, dist;
+  vd_camera cam;
+  vd_render_look look;
+  double light[5];  // azimuth, elevation (degrees), key, headlight, ambient
+} cli_view;
+
+// Help lines of the view options.
+extern const char* cli_view_help;
+// Defaults: shadows, floor, sky, supersample 2, distinct palette, elevation 10:40, distance 1:1,
+// no jitter, lights and background fixed.
+void cli_view_opts_init(cli_view_opts* v);
+// Consume a view option at argv[*i]: 1 consumed, 0 not one, -1 bad value (printed).
+int cli_view_opt(cli_view_opts* v, const char* cmd, int argc, char** argv, int* i);
+// 1 when views need an explicit pose (a distance other than 1 or jitter).
+int cli_view_explicit(const cli_view_opts* v);
+// The render settings the options set (shadows, floor, sky, supersample).
+void cli_view_def(const cli_view_opts* v, vd_render_def* def);
+// Draw one view at azimuth az (degrees) of the box lo..hi for a w x h picture from g, starting
+// from the renderer's look.
+void cli_view_draw(const cli_view_opts* v, vd_rng* g, double az, vd_vec3 lo, vd_vec3 hi, int w,
+                   int h, vd_render_look look, cli_view* out);
+// The view's fields in its record (azimuth, elevation; eye, lookat, up, distance; light; sky,
+// floor: as the options make them vary).
+void cli_view_record(const cli_view_opts* v, const cli_view* view, struct cJSON* e);
+// Append the render options that make a view again to a recipe (fields in braces: {azimuth},
+// {elevation}, {eye}, {lookat}, {up}, {light}, {sky}, {floor}, arrays written A,B,...).
+void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
 
 // Subcommands.
 int cli_grow(int argc, char** argv);
