@@ -907,7 +907,7 @@ static vd_status query_fill(turtle* T) {
   double* p = T->query + T->s->par[T->i];
   double c[3] = {v.x, v.y, v.z};
   for (int k = 0; k < T->np && k < 3; k++) {
-    if (vd_lsys_value_is_str(p[k]))
+    if (isnan(p[k]))  // a string or an object (NaN-boxed)
       return fail(T, VD_ERR_UNSUPPORTED, "unsupported: %s with a non-number parameter", sym_name(T, T->sym));
     p[k] = c[k];
   }
