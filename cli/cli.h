@@ -35,6 +35,7 @@ typedef struct cli_plant_opts {
   double curve_step;       // --curve-step (m) for curves files, < 0: the file's or the default
   double curve_connect;    // --curve-connect (m), < 0: the file's or the default
   double curve_distance;   // --curve-distance (m), < 0: the file's or the default
+  int engine;              // --engine auto|native|python (vd_lsys_engine), VD_LSYS_AUTO by default
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
@@ -53,6 +54,7 @@ typedef struct cli_grow_info {
   int64_t* sym_count;       // per-symbol module counts (nsym), owned (free with vd_free)
   char** sym_name;          // per-symbol names (nsym), owned
   double seconds_derive, seconds_turtle;
+  const char* engine;       // the engine that ran the .lpy file ("native", "python"), NULL otherwise
 } cli_grow_info;
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err);
 // Free what cli_load_plant put in info.
@@ -173,6 +175,25 @@ struct cJSON* cli_sim_def_json(const vd_sim_def* def);
 vd_status cli_sim_def_parse(const struct cJSON* o, const char* path, vd_sim_def* def, vd_error* err);
 // Write one line of colliders.jsonl: the state's time and colliders.
 void cli_colliders_write(FILE* fp, const vd_sim_data* d);
+// The rod topology of a run (DIR/rod.json: what frames refer to, and how to rebuild the model).
+vd_status cli_rod_json_write(const vd_sim_model* m, const vd_model* plant, const vd_sim_def* def,
+                             const char* dir, vd_error* err);
+// A run's frames being written: DIR/frames.bin (or .jsonl) and DIR/colliders.jsonl.
+typedef struct cli_frames {
+  vd_outfile frames, colliders;
+  int frames_open, colliders_open, jsonl, watch, cwatch;  // zero the struct, watches -1
+  size_t fbuf_n;
+  unsigned char* bbuf;
+} cli_frames;
+// Open the frames files of a run folder (temporary names until cli_frames_end).
+vd_status cli_frames_begin(cli_frames* o, const vd_sim_model* m, const char* dir, int jsonl,
+                           vd_error* err);
+// Append one frame of state d; nonzero when a write has failed (the commit reports it).
+int cli_frames_write(cli_frames* o, const vd_sim_model* m, const vd_sim_data* d);
+// Commit both files (colliders only beside complete frames) and release the writer.
+vd_status cli_frames_end(cli_frames* o, vd_error* err);
+// Remove the temporary files and release the writer (after cli_frames_end: only releases).
+void cli_frames_abort(cli_frames* o);
 
 // A run folder opened for reading.
 typedef struct cli_run {
@@ -216,7 +237,16 @@ typedef struct cli_render_opts {
   double time;              // --time (s)
   double fps;               // --fps of the MP4 (0: the run's frame rate)
   int disp_from_first;      // --displacement-from first (runs): from frame 0, not the model
+  int has_sky, has_floor;   // --sky-rgb, --floor-rgb given
+  float sky[2][3];          // --sky-rgb: zenith and horizon colours in [0, 1]
+  float floor[2][3];        // --floor-rgb: checker colours in [0, 1]
 } cli_render_opts;
+
+// Parse an option of the look of pictures (--light AZ,EL[,KEY[,HEAD[,AMBIENT]]] into def,
+// --sky-rgb, --floor-rgb into o) at argv[*i]: 1 consumed, 0 not one, -1 bad value (printed).
+int cli_look_opt(cli_render_opts* o, const char* cmd, int argc, char** argv, int* i);
+// Apply --sky-rgb and --floor-rgb to a renderer made from o->def.
+vd_status cli_apply_look(const cli_render_opts* o, vd_renderer* r, vd_error* err);
 
 // --palette NAME (distinct, natural); 1 on success.
 int cli_parse_palette(const char* s, vd_palette* out);
@@ -231,7 +261,52 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);
 
+// The pictures of `verdant dataset --images N` (cli_views.c): render options and what varies
+// from view to view.
+typedef struct cli_view_opts {
+  int shadows, floor, sky;  // 0 with --no-shadows, --no-floor, --no-sky
+  int supersample;          // --supersample K
+  vd_palette palette;       // --palette
+  double el[2];             // --view-elevation A:B (degrees)
+  double dist[2];           // --view-distance A:B (times the fitted distance)
+  double jitter;            // --view-jitter F (fraction of the plant's half-size)
+  int vary_light;           // --vary-light
+  int vary_background;      // --vary-background
+  int given;                // any of these given (they need --images)
+} cli_view_opts;
+
+// One view: its angles (degrees), distance factor, camera, look, lights as render --light takes.
+typedef struct cli_view {
+  double az, el, dist;
+  vd_camera cam;
+  vd_render_look look;
+  double light[5];  // azimuth, elevation (degrees), key, headlight, ambient
+} cli_view;
+
+// Help lines of the view options.
+extern const char* cli_view_help;
+// Defaults: shadows, floor, sky, supersample 2, distinct palette, elevation 10:40, distance 1:1,
+// no jitter, lights and background fixed.
+void cli_view_opts_init(cli_view_opts* v);
+// Consume a view option at argv[*i]: 1 consumed, 0 not one, -1 bad value (printed).
+int cli_view_opt(cli_view_opts* v, const char* cmd, int argc, char** argv, int* i);
+// 1 when views need an explicit pose (a distance other than 1 or jitter).
+int cli_view_explicit(const cli_view_opts* v);
+// The render settings the options set (shadows, floor, sky, supersample).
+void cli_view_def(const cli_view_opts* v, vd_render_def* def);
+// Draw one view at azimuth az (degrees) of the box lo..hi for a w x h picture from g, starting
+// from the renderer's look.
+void cli_view_draw(const cli_view_opts* v, vd_rng* g, double az, vd_vec3 lo, vd_vec3 hi, int w,
+                   int h, vd_render_look look, cli_view* out);
+// The view's fields in its record (azimuth, elevation; eye, lookat, up, distance; light; sky,
+// floor: as the options make them vary).
+void cli_view_record(const cli_view_opts* v, const cli_view* view, struct cJSON* e);
+// Append the render options that make a view again to a recipe (fields in braces: {azimuth},
+// {elevation}, {eye}, {lookat}, {up}, {light}, {sky}, {floor}, arrays written A,B,...).
+void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
+
 // Subcommands.
+int cli_harvest(int argc, char** argv);
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);
 int cli_dataset(int argc, char** argv);

@@ -47,7 +47,8 @@ static const char* dataset_usage =
     "      --shard I/N       make only items i with i mod N = I (0 <= I < N): one shard of a\n"
     "                        Slurm job array or of mpirun ranks (examples/dataset_*.sh)\n"
     "      --vary NAME=A:B   set the .lpy global NAME to a value drawn uniformly in [A, B] for\n"
-    "                        each item (repeatable); the value is in the item's record\n"
+    "                        each item (repeatable); integer bounds (8:24) draw integers, write\n"
+    "                        8.0:24 for real values; the value is in the item's record\n"
     "      --images N        also N pictures of each plant from around it (colour, depth and label\n"
     "                        and instance masks, camera JSON: item_000000_view0.png, ...), seeded\n"
     "                        by the item; needs an OpenGL context (EGL, software without a GPU)\n"
@@ -58,6 +59,7 @@ static const char* dataset_usage =
 typedef struct vary {
   char name[64];
   double a, b;
+  int integer;  // both bounds written as integers: draw integers in [a, b]
 } vary;
 
 typedef struct dataset {
@@ -70,8 +72,11 @@ typedef struct dataset {
   int instance_labels; // --labels instance: every item has its own label table
   char params[17];     // hex FNV-1a of the arguments that shape the output
   cJSON* arguments;    // those arguments
+  int argc;            // the command line (for the regenerate recipes)
+  char** argv;
   int images;          // --images: views per item
   int img_w, img_h;    // --image-size (pixels)
+  cli_view_opts view;  // the pictures' options (cli_views.c)
 } dataset;
 
 // Renderers shared by the worker threads, one thread at a time (an OpenGL context is current on
@@ -81,6 +86,7 @@ typedef struct render_pool {
   vd_renderer* r[POOL_MAX]; // renderers (n), NULL until first needed
   int geoms[POOL_MAX];      // their max_geoms
   int busy[POOL_MAX];       // 1 while a thread holds it
+  vd_render_look look0[POOL_MAX]; // their look as made (views vary from it)
   int n;
 } render_pool;
 
@@ -100,8 +106,16 @@ static uint64_t item_seed(const dataset* ds, int i, double* values) {
   vd_rng r;
   vd_rng_stream(&r, ds->master, (uint64_t)i);
   uint64_t hi = vd_rng_u32(&r), lo = vd_rng_u32(&r);
-  for (int k = 0; k < ds->nvary; k++)
-    values[k] = vd_rng_uniform(&r, ds->vary[k].a, ds->vary[k].b);
+  for (int k = 0; k < ds->nvary; k++) {
+    const vary* v = &ds->vary[k];
+    if (v->integer) {
+      // one draw either way, so the stream stays the same for the other values
+      double x = v->a + floor(vd_rng_uniform(&r, 0, 1) * (v->b - v->a + 1));
+      values[k] = x > v->b ? v->b : x;
+    } else {
+      values[k] = vd_rng_uniform(&r, v->a, v->b);
+    }
+  }
   return ((hi << 32) | lo) & ((1ull << 53) - 1);  // below 2^53: exact as a JSON number
 }
 
@@ -258,10 +272,12 @@ static vd_status pool_take(render_pool* p, const dataset* ds, int geoms, int* sl
   vd_render_def def = vd_render_def_default();
   def.width = ds->img_w, def.height = ds->img_h;
   def.legend = 0;  // training images: nothing drawn over the scene
+  cli_view_def(&ds->view, &def);
   if (geoms > def.max_geoms) def.max_geoms = geoms;
   p->geoms[s] = def.max_geoms;
   vd_status st = vd_render_create(&def, &p->r[s], err);
   if (st) p->busy[s] = 0;
+  if (!st) p->look0[s] = vd_render_get_look(p->r[s]);
   return st;
 }
 
@@ -295,9 +311,13 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
   int slot = -1;
   if (!st) st = pool_take(pool, ds, m->ninstance + 16, &slot, err);
   vd_renderer* r = slot >= 0 ? pool->r[slot] : NULL;
+  vd_render_look look0 = {0};
   if (!st) {
+    vd_render_style style = vd_render_style_default();
+    style.palette = ds->view.palette;
     vd_render_clear(r);
-    st = vd_render_add_plant(r, m, NULL, NULL, err);
+    look0 = pool->look0[slot];
+    st = vd_render_add_plant(r, m, NULL, &style, err);
   }
   cJSON* views = cJSON_AddArrayToObject(rec, "images");
   if (!st && !views) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
@@ -305,21 +325,23 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
   vd_rng_stream(&g, seed, VIEW_STREAM);
   double az0 = vd_rng_uniform(&g, -180, 180);
   for (int v = 0; !st && v < ds->images; v++) {
-    double az = fmod(az0 + 360.0 * v / ds->images + 180, 360) - 180, el = vd_rng_uniform(&g, 10, 40);
+    // the view: elevation, distance, offset, lights and colours drawn from the stream
+    double az = fmod(az0 + 360.0 * v / ds->images + 180, 360) - 180;
     vd_vec3 lo, hi;
     vd_render_bounds(r, &lo, &hi);
-    vd_camera cam = vd_camera_preset(VD_CAMERA_ORBIT, az * VD_PI / 180, el * VD_PI / 180, lo, hi, ds->img_w, ds->img_h);
+    cli_view view;
+    cli_view_draw(&ds->view, &g, az, lo, hi, ds->img_w, ds->img_h, look0, &view);
+    if (ds->view.vary_light || ds->view.vary_background) st = vd_render_set_look(r, &view.look, err);
     vd_frame f;
     char base[64], path[4200];
     snprintf(base, sizeof base, "item_%0*d_view%d", ds->width, i, v);
     snprintf(path, sizeof path, "%s/%s.png", ds->dir, base);
-    st = vd_render_draw(r, &cam, VD_LAYER_ALL, &f, err);
+    if (!st) st = vd_render_draw(r, &view.cam, VD_LAYER_ALL, &f, err);
     if (!st) st = cli_frame_write(&f, path, 1, 1, err);
     if (st) break;
     cJSON* e = cJSON_CreateObject();
     cJSON_AddNumberToObject(e, "view", v);
-    cJSON_AddNumberToObject(e, "azimuth", az);
-    cJSON_AddNumberToObject(e, "elevation", el);
+    cli_view_record(&ds->view, &view, e);
     static const char* roles[5][2] = {{"color", "png"}, {"depth", "depth.png"}, {"label", "label.png"},
                                       {"instance", "instance.png"}, {"camera", "png.json"}};
     for (int k = 0; k < 5; k++) {
@@ -457,6 +479,88 @@ static void exact_numbers(cJSON* rec) {
   }
 }
 
+// The command that makes one item's cloud again, as an argument list with the item's fields in
+// braces ({seed}, {vary.NAME}): `verdant cloud` with the plant, the item's seed and --vary
+// values, and every plant and cloud option of the dataset's command line (found with the same
+// parsers) but those the dataset sets itself (--seed) or that do not change the bytes
+// (--threads, --no-progress); images: the `verdant render` command of one view.
+static cJSON* recipe(const dataset* ds, const char* plant, int images) {
+  cJSON* a = cJSON_CreateArray();
+  if (!a) return NULL;
+  const char* head[] = {"verdant", images ? "render" : "cloud", plant, "--seed", "{seed}"};
+  for (size_t k = 0; k < sizeof head / sizeof *head; k++) cJSON_AddItemToArray(a, cJSON_CreateString(head[k]));
+  for (int k = 0; k < ds->nvary; k++) {
+    char buf[96];
+    snprintf(buf, sizeof buf, "%s={vary.%s}", ds->vary[k].name, ds->vary[k].name);
+    cJSON_AddItemToArray(a, cJSON_CreateString("--set"));
+    cJSON_AddItemToArray(a, cJSON_CreateString(buf));
+  }
+  cli_plant_opts po;
+  cli_cloud_opts co;
+  cli_plant_opts_init(&po);
+  cli_cloud_opts_init(&co);
+  for (int i = 1; i < ds->argc; i++) {
+    int i0 = i, r = cli_plant_opt(&po, "dataset", ds->argc, ds->argv, &i), cloud = 0;
+    if (r == 0) r = cli_cloud_opt(&co, "dataset", ds->argc, ds->argv, &i), cloud = 1;
+    if (r <= 0) {
+      // the dataset's own options: skip their values
+      int takes = 0;
+      const char* o = ds->argv[i];
+      static const char* with_value[] = {"-K", "--count", "-o", "--output", "--format", "--jobs", "--shard",
+                                         "--vary", "--images", "--image-size", "--palette", "--supersample",
+                                         "--view-elevation", "--view-distance", "--view-jitter"};
+      for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++) takes |= !strcmp(o, with_value[k]);
+      i += takes;
+      continue;
+    }
+    const char* o = ds->argv[i0];
+    if (!strcmp(o, "--seed") || !strcmp(o, "--no-progress") || !strcmp(o, "--threads")) continue;
+    // pictures take the plant options; clouds the cloud options too
+    if (images && cloud) continue;
+    for (int k = i0; k <= i; k++) cJSON_AddItemToArray(a, cJSON_CreateString(ds->argv[k]));
+  }
+  if (images) {
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", ds->img_w, ds->img_h);
+    cli_view_recipe(&ds->view, a);
+    const char* tail[] = {"--size", size, "--no-legend", "--depth", "--masks", "-o", "view.png"};
+    for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) cJSON_AddItemToArray(a, cJSON_CreateString(tail[k]));
+  } else {
+    char out[32];
+    snprintf(out, sizeof out, "item.%s", ds->ext);
+    cJSON_AddItemToArray(a, cJSON_CreateString("-o"));
+    cJSON_AddItemToArray(a, cJSON_CreateString(out));
+  }
+  return a;
+}
+
+// the recipe as one shell line (arguments quoted where they need it)
+static cJSON* recipe_line(const cJSON* a) {
+  size_t cap = 64, n = 0;
+  const cJSON* e;
+  cJSON_ArrayForEach(e, a) cap += 3 * strlen(e->valuestring) + 3;
+  char* buf = vd_malloc(cap);
+  if (!buf) return NULL;
+  buf[0] = 0;
+  cJSON_ArrayForEach(e, a) {
+    const char* v = e->valuestring;
+    int plain = *v != 0;
+    for (const char* c = v; *c; c++)
+      plain &= !!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=.,:/{}@%", *c);
+    n += (size_t)snprintf(buf + n, cap - n, "%s%s", n ? " " : "", plain ? "" : "'");
+    for (const char* c = v; *c && n + 5 < cap; c++) {
+      if (*c == '\'' && !plain)
+        n += (size_t)snprintf(buf + n, cap - n, "'\\''");
+      else
+        buf[n++] = *c, buf[n] = 0;
+    }
+    if (!plain) n += (size_t)snprintf(buf + n, cap - n, "'");
+  }
+  cJSON* s = cJSON_CreateString(buf);
+  vd_free(buf, cap);
+  return s;
+}
+
 // put ",\n\t\"key\":\t<value>" on f (value printed compactly, then deleted)
 static int put_field(FILE* f, int* first, const char* key, cJSON* value) {
   char* text = value ? cJSON_PrintUnformatted(value) : NULL;
@@ -540,9 +644,13 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
     }
   }
   ok &= put_field(fp, &first, "parameters", par);
-  ok &= put_field(fp, &first, "regenerate",
-                  cJSON_CreateString("verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
-                                     "<parameters.arguments> -o item.<cloud_format>"));
+  // how to make an item again: the argument list, {seed} and {vary.NAME} from the item's record
+  cJSON* regen = recipe(ds, po->path, 0);
+  ok &= regen != NULL;
+  if (regen) {
+    ok &= put_field(fp, &first, "regenerate", recipe_line(regen));
+    ok &= put_field(fp, &first, "regenerate_argv", regen);
+  }
   if (ds->images) {
     cJSON* im = cJSON_CreateObject();
     if (im) {
@@ -551,12 +659,12 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
       cJSON_AddNumberToObject(im, "height", ds->img_h);
       cJSON_AddStringToObject(im, "depth", "16-bit grey PNG, millimetres along the optical axis, 0 = nothing");
       cJSON_AddStringToObject(im, "masks", "16-bit grey PNG ids: label (the labels table), instance; 0 = background");
-      char regen[256];
-      snprintf(regen, sizeof regen,
-               "verdant render PLANT --seed <item seed> [--set NAME=<item vary value>]... --camera "
-               "orbit:<azimuth>:<elevation> --size %dx%d --no-legend --depth --masks -o view.png",
-               ds->img_w, ds->img_h);
-      cJSON_AddStringToObject(im, "regenerate", regen);
+      // one view: {azimuth} and {elevation} from the view's entry in the item's record
+      cJSON* view = recipe(ds, po->path, 1);
+      if (view) {
+        cJSON_AddItemToObject(im, "regenerate", recipe_line(view));
+        cJSON_AddItemToObject(im, "regenerate_argv", view);
+      }
     }
     ok &= put_field(fp, &first, "images", im);
   }
@@ -646,7 +754,30 @@ static int parse_vary(const char* s, vary* v) {
   const char* p = end + 1;
   v->b = strtod(p, &end);
   if (end == p || *end || errno || !isfinite(v->b) || v->b < v->a) return 0;
+  // integer bounds (no point, no exponent, within +-2^53) draw integers
+  char a[64];
+  size_t n = (size_t)(p - 1 - (eq + 1));
+  int64_t ia, ib;
+  snprintf(a, sizeof a, "%.*s", (int)(n < sizeof a ? n : sizeof a - 1), eq + 1);
+  v->integer = cli_parse_i64(a, -(1LL << 53), 1LL << 53, &ia) && cli_parse_i64(p, -(1LL << 53), 1LL << 53, &ib);
   return 1;
+}
+
+// every --vary names a global of the .lpy file; prints and returns EXIT_USAGE if not
+static int check_vary(const dataset* ds, const char* path) {
+  vd_lsystem* ls;
+  vd_error err = {0};
+  vd_status st = vd_lsys_load(path, &ls, &err);
+  if (st) return cli_report("dataset", &err, st);
+  int code = 0;
+  for (int k = 0; k < ds->nvary && !code; k++) {
+    vd_error e = {0};
+    if (vd_lsys_set_global(ls, ds->vary[k].name, "0", &e) == VD_ERR_NAME)
+      code = cli_usage_error("dataset", "--vary %s: %s defines no global '%s'", ds->vary[k].name, path,
+                             ds->vary[k].name);
+  }
+  vd_lsys_destroy(ls);
+  return code;
 }
 
 // options that do not change what an item holds: left out of the parameter id
@@ -670,6 +801,8 @@ int cli_dataset(int argc, char** argv) {
   memset(&ds, 0, sizeof ds);
   ds.jobs = 1, ds.nshard = 1, ds.ext = "ply", ds.count = -1;
   ds.img_w = 640, ds.img_h = 480;
+  cli_view_opts_init(&ds.view);
+  ds.argc = argc, ds.argv = argv;
   int image_size_given = 0;
   ds.progress = po.progress;
   int stats = 0;
@@ -677,6 +810,7 @@ int cli_dataset(int argc, char** argv) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       fputs(dataset_usage, stdout);
+      fputs(cli_view_help, stdout);
       fputs(cli_cloud_help, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;
@@ -685,6 +819,9 @@ int cli_dataset(int argc, char** argv) {
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     r = cli_cloud_opt(&co, "dataset", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    r = cli_view_opt(&ds.view, "dataset", argc, argv, &i);
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     const char* val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -741,7 +878,13 @@ int cli_dataset(int argc, char** argv) {
   if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
+  if (co.has_cloud_seed)
+    return cli_usage_error("dataset", "--cloud-seed does not apply to a dataset: each item's cloud is seeded by its "
+                           "item seed (from --seed)");
   if (image_size_given && !ds.images) return cli_usage_error("dataset", "--image-size goes with --images N");
+  if (ds.view.given && !ds.images)
+    return cli_usage_error("dataset", "the picture options (--no-shadows, --palette, --view-*, --vary-light, "
+                                      "--vary-background, ...) go with --images N");
   // no output may replace an input: the dataset writes manifest.json and item_* in DIR
   const char* ins[2] = {po.path, co.scanners_file};
   for (int k = 0; k < 2; k++) {
@@ -771,7 +914,12 @@ int cli_dataset(int argc, char** argv) {
   }
   h = fnv1a(h, ds.ext, strlen(ds.ext) + 1);
   snprintf(ds.params, sizeof ds.params, "%016llx", (unsigned long long)h);
-  if (mkdir(ds.dir, 0777) != 0 && errno != EEXIST) {
+  if (ds.nvary && check_vary(&ds, po.path)) {
+    cJSON_Delete(ds.arguments);
+    return EXIT_USAGE;
+  }
+  int made_dir = mkdir(ds.dir, 0777) == 0;
+  if (!made_dir && errno != EEXIST) {
     cJSON_Delete(ds.arguments);
     fprintf(stderr, "verdant dataset: %s: cannot create the folder: %s\n", ds.dir, strerror(errno));
     return EXIT_FAIL;
@@ -819,6 +967,7 @@ int cli_dataset(int argc, char** argv) {
       vd_free(todo, (size_t)ds.count * sizeof(int));
       cJSON_Delete(ds.arguments);
       cli_report("dataset", &first, st);
+      if (made_dir) rmdir(ds.dir);
       return EXIT_FAIL;
     }
     pool_put(&pool, slot);
@@ -857,6 +1006,7 @@ int cli_dataset(int argc, char** argv) {
     char buf[1024];
     fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
             first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
+    if (made_dir) rmdir(ds.dir);  // a folder made for a dataset that failed goes when empty
     // writing the dataset failed (disk full, unwritable) or memory ran out: a failed run;
     // anything else is bad input
     return failed_output || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);

@@ -57,6 +57,8 @@ enum {
   B_RANDOM, B_UNIFORM, B_GAUSS, B_NORMALVARIATE, B_RANDINT, B_RANDRANGE, B_SEED,
   B_TRIANGULAR, B_EXPOVARIATE,
   B_GETITERATIONNB, B_USEGROUP, B_GETGROUP, B_STOP, B_PRINT_UNUSED,
+  B_BACKWARD, B_FORWARD, B_ISFORWARD, B_FRAMEDISPLAY, B_ISFRAMEDISPLAYED, B_ISANIMATIONENABLED,
+  B_DISCARDNEWSTRING,
   B_COUNT
 };
 
@@ -117,6 +119,13 @@ static const builtin builtins[B_COUNT] = {
     [B_GETGROUP] = {"getGroup", 0, 0, 0},
     [B_STOP] = {"Stop", 0, 0, 0},
     [B_PRINT_UNUSED] = {"", 99, 99, -1},
+    [B_BACKWARD] = {"backward", 0, 0, 0},
+    [B_FORWARD] = {"forward", 0, 0, 0},
+    [B_ISFORWARD] = {"isForward", 0, 0, 0},
+    [B_FRAMEDISPLAY] = {"frameDisplay", 0, 1, 0},
+    [B_ISFRAMEDISPLAYED] = {"isFrameDisplayed", 0, 0, 0},
+    [B_ISANIMATIONENABLED] = {"isAnimationEnabled", 0, 0, 0},
+    [B_DISCARDNEWSTRING] = {"DiscardNewString", 0, 0, 0},
 };
 
 int builtin_find(const char* name, int len) {
@@ -156,6 +165,7 @@ static const char* type_name(value v) {
     case V_FUNC: return "function";
     case V_BUILTIN: return "builtin function";
     case V_NS: return "module";
+    case V_OBJ: return "object";
     default: return "undefined";
   }
 }
@@ -212,6 +222,9 @@ vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col
 value param_to_value(double d) {
   int sid = lsys_unbox_str(d);
   if (sid >= 0) return (value){V_STR, sid};
+  uint32_t oid;
+  unsigned epoch;
+  if (isnan(d) && lsys_unbox_obj(d, &oid, &epoch)) return (value){V_OBJ, oid};
   if (d == floor(d) && fabs(d) < 9007199254740992.0) return v_int(d);
   return v_num(d);
 }
@@ -388,6 +401,21 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
     case B_GETGROUP: *out = v_int(ls->current_group); break;
     case B_STOP:
       ls->stop_requested = 1;
+      *out = (value){V_NONE, 0};
+      break;
+    // derivation direction: backward() takes effect at the next step (L-Py)
+    case B_BACKWARD:
+    case B_FORWARD:
+      ls->backward = b == B_BACKWARD;
+      *out = (value){V_NONE, 0};
+      break;
+    case B_ISFORWARD: *out = (value){V_BOOL, !ls->backward}; break;
+    // the scene is made once, after the last step: frameDisplay() has nothing to change
+    case B_FRAMEDISPLAY: *out = (value){V_NONE, 0}; break;
+    case B_ISFRAMEDISPLAYED: *out = (value){V_BOOL, ls->frame_displayed}; break;
+    case B_ISANIMATIONENABLED: *out = (value){V_BOOL, 0}; break;
+    case B_DISCARDNEWSTRING:
+      ls->discard_requested = 1;
       *out = (value){V_NONE, 0};
       break;
     default: return vm_error(ls, VD_ERR_UNSUPPORTED, line, col, "unsupported builtin");
@@ -577,6 +605,9 @@ vd_status vm_eval(vd_lsystem* ls, const expr* e, value* frame, value* out) {
       if (vm_eval(ls, e->b, frame, &a)) return ls->err->status;
       return vm_eval(ls, value_truthy(a) ? e->a : e->c, frame, out);
     case E_CALL: return eval_call(ls, e, frame, out);
+    case E_PYSRC:
+      if (ls->py) return lsys_py_eval(ls, e, out);
+      return vm_error(ls, VD_ERR_UNSUPPORTED, e->line, e->col, "unsupported: Python source outside the Python engine");
     case E_ATTR: {
       if (vm_eval(ls, e->a, frame, &a)) return ls->err->status;
       const char* attr = ls->str[e->slot];
@@ -608,6 +639,7 @@ enum { FLOW_NONE = 0, FLOW_BREAK, FLOW_CONTINUE, FLOW_RETURN };
 
 typedef struct exec_state {
   vm_out* out;
+  int in_func;   // a def's body: produce emits and returns from the def (L-Py's pproduce)
   int flow;
   value ret;
 } exec_state;
@@ -732,8 +764,18 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
       case S_PRODUCE:
       case S_NPRODUCE:
         if (!X->out)
-          return vm_error(ls, VD_ERR_SYNTAX, s->line, s->col, "'produce' called outside a rule or the axiom");
+          return vm_error(ls, VD_ERR_SYNTAX, s->line, s->col,
+                          "'%s' called where no L-string is being written (outside a rule, the axiom or a hook "
+                          "that produces)",
+                          s->op == S_PRODUCE ? "produce" : "nproduce");
         if (vm_emit_tmpl(ls, s->t, frame, X->out)) return ls->err->status;
+        if (s->op == S_PRODUCE && X->in_func) {
+          // in a def, produce adds to what the rule produces and returns from the def
+          X->out->nproduced = 1;
+          X->flow = FLOW_RETURN;
+          X->ret = (value){V_NONE, 0};
+          return VD_OK;
+        }
         if (s->op == S_PRODUCE) {
           X->out->produced = 1;
           X->flow = FLOW_RETURN;
@@ -782,8 +824,12 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
 }
 
 vd_status vm_exec_block(vd_lsystem* ls, stmt* s, value* frame, vm_out* out, int* returned, value* retval) {
-  exec_state X = {out, FLOW_NONE, {V_NONE, 0}};
+  exec_state X = {out, 0, FLOW_NONE, {V_NONE, 0}};
+  // defs called from here (nproduce in a helper) write where this block writes
+  vm_out* outer = ls->cur_out;
+  ls->cur_out = out;
   vd_status st = exec_list(ls, s, frame, &X);
+  ls->cur_out = outer;
   if (returned) *returned = X.flow == FLOW_RETURN;
   if (retval) *retval = X.ret;
   return st;
@@ -808,8 +854,8 @@ vd_status vm_call_func(vd_lsystem* ls, int fi, int nargs, const value* args, val
   for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
   for (int i = 0; i < nargs; i++) frame[i] = args[i];
   ls->call_depth++;
-  // produce inside a function called from a rule is not part of the subset
-  exec_state X = {NULL, FLOW_NONE, {V_NONE, 0}};
+  // produce / nproduce inside a def write to the string of the rule (or hook) that called it
+  exec_state X = {ls->cur_out, 1, FLOW_NONE, {V_NONE, 0}};
   vd_status st = exec_list(ls, f->body, frame, &X);
   ls->call_depth--;
   *ret = X.ret;

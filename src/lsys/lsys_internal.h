@@ -18,7 +18,8 @@ typedef enum vtype {
   V_FUNC,     // n = user function index
   V_BUILTIN,  // n = builtin id
   V_NS,       // n = namespace id (NS_MATH, NS_RANDOM)
-  V_UNDEF     // a global slot that has no value yet
+  V_UNDEF,    // a global slot that has no value yet
+  V_OBJ       // n = a boxed Python object handle (the Python engine's object table)
 } vtype;
 
 typedef struct value {
@@ -52,7 +53,8 @@ typedef enum eop {
   E_COND,      // a if b else c: a = then, b = cond, c = else
   E_CALL,      // fn(args): a = callee expression
   E_BUILTIN,   // direct builtin call: slot = builtin id
-  E_ATTR       // namespace attribute (math.pi): k holds the resolved value
+  E_ATTR,      // namespace attribute (math.pi): k holds the resolved value
+  E_PYSRC      // Python engine: source text of an expression, k = its string id (V_STR)
 } eop;
 
 enum { CMP_LT, CMP_LE, CMP_GT, CMP_GE, CMP_EQ, CMP_NE };
@@ -81,6 +83,7 @@ typedef struct tmpl {
   int n;
   tmod* mod;
   int has_cut;  // contains %
+  int drop;     // starts with `*`: L-Py discards the whole production (deletes the module)
 } tmpl;
 
 typedef enum sop {
@@ -108,6 +111,7 @@ typedef struct stmt {
 // A user function (def).
 typedef struct func {
   char name[64];
+  int discard_wrapped;  // decorated with @enable_string_discard (L-Py's __lpyfuture__)
   int nparam;
   int nlocal;
   stmt* body;
@@ -117,29 +121,76 @@ typedef struct func {
 // ---------------------------------------------------------------------------------------------
 // rules
 
-// One module of a predecessor or context pattern. sym VD_SYM_SB/EB mark explicit brackets.
+// Kinds of pattern elements (L-Py's pattern modules).
+enum {
+  PK_MOD = 0,  // a module: same symbol and parameter count (brackets included)
+  PK_ANY,      // `*`: any module; `*(name, x, ...)` binds the name and the parameters
+  PK_REP,      // `x(pattern [, min [, max]])`: repetition of a sub-pattern
+  PK_OR,       // `or(pattern, pattern, ...)`: the first alternative that matches
+  PK_NONE,     // `None` (inside or()): matches nothing
+};
+
+struct pstr;
+
+// One element of a predecessor or context pattern.
 typedef struct pmod {
-  int32_t sym;
-  int nparam;
-  int* slot;      // binding slot per parameter, -1 when the parameter is a constant
-  value* cval;    // constant value per parameter (when slot is -1)
+  int32_t sym;     // PK_MOD: symbol (VD_SYM_SB / VD_SYM_EB for explicit brackets)
+  int nparam;      // PK_MOD: parameters; PK_ANY: parameters after the name
+  int* slot;       // binding slot per parameter, -1 when the parameter is a constant
+  value* cval;     // constant value per parameter (when slot is -1)
+  int kind;        // PK_*
+  int exact;       // `=]`: the closing bracket must come next (no skip to the branch end)
+  struct pext* x;  // PK_ANY with a name, PK_REP, PK_OR: the rest (NULL otherwise)
   int line, col;
 } pmod;
+
+// What a few pattern elements need beyond a module.
+typedef struct pext {
+  int has_name;    // PK_ANY: written with parameters, the first one is the module name
+  int name_slot;   // PK_ANY: slot of the name, -1 when the name is a constant (name_val)
+  value name_val;  // PK_ANY: constant name (a string)
+  struct pstr* sub;  // PK_REP: the repeated pattern (sub[0]); PK_OR: the alternatives
+  int nsub;
+  int rmin, rmax;  // PK_REP: repetitions allowed
+} pext;
+
+// A pattern: a string of pattern elements.
+typedef struct pstr {
+  int n;
+  pmod* m;
+} pstr;
 
 enum { SEC_PRODUCTION = 0, SEC_DECOMPOSITION = 1, SEC_INTERPRETATION = 2, SEC_COUNT = 3 };
 
 typedef struct rule {
-  int section;    // SEC_*
-  int group;      // rule group (0 = always active)
-  int npred, nleft, nright;
-  pmod* pred;     // strict predecessor (npred modules)
-  pmod* left;     // left context in reading order (nleft)
-  pmod* right;    // right context (nright)
+  // what the rewriting loop reads first
+  pstr pred;      // strict predecessor
+  pstr left;      // left context `<`, in reading order
+  pstr right;     // right context `>`
+  int simple;     // only plain modules, no new contexts, no bracket outside the right context:
+                  // the fast matcher applies (axial-tree matching, forward)
   int nlocal;     // frame size (pattern variables + body locals)
   tmpl* succ;     // one-line successor (NULL when the rule has a body)
   stmt* body;     // rule body
+  int filter;     // consider/ignore filter in force where the rule was written (-1: none)
+  // the rest
+  pstr nleft;     // new left context `<<` (forward derivation only)
+  pstr nright;    // new right context `>>` (backward derivation only)
+  int section;    // SEC_*
+  int group;      // rule group (0 = always active)
+  int is_static;  // -static-> / @static: L-Py evaluates the successor once
   int line;
+  int pyfn;       // Python engine: index of the rule's function (lsys_py.c), -1 native
 } rule;
+
+// A consider:/ignore: filter: the symbols listed, and whether they are ignored or the only
+// ones considered (brackets are always considered).
+typedef struct cfilter {
+  int mode;          // 1 ignore the listed symbols, 2 consider only them
+  int32_t* syms;     // (nsyms)
+  int nsyms;
+  unsigned char* ignored;  // per symbol, built at derive time (rule_index_nsym)
+} cfilter;
 
 // ---------------------------------------------------------------------------------------------
 // the lsystem
@@ -152,6 +203,8 @@ typedef struct symtab {
   int hcap;
   int maxlen;         // longest predefined or declared name (for longest match)
   unsigned char* declared;  // 1 when the name takes part in longest-match tokenising (n)
+  int* canon;         // the symbol a name stands for: itself, or the short name of an alias (n)
+  int cap_canon;      // capacity of canon
 } symtab;
 
 typedef struct global_def {
@@ -160,12 +213,27 @@ typedef struct global_def {
   int has_override;
 } global_def;
 
+// A logical line of the file: physical lines joined while brackets are open (parser, Python engine).
+typedef struct lsys_line {
+  const char* s;  // text without the indentation
+  int len;
+  int lineno;     // 1-based physical line where it starts
+  int col0;       // 1-based column of s[0]
+  int indent;     // indentation width (tabs to multiples of 8)
+  int blank;      // only whitespace or a comment
+  int lastline;   // physical line where it ends
+} lsys_line;
+
+// The engines that run a file's Python (vd_lsys_engine without AUTO).
+typedef struct lsys_py lsys_py;
+
 typedef struct toplevel {
   stmt* body;  // top-level statements in file order
 } toplevel;
 
-struct vd_lsystem {
+struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields grouped by meaning; one per model
   char file[256];
+  lsys_py* py;             // Python engine state (NULL for the native engine)
   vd_arena arena;          // all parse structures
   symtab syms;
   // strings
@@ -187,19 +255,35 @@ struct vd_lsystem {
   tmpl* axiom;             // line axiom (or NULL)
   stmt* axiom_body;        // functional axiom (or NULL)
   int axiom_nlocal;
+  int engine;              // VD_LSYS_NATIVE or VD_LSYS_PYTHON
   expr* derivation_length; // NULL = 1
-  int max_depth[SEC_COUNT];  // maximum depth for decomposition / interpretation
+  expr* max_depth_expr[SEC_COUNT];  // `maximum depth:` of decomposition / interpretation (NULL = 1)
+  int max_depth[SEC_COUNT];  // its value in this run
   int nrule, caprule;
   rule** rules;
-  // rules indexed by predecessor's first symbol, per section: ruleidx[sec][sym] -> list
-  int* rule_first[SEC_COUNT];   // start index into rule_list (nsym + 1), built at derive time
-  int* rule_list[SEC_COUNT];
+  // the rules that apply, per section, indexed by the predecessor's first symbol (last symbol
+  // when deriving backward): rule_list[rule_first[sym]] .. rule_list[rule_first[sym + 1] - 1],
+  // rules of the active group first, then those of group 0, each in file order; `*` rules are
+  // in every list. Rebuilt when the group, the direction or the symbol count changes.
+  int* rule_first[SEC_COUNT];   // (rule_index_nsym + 1)
+  int* rule_list[SEC_COUNT];    // (rule_list_cap[sec])
+  int rule_list_cap[SEC_COUNT];
   int rule_index_nsym;
-  int has_context[SEC_COUNT];
-  unsigned char* ignored;  // 1 for symbols skipped in context matching (nsym)
-  int ignore_mode;         // 0 none, 1 ignore list, 2 consider list
-  int32_t* ignore_syms;
-  int nignore_syms;
+  int rule_index_group, rule_index_dir;  // what the index was built for
+  int has_context[SEC_COUNT];   // some rule of the index reads a context (brackets matched)
+  int has_generic[SEC_COUNT];   // some rule of the index needs the general matcher
+  int has_query[SEC_COUNT];     // some rule of the index has a query module (?P ...) in a pattern
+  int nfilter, capfilter;
+  cfilter* filters;             // consider/ignore filters (nfilter)
+  unsigned char* no_filter;     // all zero: what a rule without filter ignores (ign_nsym + 1)
+  int ign_nsym;                 // symbols covered by the ignored tables
+  int cur_filter;               // filter in force while parsing (-1 none)
+  // L-Py options (INITIALISATION block or run time)
+  int opt_string_matching;      // 0 as string, 1 as axial tree (default)
+  int opt_early_return;         // 1: the derivation ends after a step where no rule matched
+  int opt_module_matching;      // 0 simple, 1 with *args, 2 with value constraints (default)
+  int opt_axiom_decomposition;  // 1: the axiom is decomposed before the first step
+  int has_bases;                // a module declaration names base modules (inheritance)
   // labels declared by the file
   int nlabel;
   int* label_id;
@@ -216,10 +300,15 @@ struct vd_lsystem {
   int current_group;
   int iteration;
   int stop_requested;
+  int backward;            // derive right to left (backward()); new right contexts apply
+  int frame_displayed;     // the step is the last one (L-Py draws a frame then)
+  int discard_requested;   // DiscardNewString(): the step's result is dropped
   int call_depth;
+  int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
   int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
+  struct vm_out* cur_out;  // where produce writes in the rule body (or hook) being run, NULL outside
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -228,6 +317,10 @@ struct vd_lsystem {
 // symbol table
 int sym_intern(vd_lsystem* ls, const char* name, int len, int declared);
 int sym_find(const vd_lsystem* ls, const char* name, int len);
+// Register `alias` (a long name such as "Left") as another spelling of symbol `canon`.
+int sym_alias(vd_lsystem* ls, const char* alias, int canon);
+// The symbol a name id stands for (aliases resolve to their short name).
+static inline int sym_canon(const vd_lsystem* ls, int id) { return ls->syms.canon[id]; }
 #define LSYS_MAX_STR_BYTES (64 << 20)  // all strings of an lsystem together (bytes)
 // Id of a string, added when new; -1 out of memory, -2 over LSYS_MAX_STR_BYTES.
 int str_intern(vd_lsystem* ls, const char* s, int len);
@@ -235,15 +328,23 @@ int str_intern(vd_lsystem* ls, const char* s, int len);
 vd_status str_intern_error(vd_lsystem* ls, int id, int line, int col);
 double lsys_box_str(int id);
 int lsys_unbox_str(double v);
+// Python engine objects in L-strings: NaN-boxed handles (slot id and epoch) into lsys_py's table.
+double lsys_box_obj(uint32_t id, unsigned epoch);
+int lsys_unbox_obj(double v, uint32_t* id, unsigned* epoch);
 int global_slot(vd_lsystem* ls, const char* name, int len, int create);
 
 // lstring building (int64 capacities, max_modules limit)
 int lstr_reserve(vd_lstring* s, int64_t nmod, int64_t nval);
 void lstr_clear(vd_lstring* s);
 int lstr_enable_src(vd_lstring* s);
+// Copy src into dst (dst's arrays reused; src indices copied when src has them); 0 out of memory.
+int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src);
 
 // parser
 vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len);
+// parse text with one engine (VD_LSYS_NATIVE or VD_LSYS_PYTHON) into a new lsystem
+vd_status lsys_parse_with(const char* text, size_t len, const char* name, int engine, vd_lsystem** out,
+                          vd_error* err);
 expr* lsys_parse_expr_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 tmpl* lsys_parse_tmpl_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 
@@ -261,6 +362,69 @@ typedef struct vm_out {
   int produced;        // a produce ran (body finished)
   int nproduced;       // an nproduce ran
 } vm_out;
+
+// ---------------------------------------------------------------------------------------------
+// rewriting (lsys_rewrite.c) and matching (lsys_match.c)
+
+// What one rule match reads: the string rewritten, its bracket match, the string being written
+// (for new contexts), the direction and the per-filter tables of ignored symbols.
+typedef struct lsys_mctx {
+  vd_lsystem* ls;
+  const vd_lstring* src;        // the string read
+  const int64_t* match;         // Nullable: bracket match of src
+  const vd_lstring* dest;       // the string written so far (back to front when backward)
+  int backward;                 // right-to-left pass: predecessors are matched ending at i
+  int string_mode;              // L-Py's "String matching: As String" option
+  unsigned char* const* ignored;  // [filter + 1]: ignored symbols of each filter ([0]: none)
+  int nsym;                     // size of each ignored table
+} lsys_mctx;
+
+// Scratch of the recursive rewriting, one per depth.
+typedef struct lsys_level {
+  vd_lstring buf;      // what the rule at this depth produced
+  int64_t* match;      // bracket match of the string read at this depth
+  int64_t match_cap;
+} lsys_level;
+
+// Scratch of the passes of one run.
+typedef struct lsys_pass {
+  int64_t* match;         // bracket match of the string read by a step
+  int64_t match_cap;
+  int64_t max_modules;    // largest string allowed
+  lsys_level* lvl;        // recursion scratch (nlvl)
+  int nlvl, caplvl;
+  unsigned char** ignored;  // per-filter tables handed to the matcher (cap_ignored)
+  int cap_ignored;
+  vd_lstring saved;       // the string at the end of the previous step (DiscardNewString)
+  int64_t identity_bit;   // LSYS_SRC_IDENTITY in a query pass: marks modules copied unchanged
+  vd_lstring geo;         // the interpreted string of a query pass (with source indices)
+} lsys_pass;
+
+// (Re)build the rule index for a group and a direction (no-op when up to date).
+vd_status lsys_build_index(vd_lsystem* ls, int group, int backward);
+// 1 when the section has no rule in the current index.
+int lsys_section_empty(const vd_lsystem* ls, int sec);
+// Bracket match of s: for each '[' its ']' (s->n when unclosed), for each ']' its '[' (-1).
+vd_status lsys_bracket_match(const vd_lstring* s, int64_t** out, int64_t* cap);
+// Append module i of in to out with source index src.
+vd_status lsys_copy_module(vd_lsystem* ls, const vd_lstring* in, int64_t i, vd_lstring* out, int64_t src,
+                           int64_t max_modules);
+// Reverse the order of the modules [a, s->n) of s.
+void lsys_reverse_tail(vd_lstring* s, int64_t a);
+// One parallel step of a section over in, into out (cleared first); *matched = a rule applied.
+vd_status lsys_step(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* out, lsys_pass* P, int* matched);
+// L-Py's recursive rewriting (decomposition, interpretation) of in, appended to out: each
+// production is rewritten again on its own, up to depth levels.
+vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* out, lsys_pass* P, int depth,
+                         int level, int* matched);
+// Free a run's scratch.
+void lsys_pass_free(lsys_pass* P);
+// Run the turtle over s without keeping geometry, writing the turtle's position and frame into
+// the parameters of the query modules ?P ?H ?U ?L ?R of s.
+vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
+#define LSYS_SRC_IDENTITY (INT64_C(1) << 62)  // on a source index: the module was copied unchanged
+// Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
+int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
 
 vd_status vm_exec_block(vd_lsystem* ls, stmt* s, value* frame, vm_out* out, int* returned,
                         value* retval);
@@ -280,5 +444,54 @@ value ns_constant(int ns, const char* name, int len, int* found);
 int value_truthy(value v);
 vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col);
 value param_to_value(double d);
+
+// ---------------------------------------------------------------------------------------------
+// the Python engine (lsys_py.c: CPython bridge and run time; lsys_pysrc.c: the file's Python
+// source). Only these two files include Python.h. Every function below is a no-op or an
+// error for the native engine (ls->py == NULL).
+
+// parse time: the parser hands over the Python parts of the file
+vd_status lsys_py_parse_begin(vd_lsystem* ls, const char* text, size_t len);
+vd_status lsys_py_parse_end(vd_lsystem* ls, size_t init_at);
+// the parameters of a template module, s[*pos] = '(': each an E_PYSRC expression (at most
+// max) into params; *pos moves after the ')'. Returns the count, or -1 with the error set.
+int lsys_py_params(vd_lsystem* ls, const char* s, int len, int* pos, int lineno, int col0,
+                   expr** params, int max);
+// an expression as Python source (E_PYSRC), a trailing comment dropped; NULL with the error set
+expr* lsys_py_expr(vd_lsystem* ls, const char* s, int len, int lineno, int col);
+// evaluate an E_PYSRC expression in the current run's namespace (a number, bool or str)
+vd_status lsys_py_eval(vd_lsystem* ls, const expr* e, value* out);
+// a top-level statement (with its indented block) starting at lines[*li]; advances *li
+vd_status lsys_py_toplevel(vd_lsystem* ls, const lsys_line* lines, int nline, int* li);
+// the body of rule r whose header is lines[*li]: successor r->succ, or the Python after the
+// header's ':' (body_at) and the indented lines below; names: the pattern variables in slot order
+vd_status lsys_py_rule(vd_lsystem* ls, rule* r, const char* const* names, const int* lens,
+                       int nnames, const lsys_line* lines, int nline, int* li, int body_at);
+// the axiom: a template, or the indented block below lines[*li] (advances *li)
+vd_status lsys_py_axiom(vd_lsystem* ls, const tmpl* t, const lsys_line* lines, int nline, int* li);
+// `derivation length:` text
+vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno);
+
+// run time
+void lsys_py_free(vd_lsystem* ls);
+// take the engine (process-wide lock and the GIL) for ls; lsys_py_leave gives it back
+void lsys_py_enter(vd_lsystem* ls);
+void lsys_py_leave(vd_lsystem* ls);
+// run the prologue (trailer, top-level code) in a fresh namespace, random seeded with seed
+vd_status lsys_py_run_toplevel(vd_lsystem* ls, uint64_t seed);
+vd_status lsys_py_dlength_eval(vd_lsystem* ls, int* steps);
+vd_status lsys_py_emit_axiom(vd_lsystem* ls, vm_out* out);
+vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, vm_out* out);
+// call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
+// the current string (an End hook may return a new one). Missing hooks are fine.
+vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
+// drop objects that no module of s refers to any more (after a step)
+void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
+// release every object (a new derivation starts)
+void lsys_py_reset_objects(vd_lsystem* ls);
+vd_status lsys_py_set_global(vd_lsystem* ls, const char* name, const char* text);
+vd_status lsys_py_get_global(vd_lsystem* ls, const char* name, double* out);
+// repr() of an object parameter into buf (cap bytes); "None" for a stale handle
+void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 
 #endif
