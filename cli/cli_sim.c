@@ -700,8 +700,10 @@ int cli_sim(int argc, char** argv) {
     m->opt.wind_series = wind;
     m->opt.nwind = nwind;
     d = vd_sim_data_create(m);
-    if (d) d->profile = o.profile;
-    if (!d) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (!d)
+      st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    else
+      d->profile = o.profile;
   }
   // organs to pull, colliders
   for (int k = 0; !st && k < o.npull; k++) {

@@ -21,7 +21,8 @@ typedef struct heap {
 } heap;
 
 static int above(const heap* h, int a, int b) {
-  return h->key[a] > h->key[b] || (h->key[a] == h->key[b] && a < b);
+  int ka = h->key[a], kb = h->key[b];
+  return ka > kb || (ka == kb && a < b);
 }
 
 static void heap_push(heap* h, int x) {
@@ -100,7 +101,7 @@ static void schedule_part(build* b, int part) {
     b->order[b->norder++] = t;
     if (++lanes == SIM_W) close_block(b, lanes, 1), lanes = 0;
   }
-  if (lanes) close_block(b, lanes, 1), lanes = 0;
+  if (lanes) close_block(b, lanes, 1);
   for (int t = 0; t < b->ns; t++)
     if (is_body(m, t) && b->owner[t] == part && b->kstart[t + 1] == b->kstart[t]) release(b, t, part);
   // list scheduling: a block takes the ready bodies farthest from the root; their parents may
