@@ -70,6 +70,8 @@ typedef struct dataset {
   int instance_labels; // --labels instance: every item has its own label table
   char params[17];     // hex FNV-1a of the arguments that shape the output
   cJSON* arguments;    // those arguments
+  int argc;            // the command line (for the regenerate recipes)
+  char** argv;
   int images;          // --images: views per item
   int img_w, img_h;    // --image-size (pixels)
 } dataset;
@@ -457,6 +459,87 @@ static void exact_numbers(cJSON* rec) {
   }
 }
 
+// The command that makes one item's cloud again, as an argument list with the item's fields in
+// braces ({seed}, {vary.NAME}): `verdant cloud` with the plant, the item's seed and --vary
+// values, and every plant and cloud option of the dataset's command line (found with the same
+// parsers) but those the dataset sets itself (--seed) or that do not change the bytes
+// (--threads, --no-progress); images: the `verdant render` command of one view.
+static cJSON* recipe(const dataset* ds, const char* plant, int images) {
+  cJSON* a = cJSON_CreateArray();
+  if (!a) return NULL;
+  const char* head[] = {"verdant", images ? "render" : "cloud", plant, "--seed", "{seed}"};
+  for (size_t k = 0; k < sizeof head / sizeof *head; k++) cJSON_AddItemToArray(a, cJSON_CreateString(head[k]));
+  for (int k = 0; k < ds->nvary; k++) {
+    char buf[96];
+    snprintf(buf, sizeof buf, "%s={vary.%s}", ds->vary[k].name, ds->vary[k].name);
+    cJSON_AddItemToArray(a, cJSON_CreateString("--set"));
+    cJSON_AddItemToArray(a, cJSON_CreateString(buf));
+  }
+  cli_plant_opts po;
+  cli_cloud_opts co;
+  cli_plant_opts_init(&po);
+  cli_cloud_opts_init(&co);
+  for (int i = 1; i < ds->argc; i++) {
+    int i0 = i, r = cli_plant_opt(&po, "dataset", ds->argc, ds->argv, &i), cloud = 0;
+    if (r == 0) r = cli_cloud_opt(&co, "dataset", ds->argc, ds->argv, &i), cloud = 1;
+    if (r <= 0) {
+      // the dataset's own options: skip their values
+      int takes = 0;
+      const char* o = ds->argv[i];
+      static const char* with_value[] = {"-K", "--count", "-o", "--output", "--format", "--jobs", "--shard",
+                                         "--vary", "--images", "--image-size"};
+      for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++) takes |= !strcmp(o, with_value[k]);
+      i += takes;
+      continue;
+    }
+    const char* o = ds->argv[i0];
+    if (!strcmp(o, "--seed") || !strcmp(o, "--no-progress") || !strcmp(o, "--threads")) continue;
+    // pictures take the plant options; clouds the cloud options too
+    if (images && cloud) continue;
+    for (int k = i0; k <= i; k++) cJSON_AddItemToArray(a, cJSON_CreateString(ds->argv[k]));
+  }
+  if (images) {
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", ds->img_w, ds->img_h);
+    const char* tail[] = {"--camera", "orbit:{azimuth}:{elevation}", "--size", size, "--no-legend", "--depth",
+                          "--masks", "-o", "view.png"};
+    for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) cJSON_AddItemToArray(a, cJSON_CreateString(tail[k]));
+  } else {
+    char out[32];
+    snprintf(out, sizeof out, "item.%s", ds->ext);
+    cJSON_AddItemToArray(a, cJSON_CreateString("-o"));
+    cJSON_AddItemToArray(a, cJSON_CreateString(out));
+  }
+  return a;
+}
+
+// the recipe as one shell line (arguments quoted where they need it)
+static cJSON* recipe_line(const cJSON* a) {
+  size_t cap = 64, n = 0;
+  const cJSON* e;
+  cJSON_ArrayForEach(e, a) cap += 3 * strlen(e->valuestring) + 3;
+  char* buf = vd_malloc(cap);
+  if (!buf) return NULL;
+  buf[0] = 0;
+  cJSON_ArrayForEach(e, a) {
+    const char* v = e->valuestring;
+    int plain = *v != 0;
+    for (const char* c = v; *c; c++)
+      plain &= !!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=.,:/{}@%", *c);
+    n += (size_t)snprintf(buf + n, cap - n, "%s%s", n ? " " : "", plain ? "" : "'");
+    for (const char* c = v; *c && n + 5 < cap; c++) {
+      if (*c == '\'' && !plain)
+        n += (size_t)snprintf(buf + n, cap - n, "'\\''");
+      else
+        buf[n++] = *c, buf[n] = 0;
+    }
+    if (!plain) n += (size_t)snprintf(buf + n, cap - n, "'");
+  }
+  cJSON* s = cJSON_CreateString(buf);
+  vd_free(buf, cap);
+  return s;
+}
+
 // put ",\n\t\"key\":\t<value>" on f (value printed compactly, then deleted)
 static int put_field(FILE* f, int* first, const char* key, cJSON* value) {
   char* text = value ? cJSON_PrintUnformatted(value) : NULL;
@@ -540,9 +623,13 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
     }
   }
   ok &= put_field(fp, &first, "parameters", par);
-  ok &= put_field(fp, &first, "regenerate",
-                  cJSON_CreateString("verdant cloud PLANT --seed <item seed> [--set NAME=<item vary value>]... "
-                                     "<parameters.arguments> -o item.<cloud_format>"));
+  // how to make an item again: the argument list, {seed} and {vary.NAME} from the item's record
+  cJSON* regen = recipe(ds, po->path, 0);
+  ok &= regen != NULL;
+  if (regen) {
+    ok &= put_field(fp, &first, "regenerate", recipe_line(regen));
+    ok &= put_field(fp, &first, "regenerate_argv", regen);
+  }
   if (ds->images) {
     cJSON* im = cJSON_CreateObject();
     if (im) {
@@ -551,12 +638,12 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
       cJSON_AddNumberToObject(im, "height", ds->img_h);
       cJSON_AddStringToObject(im, "depth", "16-bit grey PNG, millimetres along the optical axis, 0 = nothing");
       cJSON_AddStringToObject(im, "masks", "16-bit grey PNG ids: label (the labels table), instance; 0 = background");
-      char regen[256];
-      snprintf(regen, sizeof regen,
-               "verdant render PLANT --seed <item seed> [--set NAME=<item vary value>]... --camera "
-               "orbit:<azimuth>:<elevation> --size %dx%d --no-legend --depth --masks -o view.png",
-               ds->img_w, ds->img_h);
-      cJSON_AddStringToObject(im, "regenerate", regen);
+      // one view: {azimuth} and {elevation} from the view's entry in the item's record
+      cJSON* view = recipe(ds, po->path, 1);
+      if (view) {
+        cJSON_AddItemToObject(im, "regenerate", recipe_line(view));
+        cJSON_AddItemToObject(im, "regenerate_argv", view);
+      }
     }
     ok &= put_field(fp, &first, "images", im);
   }
@@ -670,6 +757,7 @@ int cli_dataset(int argc, char** argv) {
   memset(&ds, 0, sizeof ds);
   ds.jobs = 1, ds.nshard = 1, ds.ext = "ply", ds.count = -1;
   ds.img_w = 640, ds.img_h = 480;
+  ds.argc = argc, ds.argv = argv;
   int image_size_given = 0;
   ds.progress = po.progress;
   int stats = 0;
@@ -741,6 +829,9 @@ int cli_dataset(int argc, char** argv) {
   if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
+  if (co.has_cloud_seed)
+    return cli_usage_error("dataset", "--cloud-seed does not apply to a dataset: each item's cloud is seeded by its "
+                           "item seed (from --seed)");
   if (image_size_given && !ds.images) return cli_usage_error("dataset", "--image-size goes with --images N");
   // no output may replace an input: the dataset writes manifest.json and item_* in DIR
   const char* ins[2] = {po.path, co.scanners_file};

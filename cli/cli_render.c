@@ -12,12 +12,13 @@
 #include "cli.h"
 
 static const char* render_help =
-    "usage: verdant render PLANT|CLOUD -o OUT.png [options]\n"
+    "usage: verdant render PLANT|MESH|CLOUD -o OUT.png [options]\n"
     "       verdant render RUN/ -o OUT.png [--time T] | -o DIR/ | --mp4 OUT.mp4 [options]\n"
     "\n"
-    "Draw a plant (an .lpy file, derived on the fly, or a plant .json), a point cloud (.ply,\n"
-    ".pcd, .xyz, .csv or .las, with optional label and instance) or a simulation run (a folder\n"
-    "written by 'verdant sim -o RUN/') headless with MuJoCo's renderer (EGL; software rendering\n"
+    "Draw a plant (an .lpy file, derived on the fly, or a plant .json), a labelled mesh (.obj,\n"
+    "or a .ply with faces, as 'verdant grow' writes them), a point cloud (.ply, .pcd, .xyz, .csv\n"
+    "or .las, with optional label and instance) or a simulation run (a folder written by\n"
+    "'verdant sim -o RUN/') headless with MuJoCo's renderer (EGL; software rendering\n"
     "when there is no GPU) and write a colour PNG with a legend.\n"
     "\n"
     "options:\n"
@@ -370,13 +371,16 @@ int cli_render(int argc, char** argv) {
     const char* ins[2] = {o.po.path, o.def.robot_mjcf};
     if (cli_check_outputs("render", outs, nout, ins, 2)) return EXIT_USAGE;
   }
-  // point clouds in any format the cloud module reads; everything else is a plant
-  int is_cloud = cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") ||
-                 cli_has_ext(o.po.path, ".xyz") || cli_has_ext(o.po.path, ".csv") ||
-                 cli_has_ext(o.po.path, ".las");
+  // meshes (.obj, a .ply with faces: what 'verdant grow' writes), point clouds in any format the
+  // cloud module reads; everything else is a plant
+  int is_mesh = vd_geom_is_mesh_file(o.po.path);
+  int is_cloud = !is_mesh && (cli_has_ext(o.po.path, ".ply") || cli_has_ext(o.po.path, ".pcd") ||
+                              cli_has_ext(o.po.path, ".xyz") || cli_has_ext(o.po.path, ".csv") ||
+                              cli_has_ext(o.po.path, ".las"));
   vd_render_style style = o.style;
-  if (is_cloud && style.color_by != VD_COLOR_LABEL && style.color_by != VD_COLOR_INSTANCE)
-    return cli_usage_error("render", "a point cloud is coloured by label or instance");
+  if ((is_cloud || is_mesh) && style.color_by != VD_COLOR_LABEL &&
+      style.color_by != VD_COLOR_INSTANCE)
+    return cli_usage_error("render", "a point cloud or a mesh is coloured by label or instance");
   if (!is_cloud && style.color_by == VD_COLOR_STRESS)
     return cli_usage_error(
         "render",
@@ -392,9 +396,15 @@ int cli_render(int argc, char** argv) {
   memset(&ginfo, 0, sizeof ginfo);
   vd_cloud cl;
   memset(&cl, 0, sizeof cl);
+  vd_mesh mesh;
+  memset(&mesh, 0, sizeof mesh);
+  vd_label* mlabels = NULL;
+  int nmlabel = 0;
   vd_renderer* r = NULL;
   int code = EXIT_OK;
-  if (is_cloud) {
+  if (is_mesh) {
+    st = vd_geom_read_mesh(o.po.path, &mesh, &mlabels, &nmlabel, &err);
+  } else if (is_cloud) {
     st = vd_cloud_read(o.po.path, &cl, &err);
     if (!st && cl.n > INT32_MAX)
       st = vd_error_set(&err, VD_ERR_LIMIT, o.po.path, 0, 0, "more than 2^31 points");
@@ -409,7 +419,7 @@ int cli_render(int argc, char** argv) {
   }
   // room in the scene for every organ instance (or cloud group) whatever the plant's size
   {
-    long need = is_cloud ? cl.n : model->ninstance;
+    long need = is_mesh ? mesh.ntri : is_cloud ? cl.n : model->ninstance;
     if (need + 16 > def.max_geoms) def.max_geoms = need + 16 > 10000000 ? 10000000 : (int)need + 16;
   }
   // the renderer: a missing OpenGL context is a failed run, not bad input
@@ -420,7 +430,9 @@ int cli_render(int argc, char** argv) {
     goto done;
   }
   if (o.info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
-  if (is_cloud) {
+  if (is_mesh) {
+    st = vd_render_add_mesh(r, &mesh, mlabels, nmlabel, &style, &err);
+  } else if (is_cloud) {
     vd_points pts = {(int)cl.n, cl.pos, cl.label, cl.instance, o.point_size, cl.labels, cl.nlabel};
     st = vd_render_add_points(r, &pts, &style, &err);
   } else {
@@ -452,5 +464,7 @@ done:
   vd_plant_spec_destroy(plant);
   cli_grow_info_free(&ginfo);
   vd_cloud_free(&cl);
+  vd_mesh_free(&mesh);
+  vd_free(mlabels, sizeof(vd_label) * (size_t)(nmlabel ? nmlabel : 1));
   return code;
 }

@@ -35,6 +35,8 @@ static const char* sim_help =
     "model:\n"
     "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
     "      --max-segments N    most rod segments of the model (default 1000000, about 2 kB each)\n"
+    "      --bend-measure M    bend-twist strain: log (rotation vector, default) or quat\n"
+    "                          (Kugelstadt & Schomer's Im(q), the model before 2026-11)\n"
     "      --young [C=]E       Young's modulus (Pa) of all classes, or of class C\n"
     "      --density [C=]RHO   density (kg/m^3); --poisson [C=]NU Poisson ratio\n"
     "                          classes: green wood pedicel leaf fruit flower root\n"
@@ -614,6 +616,11 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
     } else if (!strcmp(a, "--max-segments")) {
       NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
+    } else if (!strcmp(a, "--bend-measure")) {
+      VAL();
+      int b = vd_sim_bend_parse(val);
+      if (b < 0) return cli_usage_error(cmd, "--bend-measure expects log or quat, got '%s'", val);
+      o->def.bend_measure = (vd_sim_bend)b;
     } else if (!strcmp(a, "--max-steps")) {
       NUM(o->max_steps, x_ >= 1 && x_ <= 1e15 && x_ == floor(x_), "an integer in 1..1e15");
     } else if (!strcmp(a, "--young")) {

@@ -159,6 +159,43 @@ expect "dataset other options refused" 2 "$V" dataset "$A" --count 5 -N 3000 --s
 read -r S VAL < <(python3 -c "import json; r=json.load(open('$D/item_000003.json')); print(r['seed'], repr(r['vary']['ROSETTE_LEAF']))")
 "$V" cloud "$A" -N 2000 --seed "$S" --set "ROSETTE_LEAF=$VAL" -o "$T/regen.ply"
 if cmp -s "$T/regen.ply" "$D/item_000003.ply"; then ok "item made again alone"; else bad "item made again alone"; fi
+# the manifest's recipe, followed for every item, makes the same bytes (issue 12, item 4): a
+# dataset with every kind of option (plant, cloud, dataset-only ones, images when a context is
+# there); {seed}, {vary.NAME}, {azimuth}, {elevation} come from the item's record
+R="$T/recipe"
+IMG=()
+if "$V" render "$A" -o "$T/ctx.png" --size 16x16 >/dev/null 2>&1; then IMG=(--images 1 --image-size 80x60); fi
+expect "dataset for the recipe" 0 "$V" dataset "$A" --count 3 -N 1500 --seed 7 -n 6 --vary ROSETTE_LEAF=0.025:0.045 --labels instance --noise 0.001 --format pcd --jobs 2 --threads 1 "${IMG[@]}" -o "$R"
+if python3 - "$V" "$R" "$T" <<'PY'
+import filecmp, json, subprocess, sys
+v, d, t = sys.argv[1:4]
+m = json.load(open(d + "/manifest.json"))
+def fill(argv, fields, out):
+    a = [v] + argv[1:-1] + [out]
+    for key, val in fields.items():
+        a = [x.replace("{" + key + "}", val) for x in a]
+    assert not any("{" in x for x in a), a
+    return a
+for item in m["items"]:
+    rec = json.load(open(f"{d}/item_{item['index']:06d}.json"))  # exact numbers, as the manifest's
+    fields = {"seed": str(item["seed"])}
+    for name in item["vary"]:
+        fields["vary." + name] = "%.17g" % rec["vary"][name]
+    out = f"{t}/regen_{item['index']}.pcd"
+    subprocess.run(fill(m["regenerate_argv"], fields, out), check=True)
+    assert filecmp.cmp(out, f"{d}/{item['file']}", shallow=False), item["file"]
+    for view in item.get("images", []):
+        f = dict(fields, azimuth=repr(view["azimuth"]), elevation=repr(view["elevation"]))
+        out = f"{t}/regen_{item['index']}_view.png"
+        subprocess.run(fill(m["images"]["regenerate_argv"], f, out), check=True)
+        for role, ext in (("color", "png"), ("label", "label.png"), ("depth", "depth.png")):
+            assert filecmp.cmp(out[:-3] + ext, f"{d}/{view[role]}", shallow=False), view[role]
+# the one-line form names the same arguments
+assert m["regenerate"].split() == m["regenerate_argv"], m["regenerate"]
+PY
+then ok "manifest recipe makes every item again"; else bad "manifest recipe makes every item again"; fi
+expect "dataset --cloud-seed refused" 2 "$V" dataset "$A" --count 3 --cloud-seed 3 -o "$T/cs"
+
 # two shards into another folder: the same items; the manifest comes with the last shard
 E="$T/shards"
 expect "shard 0/2" 0 "$V" dataset "$A" --count 5 -N 2000 --seed 4 --vary ROSETTE_LEAF=0.025:0.045 -o "$E" --shard 0/2

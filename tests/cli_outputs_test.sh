@@ -65,7 +65,7 @@ expect "grow into a missing folder" 1 "$V" grow tom.json -o nowhere/t.obj
 # a run that fails half way (unstable) takes back every file it wrote: a new folder goes, an
 # earlier run in the folder comes back as it was
 A="$SRC/data/arabidopsis.lpy"
-UNSTABLE=(--young 1e6 --density 100 --dt 0.01 --duration 0.5 --wind 5,0,0 --gust 0.5,0.5 --self-collision)
+UNSTABLE=(--young 1e6 --density 100 --dt 0.02 --duration 1 --wind 5,0,0 --gust 0.5,0.5 --self-collision)
 expect "unstable run into a new folder" 1 "$V" sim "$A" -o newrun "${UNSTABLE[@]}"
 if [ ! -e newrun ]; then ok "no run folder after a failed run"; else bad "no run folder after a failed run ($(ls newrun))"; fi
 expect "a run" 0 "$V" sim "$A" -o oldrun --duration 0.01 --final oldrun.obj

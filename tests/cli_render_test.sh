@@ -153,8 +153,54 @@ expect "render plant file" 0 "$V" render "$T/tomato.json" -o "$T/fromjson.png" -
 } >"$T/cloud.ply"
 expect "render ascii cloud" 0 "$V" render "$T/cloud.ply" -o "$T/cloud.png" --masks --size 160x120
 expect "render cloud by instance" 0 "$V" render "$T/cloud.ply" -o "$T/cloudi.png" --color-by instance --size 160x120
-expect "grow binary ply" 0 "$V" grow "$SRC/data/tomato.lpy" -o "$T/mesh.ply"
-expect "render binary ply vertices" 0 "$V" render "$T/mesh.ply" -o "$T/meshpts.png" --size 160x120 --point-size 0.003
+# meshes that grow wrote (per-face labels) render as meshes, not as grey points: the same masks as
+# the plant file within edge pixels (float coordinates), the same label names
+expect "grow binary ply" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesh.ply"
+expect "grow obj" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesh.obj"
+expect "grow ascii ply" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesha.ply" --ascii
+expect "grow json" 0 "$V" grow "$SRC/data/tomato.lpy" --seed 2 -o "$T/mesh.json"
+for m in mesh.ply mesh.obj mesha.ply mesh.json; do
+  expect "render $m" 0 "$V" render "$T/$m" -o "$T/r_${m%.*}_${m##*.}.png" --masks --size 320x240
+done
+expect "mesh by displacement refused" 2 "$V" render "$T/mesh.obj" -o "$T/x.png" --color-by displacement
+if python3 - "$T" <<'PY'
+import json, struct, sys, zlib
+d = sys.argv[1]
+def png16(path):
+    b = open(path, "rb").read()
+    pos, idat = 8, b""
+    while pos < len(b):
+        n, kind = struct.unpack(">I4s", b[pos:pos + 8])
+        if kind == b"IHDR": w, h = struct.unpack(">II", b[pos + 8:pos + 16])
+        if kind == b"IDAT": idat += b[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    raw, stride, prev, vals = zlib.decompress(idat), 2 * w + 1, bytearray(2 * w), []
+    for y in range(h):
+        f, line = raw[y * stride], bytearray(raw[y * stride + 1:(y + 1) * stride])
+        for i in range(len(line)):
+            a = line[i - 2] if i >= 2 else 0
+            c = prev[i - 2] if i >= 2 else 0
+            if f == 1: line[i] = (line[i] + a) & 255
+            elif f == 2: line[i] = (line[i] + prev[i]) & 255
+            elif f == 3: line[i] = (line[i] + (a + prev[i]) // 2) & 255
+            elif f == 4:
+                p = a + prev[i] - c; pa, pb, pc = abs(p - a), abs(p - prev[i]), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else prev[i] if pb <= pc else c)) & 255
+        vals += struct.unpack(">%dH" % w, line)
+        prev = line
+    return vals
+ref = {k: png16(f"{d}/r_mesh_json.{k}.png") for k in ("label", "instance")}
+names = {l["id"]: l["name"] for l in json.load(open(f"{d}/r_mesh_json.png.json"))["labels"]}
+fg = sum(1 for v in ref["label"] if v)
+for m in ("mesh_ply", "mesh_obj", "mesha_ply"):
+    meta = json.load(open(f"{d}/r_{m}.png.json"))
+    assert {l["id"]: l["name"] for l in meta["labels"]} == names, (m, meta["labels"])
+    for k in ("label", "instance"):
+        got = png16(f"{d}/r_{m}.{k}.png")
+        diff = sum(1 for a, b in zip(got, ref[k]) if a != b)
+        assert fg > 1000 and diff < 0.03 * fg, (m, k, diff, fg)
+PY
+then ok "meshes render like the plant"; else bad "meshes render like the plant"; fi
 expect "cloud by displacement refused" 2 "$V" render "$T/cloud.ply" -o "$T/x.png" --color-by displacement
 printf 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n0 0\n1 1\n' >"$T/noz.ply"
 expect "cloud without z" 2 "$V" render "$T/noz.ply" -o "$T/x.png"

@@ -639,3 +639,55 @@ TEST(sim, self_collision_pairs_linear) {
   CHECK(most[1] < 12 * nprim[1]);               // pairs per primitive bounded
   CHECK(most[1] < 6 * (most[0] > 0 ? most[0] : 1)); // 4x the rods, not 16x the pairs
 }
+
+// the bend-twist Jacobian of both measures against central differences of the constraint values,
+// for a joint on the tomato turned well away from rest (both sides, the parent's block is -G)
+TEST(sim, bend_jacobian) {
+  vd_model* pm = grow("data/tomato.lpy", NULL);
+  CHECK(pm != NULL);
+  if (!pm) return;
+  for (int kind = 0; kind < 2; kind++) {
+    vd_sim_def def = vd_sim_def_default();
+    def.bend_measure = (vd_sim_bend)kind;
+    def.sag_free = 1;
+    vd_sim_model* m = NULL;
+    vd_error e = {0};
+    CHECK_STATUS(vd_sim_build(pm, &def, &m, &e), VD_OK, e);
+    vd_sim_data* d = vd_sim_data_create(m);
+    // turn every frame by a different rotation (up to ~100 degrees away from rest)
+    for (int t = 0; t < m->nseg; t++)
+      d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_v3(0.9 * sin(t), 1.3 * cos(3.0 * t), 0.7 * sin(7.0 * t)));
+    double worst = 0;
+    int tested = 0;
+    for (int t = 1; t < m->nseg && tested < 40; t += 37) {
+      int p = m->seg_parent[t];
+      if (p < 0 || (m->seg_flags[t] & VD_SIM_FIXED) || (m->seg_flags[p] & VD_SIM_FIXED)) continue;
+      tested++;
+      sim_joint j;
+      sim_joint_eval(m, d, t, &j);
+      for (int side = 0; side < 2; side++) {
+        int s = side ? p : t;
+        vd_quat q0 = d->seg_quat[s];
+        for (int k = 0; k < 3; k++) {
+          double h = 1e-6, cp[6], cm[6];
+          vd_vec3 dv = vd_v3(k == 0 ? h : 0, k == 1 ? h : 0, k == 2 ? h : 0);
+          d->seg_quat[s] = quat_rotate_by(q0, dv);
+          sim_joint_values(m, d, t, cp);
+          d->seg_quat[s] = quat_rotate_by(q0, vd_scale(dv, -1));
+          sim_joint_values(m, d, t, cm);
+          d->seg_quat[s] = q0;
+          for (int i = 0; i < 3; i++) {
+            double fd = (cp[3 + i] - cm[3 + i]) / (2 * h), an = (side ? -1 : 1) * j.g[3 * i + k];
+            double err = fabs(fd - an) / (1 + fabs(an));
+            if (err > worst) worst = err;
+          }
+        }
+      }
+    }
+    CHECK(tested >= 20);
+    CHECK(worst < 1e-6);
+    vd_sim_data_destroy(d);
+    vd_sim_model_destroy(m);
+  }
+  vd_model_destroy(pm);
+}

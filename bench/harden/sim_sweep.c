@@ -29,6 +29,7 @@ static const char* usage =
     "  --dt LIST            time steps (s), default 1e-4,1e-3,1e-2\n"
     "  --iterations LIST    Newton iterations or Gauss-Seidel sweeps per step, default 1,10,100\n"
     "  --solver LIST        direct, gs or direct,gs (default)\n"
+    "  --bend M             bend-twist measure: log (default) or quat\n"
     "  --steps N            steps per run (default 100)\n"
     "  --span T             at most T simulated seconds per run: steps = min(N, ceil(T / dt))\n"
     "  --max-seconds S      stop a run after S wall seconds, checked between steps (outcome "
@@ -93,10 +94,13 @@ static int outcome(const run_result* r) {
 
 // one run: gravity, ground, wind 5 m/s along x with 50 % gusts of 0.5 s, `steps` steps, stopped
 // after `max_seconds` of wall time (0: no cap)
+static vd_sim_bend bend = VD_SIM_BEND_LOG;
+
 static void run_one(const vd_model* pm, double sigma, double young, double rho, double dt,
                     int iters, vd_sim_solver solver, int steps, double max_seconds, run_result* r) {
   memset(r, 0, sizeof *r);
   vd_sim_def def = vd_sim_def_default();
+  def.bend_measure = bend;
   def.segment_length = sigma;
   for (int c = 0; c < VD_SIM_CLASS_COUNT; c++)
     def.material[c].young = young, def.material[c].density = rho;
@@ -150,7 +154,14 @@ int main(int argc, char** argv) {
       quick = 1;
     else if (!strcmp(a, "--append"))
       append = 1;
-    else if (!strcmp(a, "--steps") && more)
+    else if (!strcmp(a, "--bend") && more) {
+      int b = vd_sim_bend_parse(argv[++i]);
+      if (b < 0) {
+        fprintf(stderr, "--bend: expected log or quat, got '%s'\n", argv[i]);
+        return 2;
+      }
+      bend = (vd_sim_bend)b;
+    } else if (!strcmp(a, "--steps") && more)
       steps = atoi(argv[++i]);
     else if (!strcmp(a, "--span") && more)
       span = atof(argv[++i]);

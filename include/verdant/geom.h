@@ -77,6 +77,24 @@ vd_status vd_geom_tessellate(const vd_model* m, const vd_data* d, const vd_mesh_
 // Free a mesh's arrays and zero it (NULL and empty meshes are fine).
 void vd_mesh_free(vd_mesh* mesh);
 
+// Read a triangle mesh from an .obj or .ply file: the files vd_geom_write_obj / _ply write (label
+// table from the header comments, label and instance per face from the OBJ objects and groups or
+// the PLY face properties) and meshes from other tools (OBJ groups or materials become labels 1,
+// 2, ... named after them and objects instances 1, 2, ...; faces before any group have label 0;
+// PLY faces without label or instance properties have 0). Polygons become fans of triangles;
+// normals are the file's (per vertex) or else summed from the faces around a vertex; tri_kind is
+// VD_PRIM_MESH and tri_prim 0. labels (Nullable) receives the label table sorted by id (nlabel
+// entries; free with vd_free(*labels, max(nlabel, 1) * sizeof(vd_label))). Errors name the file
+// and the line (or the byte for binary PLY); VD_ERR_FORMAT for a PLY without faces.
+vd_status vd_geom_read_mesh(const char* path, vd_mesh* mesh, vd_label** labels, int* nlabel,
+                            vd_error* err);
+// The same from memory: obj 1 for OBJ text, 0 for PLY; name (Nullable) is used in errors.
+vd_status vd_geom_parse_mesh(const char* data, size_t len, int obj, const char* name,
+                             vd_mesh* mesh, vd_label** labels, int* nlabel, vd_error* err);
+// 1 when path names a mesh: an .obj, or a .ply whose header has a face element with faces (a
+// .ply without one is a point cloud).
+int vd_geom_is_mesh_file(const char* path);
+
 // Write OBJ with normals plus a sibling .mtl (same base name), faces grouped by label/instance.
 vd_status vd_geom_write_obj(const vd_mesh* mesh, const vd_label* labels, int nlabel,
                             const char* path, vd_error* err);

@@ -30,6 +30,7 @@
 #define VERDANT_RENDER_H
 
 #include "verdant/core.h"
+#include "verdant/geom.h"
 #include "verdant/plant.h"
 
 #ifdef __cplusplus
@@ -189,6 +190,12 @@ void vd_render_clear(vd_renderer* r);
 // Add plant model m in state d (Nullable: its rest shape) with style s (Nullable: defaults).
 vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* d,
                               const vd_render_style* s, vd_error* err);
+
+// Add a labelled triangle mesh (vd_geom_read_mesh: an OBJ or PLY that verdant grow wrote) coloured
+// by label or instance (style Nullable: by label); labels (Nullable, nlabel entries, any order)
+// names them. Every triangle is drawn from both sides (which surfaces are open is not known).
+vd_status vd_render_add_mesh(vd_renderer* r, const vd_mesh* mesh, const vd_label* labels,
+                             int nlabel, const vd_render_style* style, vd_error* err);
 
 // The colour scale vd_render_add_plant gives plant m in state d (Nullable: at rest) under style
 // (Nullable: defaults) when the style fixes none: the smallest and largest stress (Pa) or

@@ -84,6 +84,20 @@ typedef struct vd_sim_material {
   double drag_cd;       // drag coefficient of the segment (cylinder) or sphere (-)
 } vd_sim_material;
 
+// Bend-twist strain measure of the rod joints (docs/physics.md section 2).
+typedef enum vd_sim_bend {
+  VD_SIM_BEND_LOG = 0,  // rotation vector of the joint's turn away from rest, log(conj(q_rest) q_rel)
+                        // / l-bar: the moment grows linearly with the angle up to 180 deg; a
+                        // junction's parent segment lumps its upper half into its own joint
+  VD_SIM_BEND_QUAT      // Kugelstadt & Schomer 2016 / Gazebo Plants: (2 / l-bar)(Im q_rel - Im q_rest),
+                        // moment sin(angle) / flexibility (none left at 180 deg); junction joints
+                        // each take half the parent segment (the model before 2026-11)
+} vd_sim_bend;
+
+// Name of a measure ("log", "quat") and back (-1 if none).
+const char* vd_sim_bend_name(vd_sim_bend b);
+int vd_sim_bend_parse(const char* name);
+
 // Rod-model settings for vd_sim_build.
 typedef struct vd_sim_def {
   double segment_length;          // target rod segment length sigma_distance (m)
@@ -99,12 +113,14 @@ typedef struct vd_sim_def {
   double stake_spacing;           // tie the main stem to a fixed stake every this length (m), 0 off
   double stake_stiffness;         // stiffness of each stake tie (N/m)
   int max_segments;               // most rod segments the model may have; larger is VD_ERR_LIMIT
+  vd_sim_bend bend_measure;       // bend-twist strain measure
 } vd_sim_def;
 
 // Defaults (sources in docs/physics.md):
 //   segment_length 0.02 m, clamp_length 0.01 m, clamp_roots 1, leaf_graphs 1, sag_free 0,
 //   gravity (0, 0, -9.81) m/s^2, stake_spacing 0 m (off), stake_stiffness 1e4 N/m,
 //   max_segments 1000000 (a model and one state take about 2 kB per segment),
+//   bend_measure VD_SIM_BEND_LOG,
 //   leaf_areal_density 0.22 kg/m^2, leaf_vein_ratio 0.015, leaf_plate_cd 1.17;
 //   materials            E (Pa)   nu    rho (kg/m^3)  drag cd   fracture
 //     green stem         1e9      0.3   1000          1.2       never
@@ -217,6 +233,7 @@ typedef struct vd_sim_model {
   int main_tip;           // node at the end of the main axis (for tip_displacement), -1 if none
   double leaf_cd;         // drag coefficient of leaf laminae, normal flow (-)
   int nsagfree_clamped;   // joints whose sag-free rest curvature was out of reach (too heavy)
+  vd_sim_bend bend_measure;  // bend-twist strain measure (from the def)
   double total_mass;      // sum of node masses (kg)
   size_t nbytes;          // size of the single allocation
 } vd_sim_model;

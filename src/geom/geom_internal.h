@@ -23,4 +23,9 @@ void geom_joints(const vd_model* m, const vd_data* d, int slices, int* cont, int
 enum { GEOM_WHOLE = 0, GEOM_PART_OFF = 1, GEOM_PART_STUB = 2 };
 int geom_seg_cut(const vd_data* d, int i, double* f);
 
+// The name of label id in OBJ/MTL files (groups, objects, materials): its name with characters
+// other than letters, digits, '_', '-', '.' made '_'; "label_<id>" without an entry or a name;
+// "<name>_<id>" when an earlier entry of the table gives the same name.
+void geom_obj_name(const vd_label* labels, int nlabel, int id, char* buf, size_t cap);
+
 #endif

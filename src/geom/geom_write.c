@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "verdant/geom.h"
+#include "geom_internal.h"
 
 // ---------------------------------------------------------------------------------------------
 // label names as they appear in files
@@ -30,7 +30,7 @@ static void sanitize(const char* name, char* buf, size_t cap) {
 
 // the name of label id in OBJ/MTL files: its sanitised name; "label_<id>" when it has no entry
 // or an empty name; "<name>_<id>" when an earlier entry sanitises to the same name
-static void safe_name(const vd_label* labels, int nlabel, int id, char* buf, size_t cap) {
+void geom_obj_name(const vd_label* labels, int nlabel, int id, char* buf, size_t cap) {
   const vd_label* l = find_label(labels, nlabel, id);
   if (!l || !l->name[0]) {
     snprintf(buf, cap, "label_%d", id);
@@ -104,7 +104,7 @@ static void write_obj_header(FILE* fp, const vd_mesh* mesh, const vd_label* labe
 
 static void write_mtl_entry(FILE* fp, const vd_label* labels, int nlabel, int id) {
   char name[VD_LABEL_NAME_MAX + 16];
-  safe_name(labels, nlabel, id, name, sizeof name);
+  geom_obj_name(labels, nlabel, id, name, sizeof name);
   const vd_label* l = find_label(labels, nlabel, id);
   float rgb[3];
   if (l)
@@ -164,7 +164,7 @@ vd_status vd_geom_write_obj(const vd_mesh* mesh, const vd_label* labels, int nla
   for (size_t t = 0; t < nkey; t++) {
     const face_key* k = &keys[t];
     if (t == 0 || k->label != keys[t - 1].label || k->instance != keys[t - 1].instance) {
-      safe_name(labels, nlabel, k->label, name, sizeof name);
+      geom_obj_name(labels, nlabel, k->label, name, sizeof name);
       fprintf(fp, "o %s_%d\ng %s\nusemtl %s\n", name, k->instance, name, name);
     }
     const int* f = mesh->tri + 3 * k->index;

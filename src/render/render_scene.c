@@ -153,7 +153,7 @@ static vd_status check_style(const vd_render_style* s, int nseg, vd_error* err) 
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "unknown colouring %d", (int)s->color_by);
   if (nseg < 0 && s->color_by != VD_COLOR_LABEL && s->color_by != VD_COLOR_INSTANCE)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
-                        "a point cloud is coloured by label or instance only");
+                        "a point cloud or a mesh file is coloured by label or instance only");
   if (s->color_by == VD_COLOR_STRESS && !s->seg_stress)
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
                         "colour by stress needs a stress per segment (a simulation state)");
@@ -557,6 +557,30 @@ done:
   vd_free(tri_rgb, value_mode ? sizeof(float) * 3 * (nt + 1) : 0);
   vd_free(open, nt + 1);
   vd_mesh_free(&mesh);
+  return st;
+}
+
+vd_status vd_render_add_mesh(vd_renderer* r, const vd_mesh* mesh, const vd_label* labels,
+                             int nlabel, const vd_render_style* style, vd_error* err) {
+  vd_render_style s = style ? *style : vd_render_style_default();
+  vd_status st = check_style(&s, -1, err);
+  if (st) return st;
+  if (nlabel < 0 || (nlabel > 0 && !labels))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad label table");
+  for (int t = 0; t < mesh->ntri; t++)
+    for (int c = 0; c < 3; c++)
+      if (mesh->tri[3 * t + c] < 0 || mesh->tri[3 * t + c] >= mesh->nvert)
+        return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "triangle %d: vertex index out of range", t);
+  for (int i = 0; i < 3 * mesh->nvert; i++)
+    if (!isfinite(mesh->pos[i]) || !isfinite(mesh->normal[i]))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "vertex %d is not finite", i / 3);
+  if ((st = gl_current(&r->gl, err))) return st;
+  // which surfaces are open is not known: every triangle is drawn from both sides
+  unsigned char* open = vd_malloc((size_t)mesh->ntri + 1);
+  if (!open) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  memset(open, 1, (size_t)mesh->ntri + 1);
+  st = add_triangles(r, mesh, open, NULL, labels, nlabel, &s, err);
+  vd_free(open, (size_t)mesh->ntri + 1);
   return st;
 }
 

@@ -27,6 +27,16 @@ vd_sim_class vd_sim_class_parse(const char* name) {
   return VD_SIM_CLASS_COUNT;
 }
 
+static const char* bend_names[2] = {"log", "quat"};
+
+const char* vd_sim_bend_name(vd_sim_bend b) { return b >= 0 && b < 2 ? bend_names[b] : "?"; }
+
+int vd_sim_bend_parse(const char* name) {
+  for (int k = 0; k < 2; k++)
+    if (name && strcmp(name, bend_names[k]) == 0) return k;
+  return -1;
+}
+
 static vd_sim_material material(double e, double rho, double cd) {
   vd_sim_material mt = {e, 0.3, rho, INFINITY, INFINITY, INFINITY, INFINITY, cd};
   return mt;
@@ -59,6 +69,7 @@ vd_sim_def vd_sim_def_default(void) {
   d.sag_free = 0;
   d.gravity = vd_v3(0, 0, -9.81);
   d.max_segments = 1000000;
+  d.bend_measure = VD_SIM_BEND_LOG;
   d.stake_spacing = 0;
   d.stake_stiffness = 1e4;
   return d;
@@ -239,6 +250,8 @@ static vd_status check_def(const vd_sim_def* d, vd_error* err) {
   if (!(isfinite(d->stake_spacing) && d->stake_spacing >= 0)) BAD("sim: stake spacing must be >= 0 (m), got %g", d->stake_spacing);
   if (!(isfinite(d->stake_stiffness) && d->stake_stiffness > 0)) BAD("sim: stake stiffness must be > 0 (N/m), got %g", d->stake_stiffness);
   if (d->max_segments < 1) BAD("sim: max_segments must be >= 1, got %d", d->max_segments);
+  if (d->bend_measure != VD_SIM_BEND_LOG && d->bend_measure != VD_SIM_BEND_QUAT)
+    BAD("sim: unknown bend-twist measure %d", (int)d->bend_measure);
 #undef BAD
   return VD_OK;
 }
@@ -901,7 +914,22 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     }
   }
   // compliances: stretch-shear of the segment, bend-twist of the joint with its parent; the
-  // joint's flexibility is that of the two half segments beside it (a fixed half is rigid)
+  // joint's flexibility is that of the two half segments beside it (a fixed half is rigid).
+  // With the log measure a junction (a segment with two or more children) lumps its upper half
+  // into its own lower joint instead of into each child's: the upper half carries the sum of
+  // its children's moments, so giving each child joint that half leaves out the others' moments
+  // (an error of first order in sigma); the moment along the segment changes by O(l), so moving
+  // the half down one joint is second order (docs/validation.md, discretisation)
+  m->bend_measure = def->bend_measure;
+  int* nkid = vd_calloc((size_t)ns + 1, sizeof(int));  // bend children of each segment
+  if (!nkid) {
+    vd_free(block, top);
+    return oom(b);
+  }
+  for (int t = 0; t < ns; t++)
+    if (m->seg_parent[t] >= 0) nkid[m->seg_parent[t]]++;
+  // junction_down[t]: segment t's upper half goes into its own lower joint
+#define JUNCTION_DOWN(t) (def->bend_measure == VD_SIM_BEND_LOG && nkid[t] >= 2 && m->seg_parent[t] >= 0)
   for (int t = 0; t < ns; t++) {
     const vd_sim_material* mt = &def->material[m->seg_class[t]];
     double e = mt->young, nu = mt->poisson, g = e / (2 * (1 + nu)), r = m->seg_radius[t];
@@ -911,11 +939,13 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     m->seg_cs[3 * t + 2] = 1.0 / (l * e * a);
     int par = m->seg_parent[t];
     double fb = 0.5 * l / (e * in), ft = 0.5 * l / (g * 2 * in), lbar = l;
+    if (JUNCTION_DOWN(t)) fb *= 2, ft *= 2;
     if (par >= 0) {
       const vd_sim_material* mp = &def->material[m->seg_class[par]];
       double ep = mp->young, gp = ep / (2 * (1 + mp->poisson)), rp = m->seg_radius[par];
       double ip = 0.25 * VD_PI * rp * rp * rp * rp, lp = m->seg_len0[par];
-      if (!(m->seg_flags[par] & VD_SIM_FIXED)) fb += 0.5 * lp / (ep * ip), ft += 0.5 * lp / (gp * 2 * ip);
+      if (!(m->seg_flags[par] & VD_SIM_FIXED) && !JUNCTION_DOWN(par))
+        fb += 0.5 * lp / (ep * ip), ft += 0.5 * lp / (gp * 2 * ip);
       lbar = 0.5 * (l + lp);
       vd_quat qr = q_mul(q_conj(m->seg_quat0[par]), m->seg_quat0[t]);
       if (qr.w < 0) qr.w = -qr.w, qr.x = -qr.x, qr.y = -qr.y, qr.z = -qr.z;
@@ -930,6 +960,8 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     vd_vec3 ln = q_rotate(q_conj(m->seg_quat0[t]), b->seg[t].leafn);
     m->seg_leaf_normal[3 * t] = ln.x, m->seg_leaf_normal[3 * t + 1] = ln.y, m->seg_leaf_normal[3 * t + 2] = ln.z;
   }
+#undef JUNCTION_DOWN
+  vd_free(nkid, ((size_t)ns + 1) * sizeof(int));
   // ties
   for (int k = 0; k < nt; k++) {
     m->tie_node[k] = b->tie_node[k];

@@ -124,6 +124,12 @@ typedef struct sim_joint {
 void sim_joint_eval(const vd_sim_model* m, const vd_sim_data* d, int t, sim_joint* j);
 // Constraint values only (for damping and fracture checks).
 void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double c[6]);
+// Bend-twist strain C_b (3, 1/m) of a joint of measure kind with relative rotation qr =
+// conj(q_parent) q_t, rest rotation q0 and Darboux length lbar; dc (Nullable) gets dC_b/dpsi
+// (3x3) for a rotation psi of qr on the left, in the parent's frame (dC_b/dtheta_t = dc R_p^T).
+void sim_bend_strain(vd_sim_bend kind, vd_quat qr, vd_quat q0, double lbar, double* c, double* dc);
+// Inverse left Jacobian of SO(3) at the rotation vector v (3x3): log(exp(u) exp(v)) = v + J u + O(u^2).
+void sim_jl_inv(vd_vec3 v, double* o);
 // Detach segment t from its parent (a fracture): its start moves to its spare node, which takes
 // half the segment's mass; the joint is marked broken (sim_step.c).
 void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t);

@@ -83,26 +83,48 @@ int sim_sagfree(vd_sim_model* m, vd_vec3 g) {
     vd_quat qp = m->seg_quat0[p];
     vd_quat qr = q_mul(q_conj(qp), m->seg_quat0[t]);
     if (qr.w < 0) qr.w = -qr.w, qr.x = -qr.x, qr.y = -qr.y, qr.z = -qr.z;
-    double lbar = m->seg_lbar[t], gm[9], rp[9], rpt[9], w[9];
+    double lbar = m->seg_lbar[t], rp[9];
     m3_from_quat(rp, qp);
-    m3_transpose(rpt, rp);
-    m3_skew(w, quat_im(qr));
-    for (int i = 0; i < 9; i++) w[i] = -w[i];
-    w[0] += qr.w, w[4] += qr.w, w[8] += qr.w;
-    m3_mul(gm, w, rpt);
-    for (int i = 0; i < 9; i++) gm[i] /= lbar;
-    vd_vec3 mu;
-    if (!solve_t3(gm, tq[t], &mu)) continue;
-    vd_vec3 cb = vd_v3(-m->seg_cb[3 * t] * mu.x, -m->seg_cb[3 * t + 1] * mu.y, -m->seg_cb[3 * t + 2] * mu.z);
-    // C_b = (2 / l-bar)(Im q_rel - Im q_rel0)  =>  Im q_rel0 = Im q_rel - (l-bar / 2) C_b
-    vd_vec3 v0 = vd_madd(quat_im(qr), cb, -0.5 * lbar);
-    double s = v_norm(v0);
-    if (s > 0.999) {
-      v0 = vd_scale(v0, 0.999 / s);
-      s = 0.999;
-      clamped++;
+    // the quat measure gives G = dC_b/dtheta = (1 / l-bar)(w I - [v]x) R_p^T at the modelled shape
+    // whatever the rest rotation, so one pass inverts it; the log measure's G depends on the
+    // rest rotation through J_l^-1(turn) R_0^T: fixed-point iterations from q_rel0 = q_rel
+    vd_quat r0 = qr;
+    int log = m->bend_measure == VD_SIM_BEND_LOG, out = 0, fail = 0;
+    vd_vec3 prev = vd_v3(0, 0, 0);
+    for (int it = 0; it < (log ? 100 : 1); it++) {
+      double dc[9], gm[9], cur[3];
+      sim_bend_strain(m->bend_measure, qr, r0, lbar, cur, dc);
+      for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+          gm[3 * i + k] = dc[3 * i] * rp[3 * k] + dc[3 * i + 1] * rp[3 * k + 1] + dc[3 * i + 2] * rp[3 * k + 2];
+      vd_vec3 mu;
+      if (!solve_t3(gm, tq[t], &mu)) {
+        fail = 1;
+        break;
+      }
+      vd_vec3 cb = vd_v3(-m->seg_cb[3 * t] * mu.x, -m->seg_cb[3 * t + 1] * mu.y, -m->seg_cb[3 * t + 2] * mu.z);
+      if (!log) {
+        // C_b = (2 / l-bar)(Im q_rel - Im q_rel0)  =>  Im q_rel0 = Im q_rel - (l-bar / 2) C_b
+        vd_vec3 v0 = vd_madd(quat_im(qr), cb, -0.5 * lbar);
+        double sn = v_norm(v0);
+        if (sn > 0.999) v0 = vd_scale(v0, 0.999 / sn), sn = 0.999, out = 1;
+        r0 = (vd_quat){sqrt(1 - sn * sn), v0.x, v0.y, v0.z};
+        break;
+      }
+      // C_b = log(conj(q_rel0) q_rel) / l-bar  =>  q_rel0 = q_rel exp(l-bar C_b)^-1; a turn of
+      // 180 degrees or more is out of reach
+      vd_vec3 ph = vd_scale(cb, lbar);
+      double an = v_norm(ph);
+      out = an > 0.999 * VD_PI;
+      if (out) ph = vd_scale(ph, 0.999 * VD_PI / an);
+      r0 = q_normalize(q_mul(qr, q_conj(quat_exp(ph))));
+      double dd = v_norm(vd_sub(ph, prev));
+      prev = ph;
+      if (dd <= 1e-15 * (1 + an)) break;
     }
-    vd_quat r0 = {sqrt(1 - s * s), v0.x, v0.y, v0.z};
+    if (fail) continue;
+    clamped += out;
+    if (r0.w < 0) r0.w = -r0.w, r0.x = -r0.x, r0.y = -r0.y, r0.z = -r0.z;
     m->seg_rest[t] = r0;
   }
 done:
