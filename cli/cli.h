@@ -216,7 +216,16 @@ typedef struct cli_render_opts {
   double time;              // --time (s)
   double fps;               // --fps of the MP4 (0: the run's frame rate)
   int disp_from_first;      // --displacement-from first (runs): from frame 0, not the model
+  int has_sky, has_floor;   // --sky-rgb, --floor-rgb given
+  float sky[2][3];          // --sky-rgb: zenith and horizon colours in [0, 1]
+  float floor[2][3];        // --floor-rgb: checker colours in [0, 1]
 } cli_render_opts;
+
+// Parse an option of the look of pictures (--light AZ,EL[,KEY[,HEAD[,AMBIENT]]] into def,
+// --sky-rgb, --floor-rgb into o) at argv[*i]: 1 consumed, 0 not one, -1 bad value (printed).
+int cli_look_opt(cli_render_opts* o, const char* cmd, int argc, char** argv, int* i);
+// Apply --sky-rgb and --floor-rgb to a renderer made from o->def.
+vd_status cli_apply_look(const cli_render_opts* o, vd_renderer* r, vd_error* err);
 
 // --palette NAME (distinct, natural); 1 on success.
 int cli_parse_palette(const char* s, vd_palette* out);

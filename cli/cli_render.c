@@ -48,7 +48,16 @@ static const char* render_help =
     "      --point-size M    splat half-size of cloud points (m, default 0.4% of the cloud)\n"
     "      --robot FILE.xml  draw a robot from its MJCF (with its own world) beside the plant\n"
     "      --no-floor, --no-shadows, --no-legend, --no-sky   leave those out\n"
+    "      --light AZ,EL[,KEY[,HEAD[,AMBIENT]]]\n"
+    "                        key light from azimuth AZ and elevation EL (degrees; default\n"
+    "                        -114.6,57.3), its intensity, the headlight's and the ambient light\n"
+    "                        (0..1; default 0.6, 0.35, 0.3)\n"
+    "      --sky-rgb R,G,B[,R,G,B]   sky colours, zenith then horizon (0..1; with --no-sky the\n"
+    "                        flat background)\n"
+    "      --floor-rgb R,G,B[,R,G,B] the floor's two checker colours (0..1)\n"
     "      --info            print the OpenGL context used on stderr\n"
+    ;
+static const char* render_help_run =
     "simulation runs (RUN/ holds rod.json, plant_initial.json, frames, colliders.jsonl):\n"
     "  -o OUT.png            one frame: the one nearest --time T (s), default the last\n"
     "  -o DIR/               every frame: DIR/frame_00000.png ... (and their depth, masks and\n"
@@ -73,6 +82,74 @@ int cli_parse_palette(const char* s, vd_palette* out) {
   else
     return 0;
   return 1;
+}
+
+// n comma-separated finite numbers, no more
+static int parse_list(const char* s, double* x, int n) {
+  for (int k = 0; k < n; k++) {
+    char* end;
+    errno = 0;
+    x[k] = strtod(s, &end);
+    if (end == s || errno || !isfinite(x[k])) return 0;
+    s = end;
+    if (k < n - 1) {
+      if (*s != ',') return 0;
+      s++;
+    }
+  }
+  return *s == 0;
+}
+
+int cli_look_opt(cli_render_opts* o, const char* cmd, int argc, char** argv, int* i) {
+  const char* a = argv[*i];
+  const char* val = NULL;
+  if (strcmp(a, "--light") != 0 && strcmp(a, "--sky-rgb") != 0 && strcmp(a, "--floor-rgb") != 0)
+    return 0;
+  CLI_TAKE();
+  double x[6];
+  if (!strcmp(a, "--light")) {
+    // AZ,EL in degrees, then the key light, headlight and ambient intensities
+    int n = 0;
+    for (int k = 2; k <= 5 && !n; k++)
+      if (parse_list(val, x, k)) n = k;
+    int ok = n >= 2 && x[0] >= -360 && x[0] <= 360 && x[1] > 0 && x[1] <= 90;
+    for (int k = 2; ok && k < n; k++)
+      ok = x[k] >= 0 && x[k] <= 1;
+    if (!ok) {
+      cli_usage_error(cmd, "--light expects AZ,EL[,KEY[,HEAD[,AMBIENT]]]: degrees (elevation in "
+                           "(0, 90]), intensities in [0, 1]; got '%s'", val);
+      return -1;
+    }
+    o->def.light_azimuth = x[0] * VD_PI / 180, o->def.light_elevation = x[1] * VD_PI / 180;
+    if (n > 2) o->def.light = x[2];
+    if (n > 3) o->def.headlight = x[3];
+    if (n > 4) o->def.ambient = x[4];
+    return 1;
+  }
+  // two colours (or one for both)
+  int n = parse_list(val, x, 6) ? 6 : parse_list(val, x, 3) ? 3 : 0;
+  for (int k = 0; k < n; k++)
+    if (x[k] < 0 || x[k] > 1) n = 0;
+  if (!n) {
+    cli_usage_error(cmd, "%s expects R,G,B[,R,G,B] in [0, 1], got '%s'", a, val);
+    return -1;
+  }
+  float(*c)[3] = !strcmp(a, "--sky-rgb") ? o->sky : o->floor;
+  for (int k = 0; k < 6; k++)
+    c[k / 3][k % 3] = (float)x[n == 6 ? k : k % 3];
+  if (c == o->sky)
+    o->has_sky = 1;
+  else
+    o->has_floor = 1;
+  return 1;
+}
+
+vd_status cli_apply_look(const cli_render_opts* o, vd_renderer* r, vd_error* err) {
+  if (!o->has_sky && !o->has_floor) return VD_OK;
+  vd_render_look look = vd_render_get_look(r);
+  if (o->has_sky) memcpy(look.sky, o->sky, sizeof look.sky);
+  if (o->has_floor) memcpy(look.floor, o->floor, sizeof look.floor);
+  return vd_render_set_look(r, &look, err);
 }
 
 // three comma-separated numbers
@@ -142,6 +219,9 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     int r = cli_plant_opt(&o->po, "render", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    r = cli_look_opt(o, "render", argc, argv, &i);
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     // options with a value
@@ -337,6 +417,7 @@ int cli_render(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(render_help, stdout);
+      fputs(render_help_run, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;
     }
@@ -430,6 +511,10 @@ int cli_render(int argc, char** argv) {
     goto done;
   }
   if (o.info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
+  if ((st = cli_apply_look(&o, r, &err))) {
+    code = cli_report("render", &err, st);
+    goto done;
+  }
   if (is_mesh) {
     st = vd_render_add_mesh(r, &mesh, mlabels, nmlabel, &style, &err);
   } else if (is_cloud) {

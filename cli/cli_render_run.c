@@ -381,6 +381,7 @@ int cli_render_run(const cli_render_opts* o) {
     goto done;
   }
   if (o->info) fprintf(stderr, "verdant render: %s\n", vd_render_info(r));
+  if ((st = cli_apply_look(o, r, &err))) goto fail;
   // the camera: fitted to the run's box and what the renderer holds (a robot)
   vd_camera cam;
   {

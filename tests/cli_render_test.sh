@@ -127,6 +127,15 @@ done
 expect "explicit pose" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/pose.png" --eye 1.5,-1.5,1.2 --lookat 0,0,0.6 --fov 40 --size 160x120
 expect "color by instance" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/inst.png" --color-by instance --size 160x120
 expect "color by displacement" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/disp.png" --color-by displacement --size 160x120
+# the look: lights, sky and floor colours (what dataset views vary)
+expect "render without a look" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/nolook.png" --size 64x48
+expect "render with a look" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/look.png" --size 64x48 --light 60,30,0.8,0.2,0.2 \
+  --sky-rgb 1,0.8,0.6,0.3,0.2,0.5 --floor-rgb 0.2,0.5,0.2
+if cmp -s "$T/look.png" "$T/nolook.png"; then bad "the look changes the picture"; else ok "the look changes the picture"; fi
+expect "light out of range" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --light 0,95
+expect "light intensity out of range" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --light 0,45,2
+expect "sky colour out of range" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --sky-rgb 1,2,3
+expect "floor colour malformed" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --floor-rgb 1,0
 # label colours: distinct by default, the label table's with --palette natural (sidecar says which)
 expect "palette natural" 0 "$V" render "$SRC/data/tomato.lpy" -o "$T/nat.png" --palette natural --masks --size 64x48
 expect "palette bad" 2 "$V" render "$SRC/data/tomato.lpy" -o "$T/x.png" --palette pastel

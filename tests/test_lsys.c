@@ -199,8 +199,11 @@ TEST(lsys, multi_module_predecessor) {
 }
 
 TEST(lsys, cut) {
-  CHECK_DERIVE("Axiom: A[BC[D]E]F\nproduction:\nC --> %\n", 1, "A[B]F");
-  CHECK_DERIVE("Axiom: AB%CD\n", 0, "AB");
+  // as in L-Py, % stays in the string until the string is read again (the next step,
+  // decomposition or interpretation), which drops it and the rest of its branch
+  CHECK_DERIVE("Axiom: A[BC[D]E]F\nproduction:\nC --> %\n", 1, "A[B%[D]E]F");
+  CHECK_DERIVE("Axiom: A[BC[D]E]F\nproduction:\nC --> %\n", 2, "A[B]F");
+  CHECK_DERIVE("Axiom: AB%CD\nproduction:\nX --> X\n", 1, "AB");
 }
 
 TEST(lsys, decomposition_and_depth) {
@@ -348,7 +351,7 @@ typedef struct bad_case {
 static const bad_case bad_cases[] = {
     {"Axiom: A(\n", VD_ERR_SYNTAX, 1},                                   // unclosed bracket
     {"production:\nA --> B\n", VD_ERR_SYNTAX, 2},                        // no axiom
-    {"Axiom: A\nproduction:\nA -> B\n", VD_ERR_UNSUPPORTED, 3},          // wrong arrow
+    {"Axiom: A\nproduction:\nA -> B\n", VD_ERR_SYNTAX, 3},               // wrong arrow
     {"Axiom: A\nproduction:\nA(x) :\nproduce B\n", VD_ERR_SYNTAX, 3},    // body not indented
     {"Axiom: A\nproduction:\nA :\n  if x\n    produce B\n", VD_ERR_SYNTAX, 4},  // missing ':'
     {"import numpy\nAxiom: A\n", VD_ERR_UNSUPPORTED, 1},                 // unsupported import
@@ -359,8 +362,8 @@ static const bad_case bad_cases[] = {
     {"Axiom: A(1 / 0)\n", VD_ERR_VALUE, 1},                              // division by zero
     {"Axiom: A\nproduction:\nA :\n  assert 1 == 2\n", VD_ERR_ASSERT, 4}, // assert
     {"Axiom: A\nproduction:\nA(x) --> B(x +)\n", VD_ERR_SYNTAX, 3},      // bad expression
-    {"Axiom: A\nproduction:\n<< A --> B\n", VD_ERR_UNSUPPORTED, 3},      // new context
-    {"Axiom: A\nproduction:\n* --> B\n", VD_ERR_UNSUPPORTED, 3},         // wildcard
+    {"Axiom: A\nproduction:\nA(*p) --> B\n", VD_ERR_UNSUPPORTED, 3},     // *args pattern
+    {"Axiom: A\nproduction:\nx(A(y)) < B --> C\n", VD_ERR_UNSUPPORTED, 3},  // list binding
     {"x = 1\n  y = 2\nAxiom: A\n", VD_ERR_SYNTAX, 2},                    // bad indentation
     {"Axiom: A\nderivation length: 'x'\n", VD_ERR_VALUE, 2},             // bad derivation length
     {"Axiom: A\ndecomposition:\nmaximum depth: 0\n", VD_ERR_VALUE, 3},   // bad maximum depth

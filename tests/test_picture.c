@@ -406,3 +406,61 @@ TEST(picture, scale_follows_the_attached_plant) {
   vd_data_destroy(d);
   vd_model_destroy(m);
 }
+
+// ---------------------------------------------------------------------------------------------
+// the look: lights, sky and floor colours between frames
+
+TEST(picture, look_changes_between_frames) {
+  vd_render_def d = vdt_small_def(160, 120);
+  d.shadows = 1;
+  vd_renderer* r = vdt_renderer(&d);
+  if (!r) return;
+  vd_vec3 v[4] = {{-0.2, 0, 0.1}, {0.2, 0, 0.1}, {0.2, 0, 0.5}, {-0.2, 0, 0.5}};
+  vd_model* m = vdt_quad_plant(v, 2, 1);
+  REQUIRE(m);
+  vd_error err = {0};
+  CHECK_STATUS(vd_render_add_plant(r, m, NULL, NULL, &err), VD_OK, err);
+  // a camera that sees the floor in the lower half and the sky in the upper
+  vd_camera c = {{0, -3, 0.6}, {0, 0, 0.3}, {0, 0, 1}, 0.9, 0.05, 60};
+  size_t n = 3 * 160 * 120;
+  uint8_t* img0 = malloc(n);
+  REQUIRE(img0);
+  vd_frame f;
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR | VD_LAYER_LABEL, &f, &err), VD_OK, err);
+  memcpy(img0, f.rgb, n);
+  vd_render_look def = vd_render_get_look(r);
+  CHECK_NEAR(def.light, d.light, 0);
+  CHECK_NEAR(def.floor[0][0], 0.62f, 0);
+  // a red floor, a dark blue sky, light from the other side
+  vd_render_look look = def;
+  look.light_azimuth = 1.0, look.light_elevation = 0.5, look.ambient = 0.2;
+  const float red[2][3] = {{0.9f, 0.1f, 0.1f}, {0.7f, 0.05f, 0.05f}};
+  const float blue[2][3] = {{0.05f, 0.1f, 0.5f}, {0.1f, 0.2f, 0.6f}};
+  memcpy(look.floor, red, sizeof red);
+  memcpy(look.sky, blue, sizeof blue);
+  CHECK_STATUS(vd_render_set_look(r, &look, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR | VD_LAYER_LABEL, &f, &err), VD_OK, err);
+  // floor pixels (bottom rows, background in the mask) are red, sky pixels (top rows) blue
+  int floor_red = 0, floor_n = 0, sky_blue = 0, sky_n = 0;
+  for (int y = 0; y < 120; y++)
+    for (int x = 0; x < 160; x++) {
+      if (f.label[y * 160 + x]) continue;
+      const uint8_t* p = f.rgb + 3 * (y * 160 + x);
+      if (y >= 110) floor_n++, floor_red += p[0] > 2 * p[1] && p[0] > 2 * p[2];
+      if (y < 10) sky_n++, sky_blue += p[2] > p[0] + 40 && p[2] > p[1];
+    }
+  CHECK(floor_n > 1000 && floor_red == floor_n);
+  CHECK(sky_n > 1000 && sky_blue == sky_n);
+  // back to the look it was made with: the same bytes again
+  CHECK_STATUS(vd_render_set_look(r, &def, &err), VD_OK, err);
+  CHECK_STATUS(vd_render_draw(r, &c, VD_LAYER_COLOR, &f, &err), VD_OK, err);
+  CHECK(!memcmp(img0, f.rgb, n));
+  // out of range
+  look = def, look.floor[1][2] = 1.5f;
+  CHECK_STATUS(vd_render_set_look(r, &look, &err), VD_ERR_ARG, err);
+  look = def, look.light_elevation = 0;
+  CHECK_STATUS(vd_render_set_look(r, &look, &err), VD_ERR_ARG, err);
+  free(img0);
+  vd_render_destroy(r);
+  vd_model_destroy(m);
+}

@@ -721,16 +721,16 @@ TEST(turtle, tropism_rule) {
   CHECK_NEAR(vd_dot(P->seg[1].up, vd_sub(seg_b(P, 1), seg_a(P, 1))), 0, TOL);
   vd_plant_spec_destroy(P);
   // full elasticity aligns H with T (normalised); f bends too
-  CHECK_V3(end_of("Tropism(2,0,0) Elasticity(1) F"), 1, 0, 0);
-  REQUIRE(run("Tropism(1,0,0) Elasticity(1) f F", &P) == VD_OK);
+  CHECK_V3(end_of("@Tp(2,0,0) @Ts(1) F"), 1, 0, 0);
+  REQUIRE(run("@Tp(1,0,0) @Ts(1) f F", &P) == VD_OK);
   CHECK_V3(seg_a(P, 0), 1, 0, 0);
   CHECK_V3(seg_b(P, 0), 2, 0, 0);
   vd_plant_spec_destroy(P);
-  // settings from the def; Elasticity() turns it off
+  // settings from the def; @Ts() turns it off
   vd_turtle_def d = vd_turtle_def_default();
   d.tropism = vd_v3(0, 1, 0);
   d.elasticity = 1;
-  REQUIRE(run_def("F Elasticity F", &d, &P) == VD_OK);
+  REQUIRE(run_def("F @Ts F", &d, &P) == VD_OK);
   CHECK_V3(seg_b(P, 0), 0, 1, 0);
   CHECK_V3(seg_b(P, 1), 0, 2, 0);
   vd_plant_spec_destroy(P);
@@ -804,9 +804,13 @@ TEST(turtle, errors) {
   CHECK_INT(status_of("F ] F"), VD_ERR_SYNTAX);
   // organ modules are ignored; display-only modules are accepted
   vd_plant_spec* P;
-  REQUIRE(run("A B F @L(1) Frame SetGuide(1, 2) % ?P InterpolateColors(1,2) F", &P) == VD_OK);
+  REQUIRE(run("A B F @L(1) Frame SetGuide(1, 2) ?P InterpolateColors(1,2) F", &P) == VD_OK);
   CHECK_INT(P->nseg, 2);
   CHECK_INT(P->seg[0].module, 2);
+  vd_plant_spec_destroy(P);
+  // % drops the rest of its branch
+  REQUIRE(run("F [ F % F [ F ] F ] F", &P) == VD_OK);
+  CHECK_INT(P->nseg, 3);
   vd_plant_spec_destroy(P);
   // the error names the module and its index
   lbuf b = {0};

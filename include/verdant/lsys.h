@@ -25,7 +25,8 @@ extern "C" {
 
 // Predefined modules (L-Py's names, then verdant's): X(enum, name as written in L-strings).
 // Symbols with ids below VD_SYM_PREDEFINED_COUNT are these; declared and one-character modules
-// get later ids.
+// get later ids. L-Py's long names (Left, Sphere, MoveTo, StartGC, ...) are aliases: they read
+// as the same symbol and print as the short name (vd_lsys_symbol_find resolves them too).
 #define VD_SYM_LIST(X)                                                                             \
   X(VD_SYM_SB, "[")                                                                                \
   X(VD_SYM_EB, "]")                                                                                \
@@ -63,8 +64,6 @@ extern "C" {
   X(VD_SYM_ENDGC, "@Ge")                                                                           \
   X(VD_SYM_TROPISM, "@Tp")                                                                         \
   X(VD_SYM_ELASTICITY, "@Ts")                                                                      \
-  X(VD_SYM_TROPISM_LONG, "Tropism")                                                                \
-  X(VD_SYM_ELASTICITY_LONG, "Elasticity")                                                          \
   X(VD_SYM_MOVETO, "@M")                                                                           \
   X(VD_SYM_MOVEREL, "MoveRel")                                                                     \
   X(VD_SYM_SETHEAD, "@R")                                                                          \
@@ -102,7 +101,14 @@ extern "C" {
   X(VD_SYM_GETLEFT, "?L")                                                                          \
   X(VD_SYM_GETRIGHT, "?R")                                                                         \
   X(VD_SYM_GETFRAME, "?F")                                                                         \
-  X(VD_SYM_SETAGE, "SetAge")
+  X(VD_SYM_SETAGE, "SetAge")                                                                       \
+  X(VD_SYM_SURFACE_NAMED, "surface")                                                               \
+  X(VD_SYM_TEXBASECOLOR, "TextureBaseColor")                                                       \
+  X(VD_SYM_INTERPTEXCOLORS, "InterpolateTextureBaseColors")                                        \
+  X(VD_SYM_TEXTRANSFORM, "TextureTransformation")                                                  \
+  X(VD_SYM_LEFTREFLECTION, "LeftReflection")                                                       \
+  X(VD_SYM_UPREFLECTION, "UpReflection")                                                           \
+  X(VD_SYM_HEADINGREFLECTION, "HeadingReflection")
 
 typedef enum vd_sym {
 #define VD_SYM_ENUM(e, s) e,

@@ -138,6 +138,24 @@ typedef struct vd_render_gl {
 const char* vd_render_info(const vd_renderer* r);
 // The OpenGL implementation of the renderer (valid while it lives).
 const vd_render_gl* vd_render_gl_info(const vd_renderer* r);
+// Lighting and stage colours, changeable between frames (a dataset varies them per view).
+typedef struct vd_render_look {
+  double light_azimuth;   // key light: azimuth it comes from, from +X toward +Y (rad)
+  double light_elevation; // key light elevation above the horizon (rad), (0, pi/2]
+  double light;           // key light diffuse intensity in [0, 1]
+  double headlight;       // light at the camera, diffuse intensity in [0, 1]
+  double ambient;         // ambient intensity in [0, 1]
+  float sky[2][3];        // sky gradient colours, zenith then horizon, in [0, 1] (with sky 0 in
+                          // the settings: the flat background, sky[0] used for both)
+  float floor[2][3];      // the floor's two checker colours in [0, 1]
+} vd_render_look;
+
+// The renderer's look: at creation the settings' lights, the sky (0.92, 0.95, 1) to (0.55, 0.68,
+// 0.85) or the flat background, the floor (0.62, 0.57, 0.50) and (0.55, 0.50, 0.43).
+vd_render_look vd_render_get_look(const vd_renderer* r);
+// Change the lights and the stage's sky and floor colours for the next frames (a robot's MJCF
+// keeps its own sky and floor: only the lights change). VD_ERR_ARG names a value out of range.
+vd_status vd_render_set_look(vd_renderer* r, const vd_render_look* look, vd_error* err);
 // Set the robot's joint positions (MuJoCo qpos, nq values) for the next frames.
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err);
 

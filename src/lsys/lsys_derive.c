@@ -21,10 +21,48 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
   vm_budget(ls, 0);
   ls->max_depth[SEC_DECOMPOSITION] = 1;
   ls->max_depth[SEC_INTERPRETATION] = 1;
+  ls->opt_string_matching = 1;
+  ls->opt_early_return = 1;
+  ls->opt_module_matching = 2;
   // predefined modules take the first ids, in VD_SYM_LIST order
   for (int i = 0; i < VD_SYM_PREDEFINED_COUNT; i++) {
     const char* n = vd_sym_predefined_name(i);
     if (sym_intern(ls, n, (int)strlen(n), 1) != i) {
+      vd_lsys_destroy(ls);
+      vd_error_set(err, VD_ERR_NOMEM, name ? name : "", 0, 0, "out of memory");
+      return NULL;
+    }
+  }
+  // L-Py's long names of the predefined modules (its predefined module table)
+  static const struct {
+    const char* name;
+    int sym;
+  } aliases[] = {
+      {"SB", VD_SYM_SB},           {"EB", VD_SYM_EB},
+      {"Cut", VD_SYM_CUT},         {"GetPos", VD_SYM_GETPOS},
+      {"GetHead", VD_SYM_GETHEAD}, {"GetUp", VD_SYM_GETUP},
+      {"GetLeft", VD_SYM_GETLEFT}, {"GetRight", VD_SYM_GETRIGHT},
+      {"GetFrame", VD_SYM_GETFRAME}, {"StartGC", VD_SYM_STARTGC},
+      {"EndGC", VD_SYM_ENDGC},     {"BP", VD_SYM_BP},
+      {"EP", VD_SYM_EP},           {"PP", VD_SYM_PP},
+      {"MoveTo", VD_SYM_MOVETO},   {"SetHead", VD_SYM_SETHEAD},
+      {"Left", VD_SYM_LEFT},       {"Right", VD_SYM_RIGHT},
+      {"Up", VD_SYM_UP},           {"Down", VD_SYM_DOWN},
+      {"RollL", VD_SYM_ROLLL},     {"RollR", VD_SYM_ROLLR},
+      {"TurnAround", VD_SYM_TURN}, {"RollToVert", VD_SYM_ROLLTOVERT},
+      {"RollToHorizontal", VD_SYM_ROLLTOHORIZ}, {"Sphere", VD_SYM_SPHERE},
+      {"Box", VD_SYM_BOX},         {"Quad", VD_SYM_QUAD},
+      {"Circle", VD_SYM_CIRCLE},   {"Label", VD_SYM_LABEL},
+      {"IncWidth", VD_SYM_INCWIDTH}, {"DecWidth", VD_SYM_DECWIDTH},
+      {"IncColor", VD_SYM_INCCOLOR}, {"DecColor", VD_SYM_DECCOLOR},
+      {"DivScale", VD_SYM_DIVSCALE}, {"MultScale", VD_SYM_MULTSCALE},
+      {"SetScale", VD_SYM_SETSCALE}, {"PglShape", VD_SYM_PGLSHAPE},
+      {"Elasticity", VD_SYM_ELASTICITY}, {"Tropism", VD_SYM_TROPISM},
+      {"TextureVCoeff", VD_SYM_TEXVSCALE}, {"StartScreenProjection", VD_SYM_2D},
+      {"EndScreenProjection", VD_SYM_3D},
+  };
+  for (size_t i = 0; i < sizeof aliases / sizeof aliases[0]; i++) {
+    if (sym_alias(ls, aliases[i].name, aliases[i].sym) < 0) {
       vd_lsys_destroy(ls);
       vd_error_set(err, VD_ERR_NOMEM, name ? name : "", 0, 0, "out of memory");
       return NULL;
@@ -38,6 +76,7 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
   vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);
+  vd_free(ls->syms.canon, (size_t)ls->syms.cap_canon * sizeof(int));
   vd_free(ls->syms.hash_slot, (size_t)ls->syms.hcap * sizeof(int));
   for (int i = 0; i < ls->nstr; i++) vd_free(ls->str[i], strlen(ls->str[i]) + 1);
   vd_free(ls->str, (size_t)ls->capstr * sizeof(char*));
@@ -48,11 +87,15 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   vd_free(ls->funcs, (size_t)ls->capfunc * sizeof(func*));
   vd_free(ls->rules, (size_t)ls->caprule * sizeof(rule*));
   for (int s = 0; s < SEC_COUNT; s++) {
-    vd_free(ls->rule_first[s], (size_t)(ls->rule_index_nsym + 1) * sizeof(int));
-    vd_free(ls->rule_list[s], (size_t)ls->nrule * sizeof(int));
+    vd_free(ls->rule_first[s], ls->rule_first[s] ? (size_t)(ls->rule_index_nsym + 2) * sizeof(int) : 0);
+    vd_free(ls->rule_list[s], (size_t)ls->rule_list_cap[s] * sizeof(int));
   }
-  vd_free(ls->ignored, (size_t)ls->rule_index_nsym);
-  vd_free(ls->ignore_syms, sizeof(int32_t) * (size_t)ls->nignore_syms);
+  vd_free(ls->no_filter, ls->no_filter ? (size_t)ls->ign_nsym + 1 : 0);
+  for (int f = 0; f < ls->nfilter; f++) {
+    vd_free(ls->filters[f].syms, sizeof(int32_t) * (size_t)ls->filters[f].nsyms);
+    vd_free(ls->filters[f].ignored, ls->filters[f].ignored ? (size_t)ls->ign_nsym + 1 : 0);
+  }
+  vd_free(ls->filters, sizeof(cfilter) * (size_t)ls->capfilter);
   vd_free(ls->label_id, sizeof(int) * (size_t)ls->nlabel);
   vd_free(ls->label_name, sizeof(char*) * (size_t)ls->nlabel);
   vd_free(ls->scalar_slot, sizeof(int) * (size_t)ls->nscalar);
@@ -201,6 +244,9 @@ static vd_status run_toplevel(vd_lsystem* ls, uint64_t seed) {
   ls->iteration = 0;
   ls->stop_requested = 0;
   ls->call_depth = 0;
+  ls->backward = 0;
+  ls->discard_requested = 0;
+  ls->frame_displayed = 0;
   for (int i = 0; i < ls->nscalar; i++) ls->gval[ls->scalar_slot[i]] = ls->scalar_val[i];
   for (stmt* s = ls->top; s; s = s->next) {
     if (s->op == S_ASSIGN && s->is_global && ls->gdef[s->slot].has_override) {
@@ -240,342 +286,7 @@ int vd_lsys_derivation_length(const vd_lsystem* ls) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// rule index
-
-static vd_status build_index(vd_lsystem* ls) {
-  int nsym = ls->syms.n;
-  for (int s = 0; s < SEC_COUNT; s++) {
-    vd_free(ls->rule_first[s], (size_t)(ls->rule_index_nsym + 1) * sizeof(int));
-    vd_free(ls->rule_list[s], (size_t)ls->nrule * sizeof(int));
-    ls->rule_first[s] = NULL;
-    ls->rule_list[s] = NULL;
-  }
-  vd_free(ls->ignored, (size_t)ls->rule_index_nsym);
-  ls->ignored = NULL;
-  ls->rule_index_nsym = nsym;
-  for (int s = 0; s < SEC_COUNT; s++) {
-    int* first = vd_calloc((size_t)nsym + 1, sizeof(int));
-    int* list = ls->nrule ? vd_malloc(sizeof(int) * (size_t)ls->nrule) : NULL;
-    if (!first || (ls->nrule && !list)) {
-      vd_free(first, ((size_t)nsym + 1) * sizeof(int));
-      vd_free(list, sizeof(int) * (size_t)ls->nrule);
-      return VD_ERR_NOMEM;
-    }
-    ls->rule_first[s] = first;
-    ls->rule_list[s] = list;
-    ls->has_context[s] = 0;
-    // counting sort by first predecessor symbol, keeping declaration order
-    for (int r = 0; r < ls->nrule; r++)
-      if (ls->rules[r]->section == s) first[ls->rules[r]->pred[0].sym + 1]++;
-    for (int k = 0; k < nsym; k++) first[k + 1] += first[k];
-    int* fill = vd_malloc(sizeof(int) * (size_t)(nsym + 1));
-    if (!fill) return VD_ERR_NOMEM;
-    memcpy(fill, first, sizeof(int) * (size_t)(nsym + 1));
-    for (int r = 0; r < ls->nrule; r++) {
-      const rule* R = ls->rules[r];
-      if (R->section != s) continue;
-      list[fill[R->pred[0].sym]++] = r;
-      if (R->nleft || R->nright) ls->has_context[s] = 1;
-    }
-    vd_free(fill, sizeof(int) * (size_t)(nsym + 1));
-  }
-  ls->ignored = vd_calloc((size_t)nsym, 1);
-  if (!ls->ignored && nsym) return VD_ERR_NOMEM;
-  if (ls->ignore_mode == 1) {
-    for (int k = 0; k < ls->nignore_syms; k++) ls->ignored[ls->ignore_syms[k]] = 1;
-  } else if (ls->ignore_mode == 2) {
-    memset(ls->ignored, 1, (size_t)nsym);
-    for (int k = 0; k < ls->nignore_syms; k++) ls->ignored[ls->ignore_syms[k]] = 0;
-  }
-  // brackets are never ignored
-  ls->ignored[VD_SYM_SB] = ls->ignored[VD_SYM_EB] = 0;
-  return VD_OK;
-}
-
-// ---------------------------------------------------------------------------------------------
-// matching
-
-// matching bracket of every '[' and ']' (others untouched)
-static vd_status bracket_match(const vd_lstring* s, int64_t** out, int64_t* cap) {
-  if (s->n > *cap) {
-    int64_t* m = vd_realloc(*out, sizeof(int64_t) * (size_t)*cap, sizeof(int64_t) * (size_t)s->n);
-    if (!m) return VD_ERR_NOMEM;
-    *out = m;
-    *cap = s->n;
-  }
-  int64_t* m = *out;
-  // use the match array itself as the stack of open brackets: m[open] links to the previous open
-  int64_t top = -1;
-  for (int64_t i = 0; i < s->n; i++) {
-    if (s->sym[i] == VD_SYM_SB) {
-      m[i] = top;
-      top = i;
-    } else if (s->sym[i] == VD_SYM_EB) {
-      if (top < 0) {
-        m[i] = -1;  // unbalanced: acts as the start of the string
-      } else {
-        int64_t open = top;
-        top = m[open];
-        m[open] = i;
-        m[i] = open;
-      }
-    }
-  }
-  while (top >= 0) {  // unclosed: the branch runs to the end
-    int64_t prev = m[top];
-    m[top] = s->n;
-    top = prev;
-  }
-  return VD_OK;
-}
-
-static int match_module(const pmod* p, const vd_lstring* s, int64_t i, value* frame) {
-  if (s->sym[i] != p->sym) return 0;
-  int64_t a = s->par[i];
-  if (s->par[i + 1] - a != p->nparam) return 0;
-  for (int k = 0; k < p->nparam; k++) {
-    double v = s->val[a + k];
-    if (p->slot[k] >= 0) {
-      frame[p->slot[k]] = param_to_value(v);
-    } else {
-      value c = p->cval[k];
-      if (c.t == V_STR) {
-        if (lsys_unbox_str(v) != (int)c.n) return 0;
-      } else if (!(v_isnum(c) && v == c.n)) {
-        return 0;
-      }
-    }
-  }
-  return 1;
-}
-
-// previous module on the same axis: skips lateral branches and ignored modules
-static int64_t prev_axial(const vd_lsystem* ls, const vd_lstring* s, const int64_t* m, int64_t j) {
-  while (j >= 0) {
-    int32_t sym = s->sym[j];
-    if (sym == VD_SYM_EB) {
-      j = m[j] - 1;
-      continue;
-    }
-    if (sym == VD_SYM_SB || ls->ignored[sym]) {
-      j--;
-      continue;
-    }
-    return j;
-  }
-  return -1;
-}
-
-// next module on the same axis: skips lateral branches and ignored modules; -1 at the axis end
-static int64_t next_axial(const vd_lsystem* ls, const vd_lstring* s, const int64_t* m, int64_t j) {
-  while (j < s->n) {
-    int32_t sym = s->sym[j];
-    if (sym == VD_SYM_SB) {
-      j = m[j] + 1;
-      continue;
-    }
-    if (sym == VD_SYM_EB) return -1;
-    if (ls->ignored[sym]) {
-      j++;
-      continue;
-    }
-    return j;
-  }
-  return -1;
-}
-
-static int match_left(const vd_lsystem* ls, const rule* r, const vd_lstring* s, const int64_t* m, int64_t i,
-                      value* frame) {
-  int64_t j = i - 1;
-  for (int p = r->nleft - 1; p >= 0; p--) {
-    j = prev_axial(ls, s, m, j);
-    if (j < 0 || !match_module(&r->left[p], s, j, frame)) return 0;
-    j--;
-  }
-  return 1;
-}
-
-static int match_right(const vd_lsystem* ls, const rule* r, const vd_lstring* s, const int64_t* m, int64_t j,
-                       value* frame) {
-  int64_t open[64];
-  int depth = 0;
-  for (int p = 0; p < r->nright; p++) {
-    const pmod* pm = &r->right[p];
-    if (pm->sym == VD_SYM_SB) {
-      // an explicit lateral branch: the next non-ignored module must open one
-      while (j < s->n && s->sym[j] != VD_SYM_SB && s->sym[j] != VD_SYM_EB && ls->ignored[s->sym[j]]) j++;
-      if (j >= s->n || s->sym[j] != VD_SYM_SB || depth == 64) return 0;
-      open[depth++] = j;
-      j++;
-      continue;
-    }
-    if (pm->sym == VD_SYM_EB) {
-      // the pattern leaves the branch: skip the rest of it
-      if (depth == 0) return 0;
-      int64_t o = open[--depth];
-      j = m[o] + 1;  // NOLINT(clang-analyzer-core.NullDereference): m holds every module of a non-empty L-string
-      continue;
-    }
-    j = next_axial(ls, s, m, j);
-    if (j < 0 || !match_module(pm, s, j, frame)) return 0;
-    j++;
-  }
-  return 1;
-}
-
-// ---------------------------------------------------------------------------------------------
-// one rewriting pass
-
-typedef struct pass_ctx {
-  int64_t* match;
-  int64_t match_cap;
-  int64_t max_modules;
-} pass_ctx;
-
-static vd_status copy_module(vd_lsystem* ls, const vd_lstring* in, int64_t i, vd_lstring* out, int64_t src,
-                             int64_t max_modules) {
-  int64_t a = in->par[i], np = in->par[i + 1] - a;
-  if (out->n + 1 > out->cap || out->par[out->n] + np > out->vcap) {
-    if (out->n + 1 > max_modules)
-      return vm_error(ls, VD_ERR_LIMIT, 0, 0, "the L-string would exceed %lld modules (raise --max-modules)",
-                      (long long)max_modules);
-    if (!lstr_reserve(out, out->n + 1, out->par[out->n] + np))
-      return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
-  }
-  int64_t n = out->n;
-  out->sym[n] = in->sym[i];
-  if (out->src) out->src[n] = src;
-  int64_t v = out->par[n];
-  for (int64_t k = 0; k < np; k++) out->val[v + k] = in->val[a + k];
-  out->par[n + 1] = v + np;
-  out->n = n + 1;
-  return VD_OK;
-}
-
-static vd_status apply_rules(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* out, pass_ctx* P,
-                             int* fired) {
-  // a pass reads every module once: it costs that many operations, so a derivation of many
-  // steps over a long string is bounded by max_ops like a runaway loop
-  vd_status sp = vm_spend(ls, in->n);
-  if (sp) return sp;
-  lstr_clear(out);
-  if (!lstr_reserve(out, in->n + 16, in->par[in->n] + 16))
-    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
-  *fired = 0;
-  if (ls->has_context[sec] && bracket_match(in, &P->match, &P->match_cap))
-    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-  const int* first = ls->rule_first[sec];
-  const int* list = ls->rule_list[sec];
-  int nsym = ls->rule_index_nsym;
-  value small[64];
-  vm_out vo = {out, 0, P->max_modules, 0, 0};
-  for (int64_t i = 0; i < in->n;) {
-    int32_t sym = in->sym[i];
-    int64_t src = in->src ? in->src[i] : i;
-    int done = 0;
-    if (sym < nsym && first[sym] != first[sym + 1]) {
-      for (int k = first[sym]; k < first[sym + 1] && !done; k++) {
-        const rule* r = ls->rules[list[k]];
-        if (r->group != 0 && r->group != ls->current_group) continue;
-        if (i + r->npred > in->n) continue;
-        value* frame = small;
-        int nl = r->nlocal;
-        if (nl > 64) {
-          frame = vd_malloc(sizeof(value) * (size_t)nl);
-          if (!frame) return vm_error(ls, VD_ERR_NOMEM, r->line, 0, "out of memory");
-        }
-        for (int q = 0; q < nl; q++) frame[q] = (value){V_UNDEF, 0};
-        int ok = 1;
-        for (int q = 0; q < r->npred && ok; q++) ok = match_module(&r->pred[q], in, i + q, frame);
-        if (ok && r->nleft) ok = match_left(ls, r, in, P->match, i, frame);
-        if (ok && r->nright) ok = match_right(ls, r, in, P->match, i + r->npred, frame);
-        if (ok) {
-          int64_t mark = out->n;
-          vo.src = src;
-          vo.produced = vo.nproduced = 0;
-          vd_status st;
-          if (r->succ) {
-            st = vm_emit_tmpl(ls, r->succ, frame, &vo);
-            vo.produced = 1;
-          } else {
-            st = vm_exec_block(ls, r->body, frame, &vo, NULL, NULL);
-          }
-          if (st) {
-            if (frame != small) vd_free(frame, sizeof(value) * (size_t)nl);
-            return st;
-          }
-          if (vo.produced || vo.nproduced) {
-            done = 1;
-            *fired = 1;
-            i += r->npred;
-          } else {
-            out->n = mark;  // the body produced nothing: the rule fails, try the next one
-          }
-        }
-        if (frame != small) vd_free(frame, sizeof(value) * (size_t)nl);
-      }
-    }
-    if (!done) {
-      vd_status st = copy_module(ls, in, i, out, src, P->max_modules);
-      if (st) return st;
-      i++;
-    }
-  }
-  return VD_OK;
-}
-
-// % removes itself and the rest of its branch (up to, not including, the closing ']')
-static void apply_cut(vd_lstring* s) {
-  int64_t w = 0, wv = 0;
-  for (int64_t i = 0; i < s->n;) {
-    if (s->sym[i] == VD_SYM_CUT) {
-      int depth = 0;
-      int64_t j = i + 1;
-      for (; j < s->n; j++) {
-        if (s->sym[j] == VD_SYM_SB) depth++;
-        else if (s->sym[j] == VD_SYM_EB && depth-- == 0) break;
-      }
-      i = j;
-      continue;
-    }
-    int64_t a = s->par[i], np = s->par[i + 1] - a;
-    s->sym[w] = s->sym[i];
-    if (s->src) s->src[w] = s->src[i];
-    memmove(s->val + wv, s->val + a, sizeof(double) * (size_t)np);
-    s->par[w] = wv;
-    wv += np;
-    w++;
-    i++;
-  }
-  s->n = w;
-  s->par[w] = wv;
-}
-
-static int has_cut(const vd_lstring* s) {
-  for (int64_t i = 0; i < s->n; i++)
-    if (s->sym[i] == VD_SYM_CUT) return 1;
-  return 0;
-}
-
-static void lstr_swap(vd_lstring* a, vd_lstring* b) {
-  vd_lstring t = *a;
-  *a = *b;
-  *b = t;
-}
-
-// repeated passes of a section's rules (decomposition, interpretation) up to its maximum depth
-static vd_status apply_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, pass_ctx* P) {
-  if (ls->rule_first[sec][ls->rule_index_nsym] == 0) return VD_OK;
-  for (int d = 0; d < ls->max_depth[sec]; d++) {
-    int fired = 0;
-    vd_status st = apply_rules(ls, sec, cur, tmp, P, &fired);
-    if (st) return st;
-    lstr_swap(cur, tmp);
-    if (!fired) break;
-  }
-  if (has_cut(cur)) apply_cut(cur);
-  return VD_OK;
-}
+// hooks
 
 static int find_hook(vd_lsystem* ls, const char* name) {
   int slot = global_slot(ls, name, (int)strlen(name), 0);
@@ -594,13 +305,47 @@ static vd_status call_hook(vd_lsystem* ls, int fi) {
 }
 
 // release a run's scratch, make sure a failure has a message, detach the error sink
-static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, pass_ctx* P) {
+static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, lsys_pass* P) {
   vd_lstring_free(tmp);
-  vd_free(P->match, sizeof(int64_t) * (size_t)P->match_cap);
+  lsys_pass_free(P);
   if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
   ls->err = NULL;
   return st;
 }
+
+static void lstr_swap(vd_lstring* a, vd_lstring* b) {
+  vd_lstring t = *a;
+  *a = *b;
+  *b = t;
+}
+
+// `maximum depth:` of a section, evaluated after the top-level code (default 1)
+static vd_status eval_max_depth(vd_lsystem* ls, int sec) {
+  ls->max_depth[sec] = 1;
+  const expr* e = ls->max_depth_expr[sec];
+  if (!e) return VD_OK;
+  value v;
+  vd_status st = vm_eval(ls, e, NULL, &v);
+  if (st) return st;
+  if (!v_isnum(v) || !(v.n >= 1 && v.n <= 1000))
+    return vm_error(ls, VD_ERR_VALUE, e->line, e->col, "maximum depth must be a number in 1..1000");
+  ls->max_depth[sec] = (int)v.n;  // L-Py rounds a float down
+  return VD_OK;
+}
+
+// the whole string through a section's recursive rewriting (also applies the cuts)
+static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, lsys_pass* P,
+                                 int* matched) {
+  lstr_clear(tmp);
+  if (!lstr_reserve(tmp, cur->n + 16, cur->par[cur->n] + 16) || (cur->src && !lstr_enable_src(tmp)))
+    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
+  vd_status st = lsys_recursive(ls, sec, cur, tmp, P, ls->max_depth[sec], 0, matched);
+  if (st) return st;
+  lstr_swap(cur, tmp);
+  return VD_OK;
+}
+
+static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 
 vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
   vd_error local = {0};
@@ -609,12 +354,10 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   if (d.max_modules <= 0) d.max_modules = 50000000;
   vm_budget(ls, d.max_ops);
   vd_lstring tmp = vd_lstring_empty();
-  pass_ctx P = {NULL, 0, d.max_modules};
-  vd_status st = build_index(ls);
-  if (st) {
-    vm_error(ls, st, 0, 0, "out of memory");
-    goto done;
-  }
+  lsys_pass P;
+  memset(&P, 0, sizeof P);
+  P.max_modules = d.max_modules;
+  vd_status st = VD_OK;
   if (out->src) {
     vd_free(out->src, sizeof(int64_t) * (size_t)out->cap);
     out->src = NULL;
@@ -634,11 +377,15 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
       steps = (int)v.n;
     }
   }
+  if ((st = eval_max_depth(ls, SEC_DECOMPOSITION)) || (st = eval_max_depth(ls, SEC_INTERPRETATION))) goto done;
+  if ((st = lsys_build_index(ls, 0, ls->backward))) {
+    vm_error(ls, st, 0, 0, "out of memory");
+    goto done;
+  }
   ls->hook_start = find_hook(ls, "Start");
   ls->hook_end = find_hook(ls, "End");
   ls->hook_starteach = find_hook(ls, "StartEach");
   ls->hook_endeach = find_hook(ls, "EndEach");
-  if ((st = call_hook(ls, ls->hook_start))) goto done;
   // axiom
   lstr_clear(out);
   if (!lstr_reserve(out, 64, 64)) {
@@ -649,7 +396,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     vm_out vo = {out, 0, d.max_modules, 0, 0};
     if (ls->axiom) {
       st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
-    } else {
+    } else if (ls->axiom_body) {
       int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
       value* frame = vd_malloc(sizeof(value) * (size_t)nl);
       if (!frame) {
@@ -662,19 +409,56 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     }
     if (st) goto done;
   }
-  if (has_cut(out)) apply_cut(out);
-  for (int step = 0; step < steps && !ls->stop_requested; step++) {
-    ls->iteration = step;
-    if ((st = call_hook(ls, ls->hook_starteach))) goto done;
-    int fired = 0;
-    if ((st = apply_rules(ls, SEC_PRODUCTION, out, &tmp, &P, &fired))) goto done;
-    lstr_swap(out, &tmp);
-    if (has_cut(out)) apply_cut(out);
-    if ((st = apply_section(ls, SEC_DECOMPOSITION, out, &tmp, &P))) goto done;
-    if ((st = call_hook(ls, ls->hook_endeach))) goto done;
-    if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
+  // L-Py returns at once, without calling any hook, when there is no rule or no axiom (and
+  // "Early return when no matching" is on, its default)
+  if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) goto done;
+  ls->iteration = 0;
+  if ((st = call_hook(ls, ls->hook_start))) goto done;
+  if (ls->opt_axiom_decomposition && !lsys_section_empty(ls, SEC_DECOMPOSITION)) {
+    int dm = 0;
+    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
   }
-  if ((st = call_hook(ls, ls->hook_end))) goto done;
+  int matching = 1, step = 0;
+  // DiscardNewString() (L-Py's __lpyfuture__) drops a step's result for the string at the end
+  // of the step before; it works through the EndEach that module provides (or decorates)
+  int discard = global_slot(ls, "DiscardNewString", 16, 0) >= 0 &&
+                (ls->hook_endeach < 0 || ls->funcs[ls->hook_endeach]->discard_wrapped);
+  int has_saved = 0;
+  for (; (matching || !ls->opt_early_return) && step < steps; step++) {
+    ls->iteration = step;
+    ls->frame_displayed = step == steps - 1;
+    if ((st = call_hook(ls, ls->hook_starteach))) goto done;
+    // useGroup() and backward() take effect at the next step
+    if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) {
+      vm_error(ls, st, 0, 0, "out of memory");
+      goto done;
+    }
+    if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
+      if ((st = lsys_step(ls, SEC_PRODUCTION, out, &tmp, &P, &matching))) goto done;
+      lstr_swap(out, &tmp);
+    }
+    if (!lsys_section_empty(ls, SEC_DECOMPOSITION)) {
+      int dm = 0;
+      if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
+      if (dm) matching = 1;
+    }
+    if (!(discard && ls->discard_requested) && (st = call_hook(ls, ls->hook_endeach))) goto done;
+    if (discard) {
+      if (ls->discard_requested) {
+        ls->discard_requested = 0;
+        if (has_saved) lstr_swap(out, &P.saved);
+      } else {
+        if (!lsys_lstring_copy(&P.saved, out)) {
+          st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+          goto done;
+        }
+        has_saved = 1;
+      }
+    }
+    if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
+    if (ls->stop_requested) break;  // Stop(): L-Py ends here, without End()
+  }
+  if (step == steps && (st = call_hook(ls, ls->hook_end))) goto done;
 done:
   return end_run(ls, st, &tmp, &P);
 }
@@ -686,25 +470,26 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
   vm_budget(ls, d.max_ops);
-  pass_ctx P = {NULL, 0, d.max_modules};
+  lsys_pass P;
+  memset(&P, 0, sizeof P);
+  P.max_modules = d.max_modules;
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;
-  if (ls->rule_index_nsym != ls->syms.n && (st = build_index(ls))) {
+  // interpretation rules of the group in use at the end of the derivation, read forward
+  if ((st = lsys_build_index(ls, ls->current_group, 0))) {
     vm_error(ls, st, 0, 0, "out of memory");
     goto done;
   }
-  // copy the input with its source indices
+  if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
   lstr_clear(out);
-  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 1, in->par[in->n] + 1) || !lstr_enable_src(&tmp)) {
+  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16)) {
     st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
     goto done;
   }
-  memcpy(out->sym, in->sym, sizeof(int32_t) * (size_t)in->n);
-  memcpy(out->par, in->par, sizeof(int64_t) * (size_t)(in->n + 1));
-  memcpy(out->val, in->val, sizeof(double) * (size_t)in->par[in->n]);
-  for (int64_t i = 0; i < in->n; i++) out->src[i] = in->src ? in->src[i] : i;
-  out->n = in->n;
-  st = apply_section(ls, SEC_INTERPRETATION, out, &tmp, &P);
+  {
+    int m = 0;
+    st = lsys_recursive(ls, SEC_INTERPRETATION, in, out, &P, ls->max_depth[SEC_INTERPRETATION], 0, &m);
+  }
 done:
   return end_run(ls, st, &tmp, &P);
 }

@@ -57,6 +57,8 @@ enum {
   B_RANDOM, B_UNIFORM, B_GAUSS, B_NORMALVARIATE, B_RANDINT, B_RANDRANGE, B_SEED,
   B_TRIANGULAR, B_EXPOVARIATE,
   B_GETITERATIONNB, B_USEGROUP, B_GETGROUP, B_STOP, B_PRINT_UNUSED,
+  B_BACKWARD, B_FORWARD, B_ISFORWARD, B_FRAMEDISPLAY, B_ISFRAMEDISPLAYED, B_ISANIMATIONENABLED,
+  B_DISCARDNEWSTRING,
   B_COUNT
 };
 
@@ -117,6 +119,13 @@ static const builtin builtins[B_COUNT] = {
     [B_GETGROUP] = {"getGroup", 0, 0, 0},
     [B_STOP] = {"Stop", 0, 0, 0},
     [B_PRINT_UNUSED] = {"", 99, 99, -1},
+    [B_BACKWARD] = {"backward", 0, 0, 0},
+    [B_FORWARD] = {"forward", 0, 0, 0},
+    [B_ISFORWARD] = {"isForward", 0, 0, 0},
+    [B_FRAMEDISPLAY] = {"frameDisplay", 0, 1, 0},
+    [B_ISFRAMEDISPLAYED] = {"isFrameDisplayed", 0, 0, 0},
+    [B_ISANIMATIONENABLED] = {"isAnimationEnabled", 0, 0, 0},
+    [B_DISCARDNEWSTRING] = {"DiscardNewString", 0, 0, 0},
 };
 
 int builtin_find(const char* name, int len) {
@@ -388,6 +397,21 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
     case B_GETGROUP: *out = v_int(ls->current_group); break;
     case B_STOP:
       ls->stop_requested = 1;
+      *out = (value){V_NONE, 0};
+      break;
+    // derivation direction: backward() takes effect at the next step (L-Py)
+    case B_BACKWARD:
+    case B_FORWARD:
+      ls->backward = b == B_BACKWARD;
+      *out = (value){V_NONE, 0};
+      break;
+    case B_ISFORWARD: *out = (value){V_BOOL, !ls->backward}; break;
+    // the scene is made once, after the last step: frameDisplay() has nothing to change
+    case B_FRAMEDISPLAY: *out = (value){V_NONE, 0}; break;
+    case B_ISFRAMEDISPLAYED: *out = (value){V_BOOL, ls->frame_displayed}; break;
+    case B_ISANIMATIONENABLED: *out = (value){V_BOOL, 0}; break;
+    case B_DISCARDNEWSTRING:
+      ls->discard_requested = 1;
       *out = (value){V_NONE, 0};
       break;
     default: return vm_error(ls, VD_ERR_UNSUPPORTED, line, col, "unsupported builtin");

@@ -81,6 +81,7 @@ typedef struct tmpl {
   int n;
   tmod* mod;
   int has_cut;  // contains %
+  int drop;     // starts with `*`: L-Py discards the whole production (deletes the module)
 } tmpl;
 
 typedef enum sop {
@@ -108,6 +109,7 @@ typedef struct stmt {
 // A user function (def).
 typedef struct func {
   char name[64];
+  int discard_wrapped;  // decorated with @enable_string_discard (L-Py's __lpyfuture__)
   int nparam;
   int nlocal;
   stmt* body;
@@ -117,29 +119,75 @@ typedef struct func {
 // ---------------------------------------------------------------------------------------------
 // rules
 
-// One module of a predecessor or context pattern. sym VD_SYM_SB/EB mark explicit brackets.
+// Kinds of pattern elements (L-Py's pattern modules).
+enum {
+  PK_MOD = 0,  // a module: same symbol and parameter count (brackets included)
+  PK_ANY,      // `*`: any module; `*(name, x, ...)` binds the name and the parameters
+  PK_REP,      // `x(pattern [, min [, max]])`: repetition of a sub-pattern
+  PK_OR,       // `or(pattern, pattern, ...)`: the first alternative that matches
+  PK_NONE,     // `None` (inside or()): matches nothing
+};
+
+struct pstr;
+
+// One element of a predecessor or context pattern.
 typedef struct pmod {
-  int32_t sym;
-  int nparam;
-  int* slot;      // binding slot per parameter, -1 when the parameter is a constant
-  value* cval;    // constant value per parameter (when slot is -1)
+  int32_t sym;     // PK_MOD: symbol (VD_SYM_SB / VD_SYM_EB for explicit brackets)
+  int nparam;      // PK_MOD: parameters; PK_ANY: parameters after the name
+  int* slot;       // binding slot per parameter, -1 when the parameter is a constant
+  value* cval;     // constant value per parameter (when slot is -1)
+  int kind;        // PK_*
+  int exact;       // `=]`: the closing bracket must come next (no skip to the branch end)
+  struct pext* x;  // PK_ANY with a name, PK_REP, PK_OR: the rest (NULL otherwise)
   int line, col;
 } pmod;
+
+// What a few pattern elements need beyond a module.
+typedef struct pext {
+  int has_name;    // PK_ANY: written with parameters, the first one is the module name
+  int name_slot;   // PK_ANY: slot of the name, -1 when the name is a constant (name_val)
+  value name_val;  // PK_ANY: constant name (a string)
+  struct pstr* sub;  // PK_REP: the repeated pattern (sub[0]); PK_OR: the alternatives
+  int nsub;
+  int rmin, rmax;  // PK_REP: repetitions allowed
+} pext;
+
+// A pattern: a string of pattern elements.
+typedef struct pstr {
+  int n;
+  pmod* m;
+} pstr;
 
 enum { SEC_PRODUCTION = 0, SEC_DECOMPOSITION = 1, SEC_INTERPRETATION = 2, SEC_COUNT = 3 };
 
 typedef struct rule {
-  int section;    // SEC_*
-  int group;      // rule group (0 = always active)
-  int npred, nleft, nright;
-  pmod* pred;     // strict predecessor (npred modules)
-  pmod* left;     // left context in reading order (nleft)
-  pmod* right;    // right context (nright)
+  // what the rewriting loop reads first
+  pstr pred;      // strict predecessor
+  pstr left;      // left context `<`, in reading order
+  pstr right;     // right context `>`
+  int simple;     // only plain modules, no new contexts, no bracket outside the right context:
+                  // the fast matcher applies (axial-tree matching, forward)
   int nlocal;     // frame size (pattern variables + body locals)
   tmpl* succ;     // one-line successor (NULL when the rule has a body)
   stmt* body;     // rule body
+  int filter;     // consider/ignore filter in force where the rule was written (-1: none)
+  // the rest
+  pstr nleft;     // new left context `<<` (forward derivation only)
+  pstr nright;    // new right context `>>` (backward derivation only)
+  int section;    // SEC_*
+  int group;      // rule group (0 = always active)
+  int is_static;  // -static-> / @static: L-Py evaluates the successor once
   int line;
 } rule;
+
+// A consider:/ignore: filter: the symbols listed, and whether they are ignored or the only
+// ones considered (brackets are always considered).
+typedef struct cfilter {
+  int mode;          // 1 ignore the listed symbols, 2 consider only them
+  int32_t* syms;     // (nsyms)
+  int nsyms;
+  unsigned char* ignored;  // per symbol, built at derive time (rule_index_nsym)
+} cfilter;
 
 // ---------------------------------------------------------------------------------------------
 // the lsystem
@@ -152,6 +200,8 @@ typedef struct symtab {
   int hcap;
   int maxlen;         // longest predefined or declared name (for longest match)
   unsigned char* declared;  // 1 when the name takes part in longest-match tokenising (n)
+  int* canon;         // the symbol a name stands for: itself, or the short name of an alias (n)
+  int cap_canon;      // capacity of canon
 } symtab;
 
 typedef struct global_def {
@@ -188,18 +238,32 @@ struct vd_lsystem {
   stmt* axiom_body;        // functional axiom (or NULL)
   int axiom_nlocal;
   expr* derivation_length; // NULL = 1
-  int max_depth[SEC_COUNT];  // maximum depth for decomposition / interpretation
+  expr* max_depth_expr[SEC_COUNT];  // `maximum depth:` of decomposition / interpretation (NULL = 1)
+  int max_depth[SEC_COUNT];  // its value in this run
   int nrule, caprule;
   rule** rules;
-  // rules indexed by predecessor's first symbol, per section: ruleidx[sec][sym] -> list
-  int* rule_first[SEC_COUNT];   // start index into rule_list (nsym + 1), built at derive time
-  int* rule_list[SEC_COUNT];
+  // the rules that apply, per section, indexed by the predecessor's first symbol (last symbol
+  // when deriving backward): rule_list[rule_first[sym]] .. rule_list[rule_first[sym + 1] - 1],
+  // rules of the active group first, then those of group 0, each in file order; `*` rules are
+  // in every list. Rebuilt when the group, the direction or the symbol count changes.
+  int* rule_first[SEC_COUNT];   // (rule_index_nsym + 1)
+  int* rule_list[SEC_COUNT];    // (rule_list_cap[sec])
+  int rule_list_cap[SEC_COUNT];
   int rule_index_nsym;
-  int has_context[SEC_COUNT];
-  unsigned char* ignored;  // 1 for symbols skipped in context matching (nsym)
-  int ignore_mode;         // 0 none, 1 ignore list, 2 consider list
-  int32_t* ignore_syms;
-  int nignore_syms;
+  int rule_index_group, rule_index_dir;  // what the index was built for
+  int has_context[SEC_COUNT];   // some rule of the index reads a context (brackets matched)
+  int has_generic[SEC_COUNT];   // some rule of the index needs the general matcher
+  int nfilter, capfilter;
+  cfilter* filters;             // consider/ignore filters (nfilter)
+  unsigned char* no_filter;     // all zero: what a rule without filter ignores (ign_nsym + 1)
+  int ign_nsym;                 // symbols covered by the ignored tables
+  int cur_filter;               // filter in force while parsing (-1 none)
+  // L-Py options (INITIALISATION block or run time)
+  int opt_string_matching;      // 0 as string, 1 as axial tree (default)
+  int opt_early_return;         // 1: the derivation ends after a step where no rule matched
+  int opt_module_matching;      // 0 simple, 1 with *args, 2 with value constraints (default)
+  int opt_axiom_decomposition;  // 1: the axiom is decomposed before the first step
+  int has_bases;                // a module declaration names base modules (inheritance)
   // labels declared by the file
   int nlabel;
   int* label_id;
@@ -216,6 +280,9 @@ struct vd_lsystem {
   int current_group;
   int iteration;
   int stop_requested;
+  int backward;            // derive right to left (backward()); new right contexts apply
+  int frame_displayed;     // the step is the last one (L-Py draws a frame then)
+  int discard_requested;   // DiscardNewString(): the step's result is dropped
   int call_depth;
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
   int64_t ops_left;        // what is left of it
@@ -228,6 +295,10 @@ struct vd_lsystem {
 // symbol table
 int sym_intern(vd_lsystem* ls, const char* name, int len, int declared);
 int sym_find(const vd_lsystem* ls, const char* name, int len);
+// Register `alias` (a long name such as "Left") as another spelling of symbol `canon`.
+int sym_alias(vd_lsystem* ls, const char* alias, int canon);
+// The symbol a name id stands for (aliases resolve to their short name).
+static inline int sym_canon(const vd_lsystem* ls, int id) { return ls->syms.canon[id]; }
 #define LSYS_MAX_STR_BYTES (64 << 20)  // all strings of an lsystem together (bytes)
 // Id of a string, added when new; -1 out of memory, -2 over LSYS_MAX_STR_BYTES.
 int str_intern(vd_lsystem* ls, const char* s, int len);
@@ -241,6 +312,8 @@ int global_slot(vd_lsystem* ls, const char* name, int len, int create);
 int lstr_reserve(vd_lstring* s, int64_t nmod, int64_t nval);
 void lstr_clear(vd_lstring* s);
 int lstr_enable_src(vd_lstring* s);
+// Copy src into dst (dst's arrays reused; src indices copied when src has them); 0 out of memory.
+int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src);
 
 // parser
 vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len);
@@ -261,6 +334,63 @@ typedef struct vm_out {
   int produced;        // a produce ran (body finished)
   int nproduced;       // an nproduce ran
 } vm_out;
+
+// ---------------------------------------------------------------------------------------------
+// rewriting (lsys_rewrite.c) and matching (lsys_match.c)
+
+// What one rule match reads: the string rewritten, its bracket match, the string being written
+// (for new contexts), the direction and the per-filter tables of ignored symbols.
+typedef struct lsys_mctx {
+  vd_lsystem* ls;
+  const vd_lstring* src;        // the string read
+  const int64_t* match;         // Nullable: bracket match of src
+  const vd_lstring* dest;       // the string written so far (back to front when backward)
+  int backward;                 // right-to-left pass: predecessors are matched ending at i
+  int string_mode;              // L-Py's "String matching: As String" option
+  unsigned char* const* ignored;  // [filter + 1]: ignored symbols of each filter ([0]: none)
+  int nsym;                     // size of each ignored table
+} lsys_mctx;
+
+// Scratch of the recursive rewriting, one per depth.
+typedef struct lsys_level {
+  vd_lstring buf;      // what the rule at this depth produced
+  int64_t* match;      // bracket match of the string read at this depth
+  int64_t match_cap;
+} lsys_level;
+
+// Scratch of the passes of one run.
+typedef struct lsys_pass {
+  int64_t* match;         // bracket match of the string read by a step
+  int64_t match_cap;
+  int64_t max_modules;    // largest string allowed
+  lsys_level* lvl;        // recursion scratch (nlvl)
+  int nlvl, caplvl;
+  unsigned char** ignored;  // per-filter tables handed to the matcher (cap_ignored)
+  int cap_ignored;
+  vd_lstring saved;       // the string at the end of the previous step (DiscardNewString)
+} lsys_pass;
+
+// (Re)build the rule index for a group and a direction (no-op when up to date).
+vd_status lsys_build_index(vd_lsystem* ls, int group, int backward);
+// 1 when the section has no rule in the current index.
+int lsys_section_empty(const vd_lsystem* ls, int sec);
+// Bracket match of s: for each '[' its ']' (s->n when unclosed), for each ']' its '[' (-1).
+vd_status lsys_bracket_match(const vd_lstring* s, int64_t** out, int64_t* cap);
+// Append module i of in to out with source index src.
+vd_status lsys_copy_module(vd_lsystem* ls, const vd_lstring* in, int64_t i, vd_lstring* out, int64_t src,
+                           int64_t max_modules);
+// Reverse the order of the modules [a, s->n) of s.
+void lsys_reverse_tail(vd_lstring* s, int64_t a);
+// One parallel step of a section over in, into out (cleared first); *matched = a rule applied.
+vd_status lsys_step(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* out, lsys_pass* P, int* matched);
+// L-Py's recursive rewriting (decomposition, interpretation) of in, appended to out: each
+// production is rewritten again on its own, up to depth levels.
+vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstring* out, lsys_pass* P, int depth,
+                         int level, int* matched);
+// Free a run's scratch.
+void lsys_pass_free(lsys_pass* P);
+// Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
+int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
 
 vd_status vm_exec_block(vd_lsystem* ls, stmt* s, value* frame, vm_out* out, int* returned,
                         value* retval);

@@ -34,6 +34,7 @@ typedef struct parser {
   int nline, capline;
   char* joined;       // storage for joined logical lines (arena)
   int failed;
+  int discard_decorator;  // the next def is decorated with @enable_string_discard
 } parser;
 
 // parse errors are recorded like run-time errors: the first one wins
@@ -54,6 +55,8 @@ static int is_blank(const char* s, int len) {
   return 1;
 }
 
+static int is_space_c(char c) { return c == ' ' || c == '\t'; }
+
 static int word_at(const char* s, int len, int i, const char* w) {
   int n = (int)strlen(w);
   if (i + n > len || memcmp(s + i, w, (size_t)n) != 0) return 0;
@@ -64,10 +67,10 @@ static int word_at(const char* s, int len, int i, const char* w) {
 // bracket balance change of a physical line, ignoring strings and comments. In L-strings
 // (after produce/nproduce, after -->, on Axiom:/ignore:/consider: lines) only parentheses
 // count: [ ] { } are modules there, and a trailing \ is the RollR module, not a continuation.
-static int bracket_delta(const char* s, int len, int* backslash) {
+static int bracket_delta(const char* s, int len, int* backslash, int header) {
   int d = 0;
   char q = 0;
-  int lstr = 0;
+  int lstr = header;  // a rule header: brackets are modules in its patterns
   *backslash = 0;
   static const char* lstr_lines[] = {"Axiom:", "axiom:", "ignore:", "consider:"};
   for (size_t k = 0; k < sizeof lstr_lines / sizeof lstr_lines[0]; k++)
@@ -108,6 +111,7 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
   *init_at = len;
   size_t pos = 0;
   int lineno = 0;
+  int in_rules = 0, rule_indent = -1;  // inside a rule section; indentation of its rules
   while (pos < len) {
     // one physical line
     size_t start = pos;
@@ -129,9 +133,33 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
       break;
     }
     pline L = {s + k, n - k, lineno, k + 1, ind, is_blank(s + k, n - k)};
+    // rule sections: their header lines (at the section's rule indentation) hold patterns,
+    // where [ ] { } are modules; the indented bodies are Python
+    int header = 0;
+    if (!L.blank) {
+      static const char* secs[] = {"production", "interpretation", "homomorphism", "decomposition"};
+      int is_sec = 0;
+      for (size_t q = 0; q < sizeof secs / sizeof secs[0]; q++) {
+        int kl = (int)strlen(secs[q]), p = kl;
+        if (ind == 0 && L.len >= kl && memcmp(L.s, secs[q], (size_t)kl) == 0) {
+          while (p < L.len && is_space_c(L.s[p])) p++;
+          if (p < L.len && L.s[p] == ':') is_sec = 1;
+        }
+      }
+      if (is_sec) {
+        in_rules = 1;
+        rule_indent = -1;
+      } else if (ind == 0 && (word_at(L.s, L.len, 0, "endlsystem") || word_at(L.s, L.len, 0, "def") ||
+                              word_at(L.s, L.len, 0, "class") || word_at(L.s, L.len, 0, "Axiom"))) {
+        in_rules = 0;
+      } else if (in_rules) {
+        if (rule_indent < 0) rule_indent = ind;
+        header = ind <= rule_indent;
+      }
+    }
     // join continuation lines while brackets are open or the line ends with a backslash
     int bs = 0;
-    int depth = L.blank ? 0 : bracket_delta(L.s, L.len, &bs);
+    int depth = L.blank ? 0 : bracket_delta(L.s, L.len, &bs, header);
     if (depth > 0 || bs) {
       // copy into the arena, joining with spaces
       size_t cap = (size_t)L.len + 1;
@@ -152,7 +180,7 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
         if (pos < len) pos++;
         lineno++;
         if (e2 > s2 && text[e2 - 1] == '\r') e2--;
-        int d2 = bracket_delta(text + s2, (int)(e2 - s2), &bs);
+        int d2 = bracket_delta(text + s2, (int)(e2 - s2), &bs, header);
         depth += d2;
         // strip a trailing comment from the piece before joining
         size_t piece = e2 - s2;
@@ -856,7 +884,7 @@ static int read_module_name(vd_lsystem* ls, const char* s, int len, int* pos, in
     int id = sym_find(ls, s + p, l);
     if (id >= 0 && ls->syms.declared[id]) {
       *pos = p + l;
-      return id;
+      return sym_canon(ls, id);
     }
   }
   if (c == '(' || c == ')' || c == '\'' || c == '"') {
@@ -884,6 +912,15 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     while (pos < len && is_space(s[pos])) pos++;
     if (pos >= len || s[pos] == '#') break;
     int mcol = col0 + pos;
+    if (s[pos] == '*') {
+      // `produce *`, `--> *`: a successor that starts with the any-module `*` produces
+      // nothing (L-Py drops the whole production); a `*` further on has no meaning there
+      if (t->n > 0) {
+        perr(ls, VD_ERR_UNSUPPORTED, lineno, mcol, "unsupported: '*' module inside a successor");
+        goto fail;
+      }
+      t->drop = 1;
+    }
     int sym = read_module_name(ls, s, len, &pos, lineno, col0);
     if (sym < 0) goto fail;
     if (t->n == cap) {
@@ -939,6 +976,7 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     }
   }
   t->mod = mods;
+  if (t->drop) t->n = 0;  // `*` first: nothing is emitted (the modules were read for their syntax)
   return t;
 fail:
   if (ls->err && ls->err->status == VD_OK) perr(ls, VD_ERR_NOMEM, lineno, col0, "out of memory");
@@ -964,98 +1002,305 @@ expr* lsys_parse_expr_text(vd_lsystem* ls, const char* text, int len, int line, 
   return e;
 }
 
-// parse a pattern (predecessor or context) s[a..b): modules whose parameters are names
-// (bound into scope) or constants
-static pmod* parse_pattern(vd_lsystem* ls, scope* sc, const char* s, int a, int b, int lineno, int col0,
-                           int* count) {
+// end of the parenthesised text that starts at s[p] == '(' (index of its ')'), or -1; only
+// parentheses nest: brackets are modules in patterns
+static int close_paren(const char* s, int p, int b) {
+  int depth = 0;
+  char q = 0;
+  for (int i = p; i < b; i++) {
+    char c = s[i];
+    if (q) {
+      if (c == '\\') i++;
+      else if (c == q) q = 0;
+    } else if (c == '\'' || c == '"') {
+      q = c;
+    } else if (c == '(') {
+      depth++;
+    } else if (c == ')' && --depth == 0) {
+      return i;
+    }
+  }
+  return -1;
+}
+
+// next top-level comma in s[p..b) (outside parentheses and strings), or b
+static int next_comma(const char* s, int p, int b) {
+  int depth = 0;
+  char q = 0;
+  for (int i = p; i < b; i++) {
+    char c = s[i];
+    if (q) {
+      if (c == '\\') i++;
+      else if (c == q) q = 0;
+    } else if (c == '\'' || c == '"') {
+      q = c;
+    } else if (c == '(') {
+      depth++;
+    } else if (c == ')') {
+      depth--;
+    } else if (c == ',' && depth == 0) {
+      return i;
+    }
+  }
+  return b;
+}
+
+// does s[p..b) start with the word w followed (after spaces) by '('? returns the index of '('
+static int call_word_at(const char* s, int p, int b, const char* w) {
+  int n = (int)strlen(w);
+  if (p + n > b || memcmp(s + p, w, (size_t)n) != 0) return -1;
+  int q = p + n;
+  while (q < b && is_space(s[q])) q++;
+  return q < b && s[q] == '(' ? q : -1;
+}
+
+static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, int lineno, int col0, int depth,
+                      pstr* out);
+
+// a constant integer argument of x(...): min or max repetitions
+static int rep_bound(vd_lsystem* ls, const char* s, int a, int b, int lineno, int col0, int* out) {
+  expr* e = lsys_parse_expr_text(ls, s + a, b - a, lineno, col0 + a);
+  if (!e) return 0;
+  if (e->op != E_CONST || e->k.t != V_INT || e->k.n < 0 || e->k.n > 1e9) {
+    perr(ls, VD_ERR_SYNTAX, lineno, col0 + a, "x(...) bounds must be non-negative integers");
+    return 0;
+  }
+  *out = (int)e->k.n;
+  return 1;
+}
+
+// parameters of a pattern module, s[p] == '(': names are bound into scope, constants compared
+static int parse_pattern_params(vd_lsystem* ls, scope* sc, const char* s, int p, int b, int lineno, int col0,
+                                pmod* m, int* after) {
+  lexer L;
+  lx_init(&L, ls, s, b, lineno, col0, p + 1);
+  if (lx_next(&L)) return 0;
+  int slots[64];
+  value cv[64];
+  int np = 0;
+  while (!tok_is(&L, ')')) {
+    if (np == 64) {
+      perr(ls, VD_ERR_LIMIT, lineno, lx_col(&L), "more than 64 pattern parameters");
+      return 0;
+    }
+    if (tok_is(&L, '*') || tok_is(&L, OP_POW)) {
+      perr(ls, VD_ERR_UNSUPPORTED, lineno, lx_col(&L), "unsupported: '%s' pattern parameter (binds a %s)",
+           tok_is(&L, '*') ? "*args" : "**kwds", tok_is(&L, '*') ? "list" : "dict");
+      return 0;
+    }
+    if (L.t == T_NAME && !tok_name(&L, "True") && !tok_name(&L, "False") && !tok_name(&L, "None")) {
+      lexer name = L;
+      if (lx_next(&L)) return 0;
+      if (!tok_is(&L, ',') && !tok_is(&L, ')')) {
+        perr(ls, VD_ERR_UNSUPPORTED, lineno, lx_col(&name), "unsupported: condition on the pattern parameter '%.*s'",
+             name.tlen, name.s + name.start);
+        return 0;
+      }
+      int sl = scope_add(ls, sc, name.s + name.start, name.tlen);
+      if (sl < 0) {
+        perr(ls, VD_ERR_NOMEM, lineno, lx_col(&name), "out of memory");
+        return 0;
+      }
+      slots[np] = sl;
+      cv[np] = (value){V_NONE, 0};
+    } else {
+      pctx C = {ls, &L, NULL};
+      int ccol = lx_col(&L);
+      expr* e = parse_expr(&C);
+      if (!e) return 0;
+      if (e->op != E_CONST) {
+        perr(ls, VD_ERR_SYNTAX, lineno, ccol, "a pattern parameter must be a name or a constant");
+        return 0;
+      }
+      slots[np] = -1;
+      cv[np] = e->k;
+    }
+    np++;
+    if (tok_is(&L, ',')) {
+      if (lx_next(&L)) return 0;
+    } else if (!tok_is(&L, ')')) {
+      char bb[64];
+      perr(ls, VD_ERR_SYNTAX, lineno, lx_col(&L), "expected ',' or ')' in a pattern, found %s",
+           tok_desc(&L, bb, sizeof bb));
+      return 0;
+    }
+  }
+  *after = L.start + 1;
+  m->nparam = np;
+  if (np) {
+    m->slot = aalloc(ls, sizeof(int) * (size_t)np);
+    m->cval = aalloc(ls, sizeof(value) * (size_t)np);
+    if (!m->slot || !m->cval) {
+      perr(ls, VD_ERR_NOMEM, lineno, m->col, "out of memory");
+      return 0;
+    }
+    memcpy(m->slot, slots, sizeof(int) * (size_t)np);
+    memcpy(m->cval, cv, sizeof(value) * (size_t)np);
+  }
+  return 1;
+}
+
+// x(...) and or(...): sub-patterns separated by top-level commas in s[p+1 .. close)
+static int parse_pattern_re(vd_lsystem* ls, scope* sc, const char* s, int p, int close, int lineno, int col0,
+                            int depth, pmod* m) {
+  pext* x = m->x = aalloc(ls, sizeof(pext));
+  if (!x) {
+    perr(ls, VD_ERR_NOMEM, lineno, col0 + p, "out of memory");
+    return 0;
+  }
+  int nargs = 0, starts[64] = {0}, ends[64] = {0};
+  for (int q = p + 1; q <= close && nargs < 64;) {
+    int c = next_comma(s, q, close);
+    starts[nargs] = q;
+    ends[nargs] = c;
+    nargs++;
+    q = c + 1;
+  }
+  if (m->kind == PK_REP) {
+    if (nargs > 3) {
+      perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "x(...) takes a pattern and at most two bounds");
+      return 0;
+    }
+    x->nsub = 1;
+    x->rmin = 0;
+    x->rmax = 1000;  // L-Py's default
+    if (nargs >= 2 && !rep_bound(ls, s, starts[1], ends[1], lineno, col0, &x->rmin)) return 0;
+    if (nargs == 2) x->rmax = x->rmin;
+    if (nargs == 3 && !rep_bound(ls, s, starts[2], ends[2], lineno, col0, &x->rmax)) return 0;
+  } else {
+    x->nsub = nargs;
+  }
+  x->sub = aalloc(ls, sizeof(pstr) * (size_t)x->nsub);
+  if (!x->sub) {
+    perr(ls, VD_ERR_NOMEM, lineno, col0 + p, "out of memory");
+    return 0;
+  }
+  for (int k = 0; k < x->nsub; k++) {
+    int before = sc->n;
+    if (!parse_pstr(ls, sc, s, starts[k], ends[k], lineno, col0, depth + 1, &x->sub[k])) return 0;
+    if (x->sub[k].n == 0) {
+      perr(ls, VD_ERR_SYNTAX, lineno, col0 + starts[k], "empty pattern in %s(...)", m->kind == PK_REP ? "x" : "or");
+      return 0;
+    }
+    if (m->kind == PK_REP && sc->n > before) {
+      perr(ls, VD_ERR_UNSUPPORTED, lineno, col0 + starts[k],
+           "unsupported: variables inside x(...) (they bind lists)");
+      return 0;
+    }
+  }
+  return 1;
+}
+
+// a pattern s[a..b): modules (parameters are names bound into scope, or constants), `*`,
+// brackets, `=]`, x(...) repetitions, or(...) alternatives, None
+static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, int lineno, int col0, int depth,
+                      pstr* out) {
   pmod* mods = NULL;
   int n = 0, cap = 0;
   int pos = a;
+  memset(out, 0, sizeof *out);
+  if (depth > 32) {
+    perr(ls, VD_ERR_LIMIT, lineno, col0 + a, "patterns nested more than 32 deep");
+    return 0;
+  }
   for (;;) {
     while (pos < b && is_space(s[pos])) pos++;
     if (pos >= b) break;
-    int mcol = col0 + pos;
-    int sym;
-    if (s[pos] == '*') {
-      perr(ls, VD_ERR_UNSUPPORTED, lineno, mcol, "unsupported: '*' wildcard in a rule pattern");
-      return NULL;
-    }
-    sym = read_module_name(ls, s, b, &pos, lineno, col0);
-    if (sym < 0) return NULL;
     if (n == cap) {
       int ncap = cap ? cap * 2 : 8;
       pmod* nm = aalloc(ls, sizeof(pmod) * (size_t)ncap);
       if (!nm) {
-        perr(ls, VD_ERR_NOMEM, lineno, mcol, "out of memory");  // NULL alone means no modules
-        return NULL;
+        perr(ls, VD_ERR_NOMEM, lineno, col0 + pos, "out of memory");
+        return 0;
       }
       if (cap) memcpy(nm, mods, sizeof(pmod) * (size_t)cap);
       mods = nm;
       cap = ncap;
     }
     pmod* m = &mods[n++];
-    m->sym = sym;
     m->line = lineno;
-    m->col = mcol;
+    m->col = col0 + pos;
+    int par;
+    if (s[pos] == '$' || (s[pos] == '?' && pos + 1 < b && s[pos + 1] == 'I')) {
+      perr(ls, VD_ERR_UNSUPPORTED, lineno, col0 + pos, "unsupported: '%s' pattern module (it binds a %s)",
+           s[pos] == '$' ? "$" : "?I", s[pos] == '$' ? "module object" : "string iterator");
+      return 0;
+    }
+    if (s[pos] == '=' && pos + 1 < b && s[pos + 1] == ']') {
+      m->kind = PK_MOD;
+      m->sym = VD_SYM_EB;
+      m->exact = 1;
+      pos += 2;
+      continue;
+    }
+    if (s[pos] == '*') {
+      m->kind = PK_ANY;
+      pos++;
+      while (pos < b && is_space(s[pos])) pos++;
+      if (pos < b && s[pos] == '(') {
+        // *(name, x, y): the name first, then the parameters
+        int after;
+        if (!parse_pattern_params(ls, sc, s, pos, b, lineno, col0, m, &after)) return 0;
+        if (m->nparam == 0) {
+          perr(ls, VD_ERR_SYNTAX, lineno, m->col, "'*()' needs at least the module name");
+          return 0;
+        }
+        m->x = aalloc(ls, sizeof(pext));
+        if (!m->x) {
+          perr(ls, VD_ERR_NOMEM, lineno, m->col, "out of memory");
+          return 0;
+        }
+        m->x->has_name = 1;
+        m->x->name_slot = m->slot[0];
+        m->x->name_val = m->cval[0];
+        if (m->x->name_slot < 0 && m->x->name_val.t != V_STR) {
+          perr(ls, VD_ERR_SYNTAX, lineno, m->col, "the first parameter of '*(...)' is the module name");
+          return 0;
+        }
+        m->slot++;
+        m->cval++;
+        m->nparam--;
+        pos = after;
+      }
+      continue;
+    }
+    if (s[pos] == 'N' && b - pos >= 4 && memcmp(s + pos, "None", 4) == 0 &&
+        (pos + 4 == b || !(isalnum((unsigned char)s[pos + 4]) || s[pos + 4] == '_')) && depth > 0) {
+      m->kind = PK_NONE;
+      pos += 4;
+      continue;
+    }
+    int sympos = pos;
+    int sym = read_module_name(ls, s, b, &pos, lineno, col0);
+    if (sym < 0) return 0;
+    // x(...) repetition and or(...) alternatives (L-Py's RepExp and Or pattern modules)
+    // (x, all and repexp are the names of the repetition; a longer declared name wins)
+    int op = -1, kind = -1;
+    static const char* const re_names[] = {"x", "all", "repexp", "or"};
+    for (int k = 0; k < 4 && kind < 0; k++)
+      if (pos - sympos <= (k == 3 ? 2 : 1) && (op = call_word_at(s, sympos, b, re_names[k])) >= 0)
+        kind = k == 3 ? PK_OR : PK_REP;
+    if (kind >= 0) {
+      int close = close_paren(s, op, b);
+      if (close < 0) {
+        perr(ls, VD_ERR_SYNTAX, lineno, col0 + op, "unclosed '(' in a pattern");
+        return 0;
+      }
+      m->kind = kind;
+      if (!parse_pattern_re(ls, sc, s, op, close, lineno, col0, depth, m)) return 0;
+      pos = close + 1;
+      continue;
+    }
+    m->kind = PK_MOD;
+    m->sym = sym;
     if (pos < b && s[pos] == '(') {
-      lexer L;
-      lx_init(&L, ls, s, b, lineno, col0, pos + 1);
-      if (lx_next(&L)) return NULL;
-      int slots[64];
-      value cv[64];
-      int np = 0;
-      while (!tok_is(&L, ')')) {
-        if (np == 64) {
-          perr(ls, VD_ERR_LIMIT, lineno, lx_col(&L), "more than 64 pattern parameters");
-          return NULL;
-        }
-        if (L.t == T_NAME && !tok_name(&L, "True") && !tok_name(&L, "False") && !tok_name(&L, "None")) {
-          int sl = scope_add(ls, sc, L.s + L.start, L.tlen);
-          if (sl < 0) {
-            perr(ls, VD_ERR_NOMEM, lineno, lx_col(&L), "out of memory");
-            return NULL;
-          }
-          slots[np] = sl;
-          cv[np] = (value){V_NONE, 0};
-          if (lx_next(&L)) return NULL;
-        } else {
-          pctx C = {ls, &L, NULL};
-          int ccol = lx_col(&L);
-          expr* e = parse_expr(&C);
-          if (!e) return NULL;
-          if (e->op != E_CONST) {
-            perr(ls, VD_ERR_SYNTAX, lineno, ccol, "a pattern parameter must be a name or a constant");
-            return NULL;
-          }
-          slots[np] = -1;
-          cv[np] = e->k;
-        }
-        np++;
-        if (tok_is(&L, ',')) {
-          if (lx_next(&L)) return NULL;
-        } else if (!tok_is(&L, ')')) {
-          char bb[64];
-          perr(ls, VD_ERR_SYNTAX, lineno, lx_col(&L), "expected ',' or ')' in a pattern, found %s",
-               tok_desc(&L, bb, sizeof bb));
-          return NULL;
-        }
-      }
-      pos = L.start + 1;
-      m->nparam = np;
-      if (np) {
-        m->slot = aalloc(ls, sizeof(int) * (size_t)np);
-        m->cval = aalloc(ls, sizeof(value) * (size_t)np);
-        if (!m->slot || !m->cval) {
-          perr(ls, VD_ERR_NOMEM, lineno, mcol, "out of memory");
-          return NULL;
-        }
-        memcpy(m->slot, slots, sizeof(int) * (size_t)np);
-        memcpy(m->cval, cv, sizeof(value) * (size_t)np);
-      }
+      if (!parse_pattern_params(ls, sc, s, pos, b, lineno, col0, m, &par)) return 0;
+      pos = par;
     }
   }
-  *count = n;
-  return mods;
+  out->n = n;
+  out->m = mods;
+  return 1;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1597,7 +1842,13 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
   const char* s = ln->s;
   for (;;) {
     while (p < ln->len && is_space(s[p])) p++;
-    if (p >= ln->len || s[p] == '#' || s[p] == ':') break;  // ': scale = ...' ignored
+    if (p < ln->len && s[p] == ':') {
+      // `: scale = n` (multiscale) and `: bases = X` (inheritance): noted, used by the options
+      for (int k = p; k + 5 <= ln->len; k++)
+        if (memcmp(s + k, "bases", 5) == 0) ls->has_bases = 1;
+      break;
+    }
+    if (p >= ln->len || s[p] == '#') break;
     int a = p;
     while (p < ln->len && !is_space(s[p]) && s[p] != ',' && s[p] != '(' && s[p] != ':' && s[p] != '#') p++;
     if (p == a) return perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + p, "expected a module name");
@@ -1618,21 +1869,31 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
   return VD_OK;
 }
 
+// consider: / ignore: followed by module names: a filter for the rules that follow (L-Py
+// applies the last one written before a rule to its contexts); an empty list ends filtering
 static vd_status parse_symbol_list(parser* P, const pline* ln, int from, int mode) {
   vd_lsystem* ls = P->ls;
+  if (is_blank(ln->s + from, ln->len - from)) {
+    ls->cur_filter = -1;
+    return VD_OK;
+  }
+  if (!vd_grow((void**)&ls->filters, &ls->capfilter, ls->nfilter + 1, sizeof(cfilter)))
+    return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+  cfilter* f = &ls->filters[ls->nfilter++];
+  memset(f, 0, sizeof *f);
+  f->mode = mode;
   int p = from;
   while (p < ln->len) {
     while (p < ln->len && is_space(ln->s[p])) p++;
     if (p >= ln->len || ln->s[p] == '#') break;
     int sym = read_module_name(ls, ln->s, ln->len, &p, ln->lineno, ln->col0);
     if (sym < 0) return ls->err->status;
-    int32_t* ns = vd_realloc(ls->ignore_syms, sizeof(int32_t) * (size_t)ls->nignore_syms,
-                             sizeof(int32_t) * (size_t)(ls->nignore_syms + 1));
+    int32_t* ns = vd_realloc(f->syms, sizeof(int32_t) * (size_t)f->nsyms, sizeof(int32_t) * (size_t)(f->nsyms + 1));
     if (!ns) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
-    ls->ignore_syms = ns;
-    ls->ignore_syms[ls->nignore_syms++] = sym;
+    f->syms = ns;
+    f->syms[f->nsyms++] = sym;
   }
-  ls->ignore_mode = mode;
+  ls->cur_filter = ls->nfilter - 1;
   return VD_OK;
 }
 
@@ -1701,58 +1962,135 @@ static vd_status parse_rule(parser* P, int* li, int section, int group) {
   memset(&sc, 0, sizeof sc);
   sc.is_function = 1;
   vd_status st = VD_OK;
-  int arrow = find_top(s, 0, len, "-->");
-  int colon = -1;
-  int hend;
-  if (arrow >= 0) {
-    hend = arrow;
-  } else {
-    // header ends at the last top-level ':' (the body follows)
-    // the first colon: rule headers hold no ':' of their own
-    int c = find_top(s, 0, len, ":");
-    if (c >= 0) colon = c;
-    if (colon < 0) {
-      if (find_top(s, 0, len, "-static->") >= 0 || find_top(s, 0, len, "->") >= 0) {
-        st = perr(ls, VD_ERR_UNSUPPORTED, ln->lineno, ln->col0, "unsupported: rule arrow other than '-->'");
-      } else {
-        st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + len,
-                  "expected '-->' or ':' after the rule's predecessor");
+  // the header ends at the first '-->' (or '-static->') or ':' (L-Py's rule)
+  int arrow = find_top(s, 0, len, "-->"), sarrow = find_top(s, 0, len, "-static->");
+  int colon = find_top(s, 0, len, ":");
+  int arrow_len = 3;
+  if (sarrow >= 0 && (arrow < 0 || sarrow < arrow)) {
+    arrow = sarrow;
+    arrow_len = 9;
+    r->is_static = 1;
+  }
+  if (colon >= 0 && arrow >= 0 && colon < arrow) arrow = -1;
+  if (arrow >= 0) colon = -1;
+  int hend = arrow >= 0 ? arrow : colon;
+  if (hend < 0) {
+    if (find_top(s, 0, len, "->") >= 0)
+      st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + find_top(s, 0, len, "->"),
+                "'->' is not a rule arrow: write '-->'");
+    else
+      st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + len, "expected '-->' or ':' after the rule's predecessor");
+    goto done;
+  }
+  // header: newleft << left < pred >> newright > right (L-Py's order), outside parentheses
+  int cut[5] = {-1, -1, -1, -1, -1};  // ends of: newleft, left, pred, newright; right runs to hend
+  {
+    int begs = 0, depth = 0, in_nright = 0, pred_end = -1;
+    int nl_end = -1, l_end = -1, nr_end = -1;
+    char q = 0;
+    for (int i = 0; i < hend; i++) {
+      char c = s[i];
+      if (q) {
+        if (c == '\\') i++;
+        else if (c == q) q = 0;
+        continue;
       }
+      if (c == '\'' || c == '"') q = c;
+      else if (c == '(') depth++;
+      else if (c == ')') depth--;
+      else if (depth == 0 && c == '<') {
+        int two = i + 1 < hend && s[i + 1] == '<';
+        if (pred_end >= 0 || (two ? nl_end >= 0 : l_end >= 0)) {
+          st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + i, "ill-formed rule header: misplaced '%s'", two ? "<<" : "<");
+          goto done;
+        }
+        if (two) nl_end = i, i++;
+        else l_end = i;
+        begs = i + 1;
+      } else if (depth == 0 && c == '>') {
+        int two = i + 1 < hend && s[i + 1] == '>';
+        if (two) {
+          if (in_nright || nr_end >= 0 || pred_end >= 0) {
+            st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + i, "ill-formed rule header: misplaced '>>'");
+            goto done;
+          }
+          pred_end = i;
+          in_nright = 1;
+          i++;
+        } else if (in_nright) {
+          nr_end = i;
+          in_nright = 0;
+        } else if (pred_end < 0) {
+          pred_end = i;
+        } else {
+          st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + i, "ill-formed rule header: two right contexts");
+          goto done;
+        }
+        begs = i + 1;
+      }
+    }
+    (void)begs;
+    cut[0] = nl_end;
+    cut[1] = l_end;
+    cut[2] = pred_end;
+    cut[3] = in_nright ? hend : nr_end;
+    cut[4] = in_nright;
+  }
+  {
+    int nl_end = cut[0], l_end = cut[1], pred_end = cut[2], nr_end = cut[3];
+    int pa = (nl_end > l_end ? nl_end + 2 : l_end >= 0 ? l_end + 1 : 0);
+    int pb = pred_end >= 0 ? pred_end : hend;
+    int lo = 0;
+    // the contexts before the predecessor, in written order
+    if (nl_end >= 0 && (l_end < 0 || nl_end < l_end)) {
+      if (!parse_pstr(ls, &sc, s, 0, nl_end, ln->lineno, ln->col0, 0, &r->nleft)) goto fail;
+      lo = nl_end + 2;
+      if (l_end >= 0 && !parse_pstr(ls, &sc, s, lo, l_end, ln->lineno, ln->col0, 0, &r->left)) goto fail;
+    } else if (l_end >= 0) {
+      if (!parse_pstr(ls, &sc, s, 0, l_end, ln->lineno, ln->col0, 0, &r->left)) goto fail;
+      lo = l_end + 1;
+      if (nl_end >= 0 && !parse_pstr(ls, &sc, s, lo, nl_end, ln->lineno, ln->col0, 0, &r->nleft)) goto fail;
+    }
+    if (!parse_pstr(ls, &sc, s, pa, pb, ln->lineno, ln->col0, 0, &r->pred)) goto fail;
+    if (r->pred.n == 0) {
+      st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + pa, "rule without a predecessor");
       goto done;
     }
-    hend = colon;
-  }
-  // new contexts << >> are not supported
-  if (find_top(s, 0, hend, "<<") >= 0 || find_top(s, 0, hend, ">>") >= 0) {
-    int at = find_top(s, 0, hend, "<<");
-    if (at < 0) at = find_top(s, 0, hend, ">>");
-    st = perr(ls, VD_ERR_UNSUPPORTED, ln->lineno, ln->col0 + at, "unsupported: new context '<<' / '>>'");
-    goto done;
-  }
-  int lt = find_top(s, 0, hend, "<");
-  int gt = find_top(s, lt >= 0 ? lt + 1 : 0, hend, ">");
-  int pa = lt >= 0 ? lt + 1 : 0, pb = gt >= 0 ? gt : hend;
-  if (lt >= 0) {
-    r->left = parse_pattern(ls, &sc, s, 0, lt, ln->lineno, ln->col0, &r->nleft);
-    if (!r->left && ls->err->status) goto fail;
-  }
-  r->pred = parse_pattern(ls, &sc, s, pa, pb, ln->lineno, ln->col0, &r->npred);
-  if (!r->pred && ls->err->status) goto fail;
-  if (r->npred == 0) {
-    st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + pa, "rule without a predecessor");
-    goto done;
-  }
-  for (int k = 0; k < r->npred; k++)
-    if (r->pred[k].sym == VD_SYM_SB || r->pred[k].sym == VD_SYM_EB) {
-      st = perr(ls, VD_ERR_UNSUPPORTED, ln->lineno, r->pred[k].col, "unsupported: bracket in a strict predecessor");
+    for (int k = 0; k < r->pred.n; k++)
+      if (r->pred.m[k].kind == PK_REP || r->pred.m[k].kind == PK_OR) {
+        st = perr(ls, VD_ERR_UNSUPPORTED, ln->lineno, r->pred.m[k].col,
+                  "unsupported: x(...) or or(...) in a strict predecessor");
+        goto done;
+      }
+    if (pred_end >= 0) {
+      if (cut[4] || nr_end >= 0) {
+        // pred >> newright [> right]
+        int ne = nr_end >= 0 ? nr_end : hend;
+        if (!parse_pstr(ls, &sc, s, pred_end + 2, ne, ln->lineno, ln->col0, 0, &r->nright)) goto fail;
+        if (nr_end >= 0 && nr_end < hend &&
+            !parse_pstr(ls, &sc, s, nr_end + 1, hend, ln->lineno, ln->col0, 0, &r->right))
+          goto fail;
+      } else if (!parse_pstr(ls, &sc, s, pred_end + 1, hend, ln->lineno, ln->col0, 0, &r->right)) {
+        goto fail;
+      }
+    }
+    if (r->nleft.n && r->nright.n) {
+      st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0, "ill-formed rule header: new left and new right contexts");
       goto done;
     }
-  if (gt >= 0) {
-    r->right = parse_pattern(ls, &sc, s, gt + 1, hend, ln->lineno, ln->col0, &r->nright);
-    if (!r->right && ls->err->status) goto fail;
+  }
+  r->filter = ls->cur_filter;
+  // @static after ':' (L-Py's marker for a static rule body)
+  if (colon >= 0) {
+    int m = colon + 1;
+    while (m < len && is_space(s[m])) m++;
+    if (len - m >= 7 && memcmp(s + m, "@static", 7) == 0) {
+      r->is_static = 1;
+      colon = m + 6;
+    }
   }
   if (arrow >= 0) {
-    r->succ = parse_tmpl(ls, &sc, s, len, arrow + 3, ln->lineno, ln->col0);
+    r->succ = parse_tmpl(ls, &sc, s, len, arrow + arrow_len, ln->lineno, ln->col0);
     if (!r->succ) goto fail;
     (*li)++;
   } else {
@@ -1817,6 +2155,8 @@ static vd_status parse_def(parser* P, int* li) {
   if (!f) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
   snprintf(f->name, sizeof f->name, "%.*s", L.tlen, L.s + L.start);
   f->line = ln->lineno;
+  f->discard_wrapped = P->discard_decorator;
+  P->discard_decorator = 0;
   int g = global_slot(ls, L.s + L.start, L.tlen, 1);
   if (g < 0) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
   if (lx_next(&L) || expect(&L, '(', "'(' after the function name")) return ls->err->status;
@@ -1892,6 +2232,15 @@ static vd_status parse_toplevel_stmt(parser* P, int* li) {
     vd_status st = parse_import(P, ln);
     (*li)++;
     return st;
+  }
+  if (ln->len > 1 && ln->s[0] == '@') {
+    // decorators: only L-Py's @enable_string_discard (DiscardNewString through EndEach)
+    if (starts_kw(ln, "@enable_string_discard", &a) && rest_blank(ln, a)) {
+      P->discard_decorator = 1;
+      (*li)++;
+      return VD_OK;
+    }
+    return perr(ls, VD_ERR_UNSUPPORTED, ln->lineno, ln->col0, "unsupported: decorator '%.*s'", ln->len, ln->s);
   }
   if (starts_kw(ln, "def ", &a)) return parse_def(P, li);
   if (starts_kw(ln, "class ", &a))
@@ -1991,6 +2340,54 @@ static int parse_scalar_value(const char* s, int len, value* v) {
   return 1;
 }
 
+// context.options.setSelection('NAME', VALUE) lines of the trailer: the L-Py options that change
+// results are applied; those the native engine cannot honour are refused
+static vd_status parse_options(vd_lsystem* ls, const char* s, size_t len, int line0) {
+  static const char key[] = "options.setSelection(";
+  size_t kl = strlen(key);
+  for (size_t i = 0; i + kl <= len; i++) {
+    if (memcmp(s + i, key, kl) != 0) continue;
+    int line = line0;
+    for (size_t k = 0; k < i; k++) line += s[k] == '\n';
+    size_t p = i + kl;
+    while (p < len && is_space(s[p])) p++;
+    if (p >= len || (s[p] != '\'' && s[p] != '"')) continue;
+    char q = s[p++];
+    size_t n0 = p;
+    while (p < len && s[p] != q && s[p] != '\n') p++;
+    if (p >= len || s[p] != q) continue;
+    int nlen = (int)(p - n0);
+    const char* name = s + n0;
+    p++;
+    while (p < len && (is_space(s[p]) || s[p] == ',')) p++;
+    char* end;
+    char buf[24];
+    size_t bl = 0;
+    while (p < len && bl < sizeof buf - 1 && s[p] != ')' && s[p] != '\n') buf[bl++] = s[p++];
+    buf[bl] = 0;
+    long v = strtol(buf, &end, 10);
+    while (*end && isspace((unsigned char)*end)) end++;
+    if (end == buf || *end) continue;  // a value computed at run time: not an option we read
+    if (name_is(name, nlen, "Early return when no matching")) {
+      ls->opt_early_return = v != 0;
+    } else if (name_is(name, nlen, "Axiom decomposition")) {
+      ls->opt_axiom_decomposition = v != 0;
+    } else if (name_is(name, nlen, "Module matching")) {
+      ls->opt_module_matching = (int)v;
+    } else if (name_is(name, nlen, "String matching")) {
+      if (v == 2 || v == 3)
+        return perr(ls, VD_ERR_UNSUPPORTED, line, 1,
+                    "unsupported: option 'String matching' = %s (multi-level and multiscale matching)",
+                    v == 2 ? "As Multi-level AxialTree" : "As Multiscale AxialTree");
+      ls->opt_string_matching = v != 0;
+    } else if (name_is(name, nlen, "Module inheritance")) {
+      if (v != 0 && ls->has_bases)
+        return perr(ls, VD_ERR_UNSUPPORTED, line, 1, "unsupported: option 'Module inheritance' (modules with bases)");
+    }
+  }
+  return VD_OK;
+}
+
 static void parse_trailer(vd_lsystem* ls, const char* s, size_t len) {
   // scalars = [('name', 'Float', 0.1, 0.0, 1.0, 2), ('n', 8, 0, 20)]
   const char* keys[] = {"scalars = [", "scalars=[", "__scalars__ = [", "__scalars__=["};
@@ -2067,6 +2464,7 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
   parser P;
   memset(&P, 0, sizeof P);
   P.ls = ls;
+  ls->cur_filter = -1;
   size_t init_at;
   vd_status st = split_lines(&P, text, len, &init_at);
   if (st) goto done;
@@ -2128,20 +2526,9 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
                   "'maximum depth:' must follow 'decomposition:' or 'interpretation:'");
         goto done;
       }
-      char buf[32];
-      int n = ln->len - a < 31 ? ln->len - a : 31;
-      memcpy(buf, ln->s + a, (size_t)n);
-      buf[n] = 0;
-      char* hash = strchr(buf, '#');
-      if (hash) *hash = 0;
-      char* end;
-      long d = strtol(buf, &end, 10);
-      while (*end && isspace((unsigned char)*end)) end++;
-      if (*end || d < 1 || d > 1000) {
-        st = perr(ls, VD_ERR_VALUE, ln->lineno, ln->col0 + a, "maximum depth must be an integer in 1..1000");
-        goto done;
-      }
-      ls->max_depth[section] = (int)d;
+      // an expression (L-Py evaluates it after the top-level code): `maximum depth: N`
+      ls->max_depth_expr[section] = lsys_parse_expr_text(ls, ln->s + a, ln->len - a, ln->lineno, ln->col0 + a);
+      if (!ls->max_depth_expr[section]) goto fail;
       li++;
       continue;
     }
@@ -2189,6 +2576,8 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
       st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0, "'produce' outside a rule or the axiom");
       goto done;
     }
+    // a def in a rule section ends the section (L-Py switches to Python code there)
+    if (section >= 0 && ln->indent == 0 && starts_kw(ln, "def ", &a)) section = -1;
     // rules inside a section
     if (section >= 0 && (rule_indent < 0 || ln->indent <= rule_indent)) {
       if (rule_indent < 0) rule_indent = ln->indent;
@@ -2209,7 +2598,12 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
     st = perr(ls, VD_ERR_SYNTAX, P.nline ? P.lines[P.nline - 1].lineno : 1, 1, "the file has no 'Axiom:'");
     goto done;
   }
-  if (init_at < len) parse_trailer(ls, text + init_at, len - init_at);
+  if (init_at < len) {
+    int line0 = 1;
+    for (size_t k = 0; k < init_at; k++) line0 += text[k] == '\n';
+    parse_trailer(ls, text + init_at, len - init_at);
+    if ((st = parse_options(ls, text + init_at, len - init_at, line0))) goto done;
+  }
   goto done;
 fail:
   st = ls->err && ls->err->status ? ls->err->status : VD_ERR_NOMEM;

@@ -64,7 +64,8 @@ int sym_intern(vd_lsystem* ls, const char* name, int len, int declared) {
     return id;
   }
   if (!vd_grow((void**)&t->name, &t->cap, t->n + 1, sizeof(char*)) ||
-      !vd_grow((void**)&t->declared, &t->cap_declared, t->n + 1, 1))
+      !vd_grow((void**)&t->declared, &t->cap_declared, t->n + 1, 1) ||
+      !vd_grow((void**)&t->canon, &t->cap_canon, t->n + 1, sizeof(int)))
     return -1;
   char* s = vd_malloc((size_t)len + 1);
   if (!s) return -1;
@@ -72,6 +73,7 @@ int sym_intern(vd_lsystem* ls, const char* name, int len, int declared) {
   s[len] = 0;
   id = t->n++;
   t->name[id] = s;
+  t->canon[id] = id;
   t->declared[id] = (unsigned char)(declared != 0);
   if (declared && len > t->maxlen) t->maxlen = len;
   if (t->n * 2 > t->hcap) {
@@ -81,6 +83,13 @@ int sym_intern(vd_lsystem* ls, const char* name, int len, int declared) {
     while (t->hash_slot[h] >= 0) h = (h + 1) & (uint32_t)(t->hcap - 1);
     t->hash_slot[h] = id;
   }
+  return id;
+}
+
+int sym_alias(vd_lsystem* ls, const char* alias, int canon) {
+  int id = sym_intern(ls, alias, (int)strlen(alias), 1);
+  if (id < 0) return -1;
+  ls->syms.canon[id] = canon;
   return id;
 }
 
@@ -96,7 +105,8 @@ const char* vd_lsys_symbol_name(const vd_lsystem* ls, int sym) {
 int vd_lsys_symbol_count(const vd_lsystem* ls) { return ls->syms.n; }
 
 int vd_lsys_symbol_find(const vd_lsystem* ls, const char* name) {
-  return sym_find(ls, name, (int)strlen(name));
+  int id = sym_find(ls, name, (int)strlen(name));
+  return id < 0 ? id : sym_canon(ls, id);
 }
 
 // strings: interned, referenced from values and NaN-boxed inside L-strings
@@ -243,6 +253,18 @@ int lstr_enable_src(vd_lstring* s) {
   if (!s->cap && !lstr_reserve(s, 64, 0)) return 0;
   s->src = vd_malloc((size_t)c * sizeof(int64_t));
   return s->src != NULL;
+}
+
+int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src) {
+  lstr_clear(dst);
+  if (!lstr_reserve(dst, src->n + 1, src->par[src->n] + 1)) return 0;
+  if (src->src && !lstr_enable_src(dst)) return 0;
+  memcpy(dst->sym, src->sym, sizeof(int32_t) * (size_t)src->n);
+  memcpy(dst->par, src->par, sizeof(int64_t) * (size_t)(src->n + 1));
+  memcpy(dst->val, src->val, sizeof(double) * (size_t)src->par[src->n]);
+  if (src->src) memcpy(dst->src, src->src, sizeof(int64_t) * (size_t)src->n);
+  dst->n = src->n;
+  return 1;
 }
 
 void lstr_clear(vd_lstring* s) {

@@ -1011,7 +1011,8 @@ static vd_status step(turtle* T) {
     return draw_box_quad(T, T->sym == VD_SYM_BOX);
   case VD_SYM_LEAF:
     return draw_leaf(T, 0);
-  case VD_SYM_SURFACE: {
+  case VD_SYM_SURFACE:
+  case VD_SYM_SURFACE_NAMED: {
     const char* name = NULL;
     if (T->np > 0 && T->ls && vd_lsys_value_is_str(T->p[0]))
       name = vd_lsys_value_str(T->ls, T->p[0]);
@@ -1046,12 +1047,10 @@ static vd_status step(turtle* T) {
 
   // tropism: Tropism() = (0,0,1); one or two values fill x, y with z = 1 (PlantGL defaults)
   case VD_SYM_TROPISM:
-  case VD_SYM_TROPISM_LONG:
     if ((st = vec_args(T, 0, vd_v3(0, 0, 1), &v))) return st;
     t->tropism = vd_norm(v) > 0 ? vd_normalize(v) : vd_v3(0, 0, 0);
     return VD_OK;
   case VD_SYM_ELASTICITY:
-  case VD_SYM_ELASTICITY_LONG:
     // exactly one value sets it; otherwise L-Py resets it to 0
     a = 0;
     if (T->np == 1 && (st = num(T, 0, &a))) return st;
@@ -1129,6 +1128,12 @@ static vd_status step(turtle* T) {
     t->age = a;
     return VD_OK;
 
+  // PlantGL mirrors the shapes drawn after a reflection (not the frame): not supported
+  case VD_SYM_LEFTREFLECTION:
+  case VD_SYM_UPREFLECTION:
+  case VD_SYM_HEADINGREFLECTION:
+    return fail(T, VD_ERR_UNSUPPORTED, "unsupported: reflections of the drawn shapes");
+
   // curves are not supported: accepted and ignored with one warning
   case VD_SYM_SETGUIDE:
   case VD_SYM_SWEEP:
@@ -1156,6 +1161,9 @@ static vd_status step(turtle* T) {
   case VD_SYM_TEXVSCALE:
   case VD_SYM_TEXTRANS:
   case VD_SYM_TEXROT:
+  case VD_SYM_TEXBASECOLOR:
+  case VD_SYM_INTERPTEXCOLORS:
+  case VD_SYM_TEXTRANSFORM:
   case VD_SYM_GETPOS:
   case VD_SYM_GETHEAD:
   case VD_SYM_GETUP:
@@ -1249,6 +1257,15 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
   // interpret every predefined module; organ modules have no geometry
   for (int64_t i = 0; i < s->n && st == VD_OK; i++) {
     int sym = s->sym[i];
+    if (sym == VD_SYM_CUT) {
+      // % drops the rest of its branch (the derivation leaves it until the string is read)
+      int depth = 0;
+      while (i + 1 < s->n && !(s->sym[i + 1] == VD_SYM_EB && depth == 0)) {
+        depth += s->sym[i + 1] == VD_SYM_SB ? 1 : s->sym[i + 1] == VD_SYM_EB ? -1 : 0;
+        i++;
+      }
+      continue;
+    }
     if (sym < 0 || sym >= VD_SYM_PREDEFINED_COUNT) {
       // `~x` surfaces other than the predefined leaf `~l` need PlantGL objects
       const char* name = ls ? vd_lsys_symbol_name(ls, sym) : "";

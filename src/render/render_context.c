@@ -73,9 +73,15 @@ static vd_status check_def(const vd_render_def* d, vd_error* err) {
   return VD_OK;
 }
 
+// the stage's colours as made: sky zenith and horizon, floor checker
+static const float sky_rgb[2][3] = {{0.92f, 0.95f, 1.0f}, {0.55f, 0.68f, 0.85f}};
+static const float floor_rgb[2][3] = {{0.62f, 0.57f, 0.50f}, {0.55f, 0.50f, 0.43f}};
+
 // the stage: a floor plane and a sky, as MJCF text (lights are set per frame)
 static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
   const float* bg = d->background;
+  const float* s0 = d->sky ? sky_rgb[0] : bg;
+  const float* s1 = d->sky ? sky_rgb[1] : bg;
   return snprintf(
       buf, cap,
       "<mujoco model=\"verdant_stage\">\n"
@@ -87,17 +93,17 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
       "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"%g %g %g\" rgb2=\"%g "
       "%g %g\" "
       "width=\"256\" height=\"1536\"/>\n"
-      "    <texture name=\"ground\" type=\"2d\" builtin=\"checker\" rgb1=\"0.62 0.57 0.50\" "
-      "rgb2=\"0.55 0.50 0.43\" width=\"256\" height=\"256\"/>\n"
+      "    <texture name=\"ground\" type=\"2d\" builtin=\"checker\" rgb1=\"%g %g %g\" "
+      "rgb2=\"%g %g %g\" width=\"256\" height=\"256\"/>\n"
       "    <material name=\"ground\" texture=\"ground\" texrepeat=\"2 2\" texuniform=\"true\"/>\n"
       "  </asset>\n"
       "  <worldbody>\n"
       "%s"
       "  </worldbody>\n"
       "</mujoco>\n",
-      d->width * d->supersample, d->height * d->supersample, d->sky ? 0.92 : bg[0],
-      d->sky ? 0.95 : bg[1], d->sky ? 1.0 : bg[2], d->sky ? 0.55 : bg[0], d->sky ? 0.68 : bg[1],
-      d->sky ? 0.85 : bg[2],
+      d->width * d->supersample, d->height * d->supersample, s0[0], s0[1], s0[2], s1[0], s1[1],
+      s1[2], floor_rgb[0][0], floor_rgb[0][1], floor_rgb[0][2], floor_rgb[1][0], floor_rgb[1][1],
+      floor_rgb[1][2],
       d->floor ? "    <geom name=\"floor\" type=\"plane\" size=\"30 30 3\" material=\"ground\"/>\n"
                : "");
 }
@@ -168,6 +174,23 @@ static vd_status make_mujoco(vd_renderer* r, vd_error* err) {
     r->m->vis.quality.offsamples = 0;
     r->m->vis.quality.shadowsize = 2048;
     r->d = mj_makeData(r->m);
+    // the look as made; the stage's textures kept for recolouring (vd_render_set_look)
+    r->look.light_azimuth = r->def.light_azimuth, r->look.light_elevation = r->def.light_elevation;
+    r->look.light = r->def.light, r->look.headlight = r->def.headlight;
+    r->look.ambient = r->def.ambient;
+    for (int k = 0; k < 3; k++) {
+      r->look.sky[0][k] = r->def.sky ? sky_rgb[0][k] : r->def.background[k];
+      r->look.sky[1][k] = r->def.sky ? sky_rgb[1][k] : r->def.background[k];
+      r->look.floor[0][k] = floor_rgb[0][k], r->look.floor[1][k] = floor_rgb[1][k];
+    }
+    r->tex_sky = r->tex_floor = -1;
+    if (!r->def.robot_mjcf) {
+      r->tex_sky = mj_name2id(r->m, mjOBJ_TEXTURE, "sky");
+      r->tex_floor = mj_name2id(r->m, mjOBJ_TEXTURE, "ground");
+      r->tex0 = vd_malloc((size_t)r->m->ntexdata + 1);
+      if (!r->tex0) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+      else memcpy(r->tex0, r->m->tex_rgb, (size_t)r->m->ntexdata);
+    }
     mj_forward(r->m, r->d);
     mjv_defaultOption(&r->opt);
     mjv_defaultPerturb(&r->pert);
@@ -250,6 +273,7 @@ void vd_render_destroy(vd_renderer* r) {
     mjv_freeScene(&r->scn);
   }
   if (r->d) mj_deleteData(r->d);
+  if (r->m) vd_free(r->tex0, (size_t)r->m->ntexdata + 1);
   if (r->m) mj_deleteModel(r->m);
   if (r->vfs) mj_deleteVFS(r->vfs);
   vd_free(r->vfs, sizeof *r->vfs);
@@ -268,6 +292,87 @@ void vd_render_destroy(vd_renderer* r) {
 
 const char* vd_render_info(const vd_renderer* r) {
   return r->gl.info;
+}
+
+vd_render_look vd_render_get_look(const vd_renderer* r) {
+  return r->look;
+}
+
+// recolour texture id from the colours it was made with (a0 -> a1 texel by texel, each texel's
+// place between them kept) to b0 -> b1, and upload it
+static void recolour(vd_renderer* r, int id, const float a[2][3], const float b[2][3]) {
+  if (id < 0) return;
+  const mjModel* m = r->m;
+  size_t n = (size_t)m->tex_width[id] * (size_t)m->tex_height[id], adr = (size_t)m->tex_adr[id];
+  int same = 1;
+  for (int k = 0; k < 6; k++)
+    same &= a[k / 3][k % 3] == b[k / 3][k % 3];
+  if (same) { // back to the colours it was made with: the texels as made
+    memcpy(m->tex_rgb + adr, r->tex0 + adr, 3 * n);
+    mjr_uploadTexture(m, &r->con, id);
+    return;
+  }
+  double d[3], dd = 0;
+  for (int k = 0; k < 3; k++)
+    d[k] = 255.0 * (a[1][k] - a[0][k]), dd += d[k] * d[k];
+  for (size_t i = 0; i < n; i++) {
+    const uint8_t* src = r->tex0 + adr + 3 * i;
+    double t = 0;
+    for (int k = 0; dd > 1e-9 && k < 3; k++)
+      t += (src[k] - 255.0 * a[0][k]) * d[k] / dd;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    for (int k = 0; k < 3; k++) {
+      double v = 255.0 * (b[0][k] + t * (b[1][k] - b[0][k]));
+      m->tex_rgb[adr + 3 * i + k] = (mjtByte)(v < 0 ? 0 : v > 255 ? 255 : floor(v + 0.5));
+    }
+  }
+  mjr_uploadTexture(m, &r->con, id);
+}
+
+vd_status vd_render_set_look(vd_renderer* r, const vd_render_look* look, vd_error* err) {
+  const char* bad = NULL;
+  if (!in_range(look->light_azimuth, -1e3, 1e3))
+    bad = "light_azimuth (finite, rad)";
+  else if (!in_range(look->light_elevation, 1e-3, VD_PI / 2 + 1e-9))
+    bad = "light_elevation (0..pi/2 rad)";
+  else if (!in_range(look->light, 0, 1))
+    bad = "light (0..1)";
+  else if (!in_range(look->headlight, 0, 1))
+    bad = "headlight (0..1)";
+  else if (!in_range(look->ambient, 0, 1))
+    bad = "ambient (0..1)";
+  for (int j = 0; !bad && j < 2; j++)
+    for (int k = 0; k < 3; k++) {
+      if (!in_range(look->sky[j][k], 0, 1)) bad = "sky colour (each in 0..1)";
+      if (!in_range(look->floor[j][k], 0, 1)) bad = "floor colour (each in 0..1)";
+    }
+  if (bad) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad look: %s", bad);
+  vd_render_look want = *look;
+  if (!r->def.sky) memcpy(want.sky[1], want.sky[0], sizeof want.sky[0]);
+  int sky = 0, floor_changed = 0;
+  for (int j = 0; j < 2; j++)
+    for (int k = 0; k < 3; k++) {
+      sky |= want.sky[j][k] != r->look.sky[j][k];
+      floor_changed |= want.floor[j][k] != r->look.floor[j][k];
+    }
+  if (r->tex0 && (sky || floor_changed)) {
+    vd_status st = gl_current(&r->gl, err);
+    if (st) return st;
+    vd_mj_trap trap;
+    if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
+    // the stage as made: recolour from its own colours
+    float s0[2][3], f0[2][3];
+    for (int k = 0; k < 3; k++) {
+      s0[0][k] = r->def.sky ? sky_rgb[0][k] : r->def.background[k];
+      s0[1][k] = r->def.sky ? sky_rgb[1][k] : r->def.background[k];
+      f0[0][k] = floor_rgb[0][k], f0[1][k] = floor_rgb[1][k];
+    }
+    if (sky) recolour(r, r->tex_sky, (const float(*)[3])s0, (const float(*)[3])want.sky);
+    if (floor_changed) recolour(r, r->tex_floor, (const float(*)[3])f0, (const float(*)[3])want.floor);
+    vd_mj_trap_end(&trap);
+  }
+  r->look = want;
+  return VD_OK;
 }
 
 const vd_render_gl* vd_render_gl_info(const vd_renderer* r) {

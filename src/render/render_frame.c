@@ -266,7 +266,7 @@ static void draw_legend(vd_renderer* r, int w, int h, int k) {
 static void set_lights(vd_renderer* r, const vd_camera* c, vd_vec3 ctr, double reach) {
   mjvScene* scn = &r->scn;
   vd_vec3 f = vd_normalize(vd_sub(c->lookat, c->eye));
-  double az = r->def.light_azimuth, el = r->def.light_elevation;
+  double az = r->look.light_azimuth, el = r->look.light_elevation;
   vd_vec3 from = vd_v3(cos(el) * cos(az), cos(el) * sin(az), sin(el));
   scn->nlight = 2;
   for (int i = 0; i < 2; i++) {
@@ -274,8 +274,8 @@ static void set_lights(vd_renderer* r, const vd_camera* c, vd_vec3 ctr, double r
     memset(l, 0, sizeof *l);
     vd_vec3 pos = i == 0 ? c->eye : vd_madd(ctr, from, 4 * reach);
     vd_vec3 dir = i == 0 ? f : vd_scale(from, -1);
-    float amb = i == 0 ? (float)r->def.ambient : 0.f;
-    float dif = (float)(i == 0 ? r->def.headlight : r->def.light);
+    float amb = i == 0 ? (float)r->look.ambient : 0.f;
+    float dif = (float)(i == 0 ? r->look.headlight : r->look.light);
     float spec = i == 0 ? 0.1f : 0.25f;
     l->pos[0] = (float)pos.x, l->pos[1] = (float)pos.y, l->pos[2] = (float)pos.z;
     l->dir[0] = (float)dir.x, l->dir[1] = (float)dir.y, l->dir[2] = (float)dir.z;

@@ -87,6 +87,9 @@ struct vd_renderer {
   mjvPerturb pert;
   mjvCamera mjcam;
   mjVFS* vfs;      // stage file system (owned)
+  vd_render_look look;   // lights and stage colours of the next frames
+  int tex_sky, tex_floor; // the stage's sky and floor textures, -1 with a robot's model
+  uint8_t* tex0;         // the stage textures as made (ntexdata bytes), recoloured from
   int nmodel_geom; // geoms mjv_updateScene adds for the model
   int digit_base;  // font: lowest ink row of '0' above the bottom of its cell (pixels)
   int dot_size;    // font: side of the decimal point we draw (pixels)

@@ -1,0 +1,211 @@
+// SPDX-License-Identifier: MIT
+// lpy: compatibility with L-Py's semantics (openalea/lpy): results that used to be silently
+// wrong, the grammar beyond the basics (contexts, patterns, hooks, the L-string object) and the
+// refusals of what the native engine does not run. Every L-Py text here is our own.
+#include <stdlib.h>
+
+#include "test.h"
+#include "verdant/lsys.h"
+
+// parse and derive src (steps -1 = the file's), format the result into buf
+static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, vd_error* e) {
+  vd_lsystem* ls;
+  buf[0] = 0;
+  vd_status st = vd_lsys_parse(src, strlen(src), "t.lpy", &ls, e);
+  if (st) return st;
+  vd_lsys_def d = vd_lsys_def_default();
+  d.steps = steps;
+  d.max_ops = 10000000;
+  vd_lstring s = vd_lstring_empty();
+  st = vd_lsys_derive(ls, &d, &s, e);
+  if (!st) vd_lsys_format(ls, &s, buf, cap);
+  vd_lstring_free(&s);
+  vd_lsys_destroy(ls);
+  return st;
+}
+
+#define DERIVES(src, steps, expected)                                                              \
+  do {                                                                                             \
+    char b_[4096];                                                                                 \
+    vd_error e_ = {0};                                                                             \
+    CHECK_STATUS(derive_text(src, steps, b_, sizeof b_, &e_), VD_OK, e_);                          \
+    CHECK_STR(b_, expected);                                                                       \
+  } while (0)
+
+// the status of parsing and deriving src; the message is left in *e
+static vd_status run_status(const char* src, vd_error* e) {
+  char b[256];
+  memset(e, 0, sizeof *e);
+  return derive_text(src, -1, b, sizeof b, e);
+}
+
+#define REFUSED(src, what)                                                                         \
+  do {                                                                                             \
+    vd_error e_;                                                                                   \
+    CHECK_STATUS(run_status(src, &e_), VD_ERR_UNSUPPORTED, e_);                                    \
+    if (!strstr(e_.msg, what)) vdt_fail(__FILE__, __LINE__, "message '%s' lacks '%s'", e_.msg, what); \
+  } while (0)
+
+TEST(lpy, star_successor_deletes) {
+  // `--> *` and `produce *` delete the module as in L-Py (a successor that starts with `*`
+  // produces nothing); before, a literal `*` module was left in the string
+  DERIVES("Axiom: A B A\nproduction:\nB --> *\n", 1, "AA");
+  DERIVES("Axiom: A(1) A(2) A(3)\nproduction:\nA(x) :\n  if x == 2: produce *\n  else: produce B(x)\n",
+          1, "B(1)B(3)");
+  DERIVES("Axiom: A\nproduction:\nA --> * B\n", 1, "");
+  REFUSED("Axiom: A\nproduction:\nA --> B *\n", "'*' module inside a successor");
+}
+
+TEST(lpy, predefined_long_names) {
+  // L-Py's long names are the same modules as the short ones: Left(30) is +(30), not the five
+  // modules L e f t(30) (the last one a hidden move)
+  DERIVES("Axiom: Left(30) Right RollL(2) SetHead(0,0,1,1,0,0) Sphere(1) StartGC EndGC BP PP EP IncColor "
+          "DecColor(2) MoveTo(1,2,3) Label('x') IncWidth DecWidth SB EB\n",
+          0, "+(30)-/(2)@R(0,0,1,1,0,0)@O(1)@Gc@Ge{.};,(2)@M(1,2,3)@L('x')_![]");
+  // a rule written with the short name matches modules written with the long one, and back
+  DERIVES("Axiom: Left(30) +(10)\nproduction:\n+(a) --> Right(a)\n", 1, "-(30)-(10)");
+  DERIVES("Axiom: Tropism(0,0,1) @Ts(0.5) Elasticity(0.2)\nproduction:\nElasticity(e) --> @Ts(e * 2)\n", 1,
+          "@Tp(0,0,1)@Ts(1)@Ts(0.4)");
+  vd_lsystem* ls;
+  vd_error e = {0};
+  const char* src = "Axiom: Sphere\n";
+  CHECK_STATUS(vd_lsys_parse(src, strlen(src), "t", &ls, &e), VD_OK, e);
+  CHECK_INT(vd_lsys_symbol_find(ls, "Sphere"), VD_SYM_SPHERE);
+  CHECK_INT(vd_lsys_symbol_find(ls, "GetPos"), VD_SYM_GETPOS);
+  CHECK_INT(vd_lsys_symbol_find(ls, "surface"), VD_SYM_SURFACE_NAMED);
+  vd_lsys_destroy(ls);
+}
+
+TEST(lpy, new_left_context) {
+  // `<<` reads the string already written by the forward pass: the first A follows the Y that
+  // X just became, the second follows Z
+  DERIVES("Axiom: X A A\nproduction:\nY << A --> Z\nA --> Y\nX --> Y\n", 1, "YZY");
+  // a left context `<` reads the old string instead
+  DERIVES("Axiom: X A A\nproduction:\nY < A --> Z\nA --> Y\nX --> Y\n", 1, "YYY");
+}
+
+TEST(lpy, backward_and_new_right_context) {
+  // backward(): right to left; `>>` reads what the pass has already written to the right
+  const char* src =
+      "def Start():\n  backward()\n"
+      "Axiom: A A X\nproduction:\nA >> Z --> Z\nA --> B\nX --> Z\n";
+  DERIVES(src, 1, "ZZZ");
+  // forward, a rule with `>>` does not apply (L-Py)
+  DERIVES("Axiom: A A X\nproduction:\nA >> Z --> Z\nA --> B\nX --> Z\n", 1, "BBZ");
+  // backward() at the top level, multi-module predecessors read right to left
+  DERIVES("backward()\nAxiom: A B A B\nproduction:\nA B --> C\n", 1, "CC");
+  // isForward() follows the direction
+  DERIVES("def Start():\n  backward()\nAxiom: A\nproduction:\nA :\n  produce B(isForward())\n", 1, "B(0)");
+}
+
+TEST(lpy, any_module_patterns) {
+  DERIVES("Axiom: A B(1) C\nproduction:\n* < B(x) --> D(x)\n", 1, "AD(1)C");
+  DERIVES("Axiom: A B\nproduction:\n* --> C\n", 1, "CC");
+  // *(name, x): the module name and its parameters
+  DERIVES("Axiom: B(2) C\nproduction:\n*(n, x) --> E(n, x)\n", 1, "E('B',2)C");
+  // a `*` rule is tried in file order among the others
+  DERIVES("Axiom: A B\nproduction:\nA --> X\n* --> Y\nB --> Z\n", 1, "XY");
+}
+
+TEST(lpy, brackets_in_patterns) {
+  // a bracket in a strict predecessor matches itself
+  DERIVES("Axiom: A[B]C\nproduction:\nA [ --> D [\n", 1, "D[B]C");
+  // `[` in a left context is the module just before (the branch start), then up the tree
+  DERIVES("Axiom: X [ Y ] Z\nproduction:\nX [ < Y --> W\n", 1, "X[W]Z");
+  DERIVES("Axiom: X Y [ Z ]\nproduction:\nX [ < Z --> W\n", 1, "XY[Z]");
+  // `]` skips the rest of the branch the pattern opened; `=]` wants it at once
+  DERIVES("Axiom: A [ B C ] E\nproduction:\nA > [ B ] E --> X\n", 1, "X[BC]E");
+  DERIVES("Axiom: A [ B C ] E\nproduction:\nA > [ B =] E --> X\n", 1, "A[BC]E");
+}
+
+TEST(lpy, repetition_and_alternatives) {
+  DERIVES("Axiom: I I I A\nproduction:\nx(I) < A --> B\n", 1, "IIIB");
+  DERIVES("Axiom: I I I A\nproduction:\nx(I, 4) < A --> B\n", 1, "IIIA");
+  DERIVES("Axiom: I I I A\nproduction:\nx(I, 1, 3) < A --> B\n", 1, "IIIB");
+  DERIVES("Axiom: C A D A E A\nproduction:\nor(C, D) < A --> B\n", 1, "CBDBEA");
+  // the variables of the alternatives that did not match are None
+  DERIVES("Axiom: C(1) A D(2) A\nproduction:\nor(C(x), D(y)) < A :\n  if x == None: produce B(y)\n"
+          "  else: produce E(x)\n",
+          1, "C(1)E(1)D(2)B(2)");
+  DERIVES("Axiom: A C A\nproduction:\nA > or(C, None) --> B\n", 1, "BCB");
+}
+
+TEST(lpy, filters_per_rule_and_group_order) {
+  // each rule reads its contexts with the consider/ignore written last before it
+  DERIVES("Axiom: A + B - C\nproduction:\nignore: +\nA > B --> X\nignore: -\nB > C --> Y\n", 1, "X+Y-C");
+  // with a group active its rules come before those of group 0 (L-Py), not in file order
+  DERIVES("def Start():\n  useGroup(1)\nAxiom: A\nproduction:\nA --> B\ngroup 1:\nA --> C\nendgroup\n", 1, "C");
+  DERIVES("Axiom: A\nproduction:\nA --> B\ngroup 1:\nA --> C\nendgroup\n", 1, "B");
+}
+
+TEST(lpy, early_return_and_stop) {
+  // "Early return when no matching" (L-Py's default): a step where no rule applies ends the
+  // derivation, and End() is not called
+  const char* src =
+      "def End():\n  assert False\n"
+      "Axiom: A\nderivation length: 3\nproduction:\nB --> C\n";
+  vd_error e;
+  CHECK_STATUS(run_status(src, &e), VD_OK, e);
+  char with_option[512];
+  snprintf(with_option, sizeof with_option,
+           "%s###### INITIALISATION ######\ndef __initialiseContext__(context):\n"
+           "\tcontext.options.setSelection('Early return when no matching',0)\n",
+           src);
+  CHECK_STATUS(run_status(with_option, &e), VD_ERR_ASSERT, e);
+  // Stop() ends after the step, without End()
+  CHECK_STATUS(run_status("def End():\n  assert False\nAxiom: A(0)\nderivation length: 5\nproduction:\n"
+                          "A(x) :\n  if x == 1: Stop()\n  produce A(x + 1)\n",
+                          &e),
+               VD_OK, e);
+  DERIVES("Axiom: A(0)\nderivation length: 5\nproduction:\nA(x) :\n  if x == 1: Stop()\n  produce A(x + 1)\n", -1,
+          "A(2)");
+  // no rule at all: the axiom, and no hook runs
+  CHECK_STATUS(run_status("def Start():\n  assert False\nAxiom: A\n", &e), VD_OK, e);
+}
+
+TEST(lpy, decomposition_recursive_and_depth_expression) {
+  // decomposition rewrites each production again on its own, up to `maximum depth` (an
+  // expression)
+  DERIVES("N = 3\nAxiom: A(0)\nproduction:\nX --> X\ndecomposition:\nmaximum depth: N\nA(x) --> B(x) A(x + 1)\n", 1,
+          "B(0)B(1)B(2)A(3)");
+  // contexts inside the recursion see only the production being rewritten
+  DERIVES("Axiom: C A\nproduction:\nX --> X\ndecomposition:\nmaximum depth: 2\nA --> D E\nC < E --> F\nD < E --> G\n", 1,
+          "CDG");
+}
+
+TEST(lpy, string_matching_option) {
+  const char* trailer =
+      "###### INITIALISATION ######\ndef __initialiseContext__(context):\n"
+      "\tcontext.options.setSelection('String matching',%d)\n";
+  char src[512], t[256];
+  // as an axial tree (default) the left context of C is A; as a string it is ']'
+  snprintf(t, sizeof t, trailer, 1);
+  snprintf(src, sizeof src, "Axiom: A [ B ] C\nproduction:\nA < C --> D\n%s", t);
+  DERIVES(src, 1, "A[B]D");
+  snprintf(t, sizeof t, trailer, 0);
+  snprintf(src, sizeof src, "Axiom: A [ B ] C\nproduction:\nA < C --> D\n] < C --> E\n%s", t);
+  DERIVES(src, 1, "A[B]E");
+  // multiscale matching is refused, never silently ignored
+  snprintf(t, sizeof t, trailer, 3);
+  snprintf(src, sizeof src, "module U : scale = 1\nAxiom: U\nproduction:\nU --> U\n%s", t);
+  REFUSED(src, "String matching");
+}
+
+TEST(lpy, refusals_name_the_construct) {
+  REFUSED("Axiom: A\nproduction:\n$A(a) --> B\n", "'$' pattern module");
+  REFUSED("Axiom: A\nproduction:\nA > ?I(it) --> B\n", "'?I' pattern module");
+  REFUSED("Axiom: A\nproduction:\nA(*p) --> B\n", "'*args' pattern parameter");
+  REFUSED("Axiom: A\nproduction:\nA(**p) --> B\n", "'**kwds' pattern parameter");
+  REFUSED("Axiom: A\nproduction:\n*(n in 'AB') --> B\n", "condition on the pattern parameter 'n'");
+  REFUSED("Axiom: A\nproduction:\nx(A) --> B\n", "x(...) or or(...) in a strict predecessor");
+  REFUSED("@decorate\ndef f(): pass\nAxiom: A\n", "decorator");
+}
+
+TEST(lpy, discard_new_string) {
+  // DiscardNewString() (L-Py's __lpyfuture__) drops the result of the step it is called in
+  const char* src =
+      "from openalea.lpy.__lpyfuture__ import *\n"
+      "Axiom: A\nderivation length: 3\nproduction:\nA :\n  if getIterationNb() == 1: DiscardNewString()\n"
+      "  produce A B\n";
+  DERIVES(src, -1, "ABB");
+}
