@@ -47,7 +47,8 @@ static const char* dataset_usage =
     "      --shard I/N       make only items i with i mod N = I (0 <= I < N): one shard of a\n"
     "                        Slurm job array or of mpirun ranks (examples/dataset_*.sh)\n"
     "      --vary NAME=A:B   set the .lpy global NAME to a value drawn uniformly in [A, B] for\n"
-    "                        each item (repeatable); the value is in the item's record\n"
+    "                        each item (repeatable); integer bounds (8:24) draw integers, write\n"
+    "                        8.0:24 for real values; the value is in the item's record\n"
     "      --images N        also N pictures of each plant from around it (colour, depth and label\n"
     "                        and instance masks, camera JSON: item_000000_view0.png, ...), seeded\n"
     "                        by the item; needs an OpenGL context (EGL, software without a GPU)\n"
@@ -58,6 +59,7 @@ static const char* dataset_usage =
 typedef struct vary {
   char name[64];
   double a, b;
+  int integer;  // both bounds written as integers: draw integers in [a, b]
 } vary;
 
 typedef struct dataset {
@@ -102,8 +104,16 @@ static uint64_t item_seed(const dataset* ds, int i, double* values) {
   vd_rng r;
   vd_rng_stream(&r, ds->master, (uint64_t)i);
   uint64_t hi = vd_rng_u32(&r), lo = vd_rng_u32(&r);
-  for (int k = 0; k < ds->nvary; k++)
-    values[k] = vd_rng_uniform(&r, ds->vary[k].a, ds->vary[k].b);
+  for (int k = 0; k < ds->nvary; k++) {
+    const vary* v = &ds->vary[k];
+    if (v->integer) {
+      // one draw either way, so the stream stays the same for the other values
+      double x = v->a + floor(vd_rng_uniform(&r, 0, 1) * (v->b - v->a + 1));
+      values[k] = x > v->b ? v->b : x;
+    } else {
+      values[k] = vd_rng_uniform(&r, v->a, v->b);
+    }
+  }
   return ((hi << 32) | lo) & ((1ull << 53) - 1);  // below 2^53: exact as a JSON number
 }
 
@@ -733,7 +743,30 @@ static int parse_vary(const char* s, vary* v) {
   const char* p = end + 1;
   v->b = strtod(p, &end);
   if (end == p || *end || errno || !isfinite(v->b) || v->b < v->a) return 0;
+  // integer bounds (no point, no exponent, within +-2^53) draw integers
+  char a[64];
+  size_t n = (size_t)(p - 1 - (eq + 1));
+  int64_t ia, ib;
+  snprintf(a, sizeof a, "%.*s", (int)(n < sizeof a ? n : sizeof a - 1), eq + 1);
+  v->integer = cli_parse_i64(a, -(1LL << 53), 1LL << 53, &ia) && cli_parse_i64(p, -(1LL << 53), 1LL << 53, &ib);
   return 1;
+}
+
+// every --vary names a global of the .lpy file; prints and returns EXIT_USAGE if not
+static int check_vary(const dataset* ds, const char* path) {
+  vd_lsystem* ls;
+  vd_error err = {0};
+  vd_status st = vd_lsys_load(path, &ls, &err);
+  if (st) return cli_report("dataset", &err, st);
+  int code = 0;
+  for (int k = 0; k < ds->nvary && !code; k++) {
+    vd_error e = {0};
+    if (vd_lsys_set_global(ls, ds->vary[k].name, "0", &e) == VD_ERR_NAME)
+      code = cli_usage_error("dataset", "--vary %s: %s defines no global '%s'", ds->vary[k].name, path,
+                             ds->vary[k].name);
+  }
+  vd_lsys_destroy(ls);
+  return code;
 }
 
 // options that do not change what an item holds: left out of the parameter id
@@ -862,7 +895,12 @@ int cli_dataset(int argc, char** argv) {
   }
   h = fnv1a(h, ds.ext, strlen(ds.ext) + 1);
   snprintf(ds.params, sizeof ds.params, "%016llx", (unsigned long long)h);
-  if (mkdir(ds.dir, 0777) != 0 && errno != EEXIST) {
+  if (ds.nvary && check_vary(&ds, po.path)) {
+    cJSON_Delete(ds.arguments);
+    return EXIT_USAGE;
+  }
+  int made_dir = mkdir(ds.dir, 0777) == 0;
+  if (!made_dir && errno != EEXIST) {
     cJSON_Delete(ds.arguments);
     fprintf(stderr, "verdant dataset: %s: cannot create the folder: %s\n", ds.dir, strerror(errno));
     return EXIT_FAIL;
@@ -910,6 +948,7 @@ int cli_dataset(int argc, char** argv) {
       vd_free(todo, (size_t)ds.count * sizeof(int));
       cJSON_Delete(ds.arguments);
       cli_report("dataset", &first, st);
+      if (made_dir) rmdir(ds.dir);
       return EXIT_FAIL;
     }
     pool_put(&pool, slot);
@@ -948,6 +987,7 @@ int cli_dataset(int argc, char** argv) {
     char buf[1024];
     fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
             first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
+    if (made_dir) rmdir(ds.dir);  // a folder made for a dataset that failed goes when empty
     // writing the dataset failed (disk full, unwritable) or memory ran out: a failed run;
     // anything else is bad input
     return failed_output || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);

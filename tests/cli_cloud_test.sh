@@ -196,6 +196,25 @@ PY
 then ok "manifest recipe makes every item again"; else bad "manifest recipe makes every item again"; fi
 expect "dataset --cloud-seed refused" 2 "$V" dataset "$A" --count 3 --cloud-seed 3 -o "$T/cs"
 
+# --vary (issue 12, item 5): integer bounds draw integers (the tomato's NODES is a derivation
+# length, randint bounds elsewhere); an unknown name is reported as --vary; a failed dataset
+# leaves no empty folder
+expect "dataset --vary of an integer global" 0 "$V" dataset "$TOM" --count 4 -N 200 --vary NODES=8:24 --vary INTERNODE=0.04:0.06 -o "$T/vi"
+if python3 - "$T/vi" <<'PY'
+import json, sys
+items = json.load(open(sys.argv[1] + "/manifest.json"))["items"]
+n = [i["vary"]["NODES"] for i in items]
+assert all(isinstance(x, int) and 8 <= x <= 24 for x in n), n
+assert len(set(n)) > 1, n
+assert all(isinstance(i["vary"]["INTERNODE"], float) for i in items)
+PY
+then ok "integer bounds draw integers"; else bad "integer bounds draw integers"; fi
+expect "dataset --vary unknown global" 2 "$V" dataset "$TOM" --count 2 -N 200 --vary NODEZ=8:24 -o "$T/vu"
+expect_err "unknown --vary named as --vary" "[-]-vary NODEZ: .*no global 'NODEZ'"
+if [ ! -e "$T/vu" ]; then ok "no folder for a refused dataset"; else bad "no folder for a refused dataset"; fi
+expect "dataset whose items fail" 2 "$V" dataset "$TOM" --count 2 -N 200 --set NODES=-3 -o "$T/vf"
+if [ ! -e "$T/vf" ]; then ok "no empty folder after a failed dataset"; else bad "no empty folder after a failed dataset"; fi
+
 # two shards into another folder: the same items; the manifest comes with the last shard
 E="$T/shards"
 expect "shard 0/2" 0 "$V" dataset "$A" --count 5 -N 2000 --seed 4 --vary ROSETTE_LEAF=0.025:0.045 -o "$E" --shard 0/2
@@ -211,7 +230,7 @@ then ok "shards give the same dataset"; else bad "shards give the same dataset";
 expect "bad shard" 2 "$V" dataset "$A" --count 5 -o "$E" --shard 2/2
 expect "bad vary" 2 "$V" dataset "$A" --count 5 -o "$E" --vary X=3:1
 expect "vary unknown global" 2 "$V" dataset "$A" --count 1 -N 100 -o "$T/ds3" --vary NOPE=1:2
-expect_err "failing item named" "item 0"
+expect_err "unknown --vary named" "[-]-vary NOPE"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
