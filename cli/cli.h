@@ -240,6 +240,50 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);
 
+// The pictures of `verdant dataset --images N` (cli_views.c): render options and what varies
+// from view to view.
+typedef struct cli_view_opts {
+  int shadows, floor, sky;  // 0 with --no-shadows, --no-floor, --no-sky
+  int supersample;          // --supersample K
+  vd_palette palette;       // --palette
+  double el[2];             // --view-elevation A:B (degrees)
+  double dist[2];           // --view-distance A:B (times the fitted distance)
+  double jitter;            // --view-jitter F (fraction of the plant's half-size)
+  int vary_light;           // --vary-light
+  int vary_background;      // --vary-background
+  int given;                // any of these given (they need --images)
+} cli_view_opts;
+
+// One view: its angles (degrees), distance factor, camera, look, lights as render --light takes.
+typedef struct cli_view {
+  double az, el, dist;
+  vd_camera cam;
+  vd_render_look look;
+  double light[5];  // azimuth, elevation (degrees), key, headlight, ambient
+} cli_view;
+
+// Help lines of the view options.
+extern const char* cli_view_help;
+// Defaults: shadows, floor, sky, supersample 2, distinct palette, elevation 10:40, distance 1:1,
+// no jitter, lights and background fixed.
+void cli_view_opts_init(cli_view_opts* v);
+// Consume a view option at argv[*i]: 1 consumed, 0 not one, -1 bad value (printed).
+int cli_view_opt(cli_view_opts* v, const char* cmd, int argc, char** argv, int* i);
+// 1 when views need an explicit pose (a distance other than 1 or jitter).
+int cli_view_explicit(const cli_view_opts* v);
+// The render settings the options set (shadows, floor, sky, supersample).
+void cli_view_def(const cli_view_opts* v, vd_render_def* def);
+// Draw one view at azimuth az (degrees) of the box lo..hi for a w x h picture from g, starting
+// from the renderer's look.
+void cli_view_draw(const cli_view_opts* v, vd_rng* g, double az, vd_vec3 lo, vd_vec3 hi, int w,
+                   int h, vd_render_look look, cli_view* out);
+// The view's fields in its record (azimuth, elevation; eye, lookat, up, distance; light; sky,
+// floor: as the options make them vary).
+void cli_view_record(const cli_view_opts* v, const cli_view* view, struct cJSON* e);
+// Append the render options that make a view again to a recipe (fields in braces: {azimuth},
+// {elevation}, {eye}, {lookat}, {up}, {light}, {sky}, {floor}, arrays written A,B,...).
+void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
+
 // Subcommands.
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);

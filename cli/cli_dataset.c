@@ -76,6 +76,7 @@ typedef struct dataset {
   char** argv;
   int images;          // --images: views per item
   int img_w, img_h;    // --image-size (pixels)
+  cli_view_opts view;  // the pictures' options (cli_views.c)
 } dataset;
 
 // Renderers shared by the worker threads, one thread at a time (an OpenGL context is current on
@@ -85,6 +86,7 @@ typedef struct render_pool {
   vd_renderer* r[POOL_MAX]; // renderers (n), NULL until first needed
   int geoms[POOL_MAX];      // their max_geoms
   int busy[POOL_MAX];       // 1 while a thread holds it
+  vd_render_look look0[POOL_MAX]; // their look as made (views vary from it)
   int n;
 } render_pool;
 
@@ -270,10 +272,12 @@ static vd_status pool_take(render_pool* p, const dataset* ds, int geoms, int* sl
   vd_render_def def = vd_render_def_default();
   def.width = ds->img_w, def.height = ds->img_h;
   def.legend = 0;  // training images: nothing drawn over the scene
+  cli_view_def(&ds->view, &def);
   if (geoms > def.max_geoms) def.max_geoms = geoms;
   p->geoms[s] = def.max_geoms;
   vd_status st = vd_render_create(&def, &p->r[s], err);
   if (st) p->busy[s] = 0;
+  if (!st) p->look0[s] = vd_render_get_look(p->r[s]);
   return st;
 }
 
@@ -307,9 +311,13 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
   int slot = -1;
   if (!st) st = pool_take(pool, ds, m->ninstance + 16, &slot, err);
   vd_renderer* r = slot >= 0 ? pool->r[slot] : NULL;
+  vd_render_look look0 = {0};
   if (!st) {
+    vd_render_style style = vd_render_style_default();
+    style.palette = ds->view.palette;
     vd_render_clear(r);
-    st = vd_render_add_plant(r, m, NULL, NULL, err);
+    look0 = pool->look0[slot];
+    st = vd_render_add_plant(r, m, NULL, &style, err);
   }
   cJSON* views = cJSON_AddArrayToObject(rec, "images");
   if (!st && !views) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
@@ -317,21 +325,23 @@ static vd_status make_images(const dataset* ds, render_pool* pool, const cli_pla
   vd_rng_stream(&g, seed, VIEW_STREAM);
   double az0 = vd_rng_uniform(&g, -180, 180);
   for (int v = 0; !st && v < ds->images; v++) {
-    double az = fmod(az0 + 360.0 * v / ds->images + 180, 360) - 180, el = vd_rng_uniform(&g, 10, 40);
+    // the view: elevation, distance, offset, lights and colours drawn from the stream
+    double az = fmod(az0 + 360.0 * v / ds->images + 180, 360) - 180;
     vd_vec3 lo, hi;
     vd_render_bounds(r, &lo, &hi);
-    vd_camera cam = vd_camera_preset(VD_CAMERA_ORBIT, az * VD_PI / 180, el * VD_PI / 180, lo, hi, ds->img_w, ds->img_h);
+    cli_view view;
+    cli_view_draw(&ds->view, &g, az, lo, hi, ds->img_w, ds->img_h, look0, &view);
+    if (ds->view.vary_light || ds->view.vary_background) st = vd_render_set_look(r, &view.look, err);
     vd_frame f;
     char base[64], path[4200];
     snprintf(base, sizeof base, "item_%0*d_view%d", ds->width, i, v);
     snprintf(path, sizeof path, "%s/%s.png", ds->dir, base);
-    st = vd_render_draw(r, &cam, VD_LAYER_ALL, &f, err);
+    if (!st) st = vd_render_draw(r, &view.cam, VD_LAYER_ALL, &f, err);
     if (!st) st = cli_frame_write(&f, path, 1, 1, err);
     if (st) break;
     cJSON* e = cJSON_CreateObject();
     cJSON_AddNumberToObject(e, "view", v);
-    cJSON_AddNumberToObject(e, "azimuth", az);
-    cJSON_AddNumberToObject(e, "elevation", el);
+    cli_view_record(&ds->view, &view, e);
     static const char* roles[5][2] = {{"color", "png"}, {"depth", "depth.png"}, {"label", "label.png"},
                                       {"instance", "instance.png"}, {"camera", "png.json"}};
     for (int k = 0; k < 5; k++) {
@@ -497,7 +507,8 @@ static cJSON* recipe(const dataset* ds, const char* plant, int images) {
       int takes = 0;
       const char* o = ds->argv[i];
       static const char* with_value[] = {"-K", "--count", "-o", "--output", "--format", "--jobs", "--shard",
-                                         "--vary", "--images", "--image-size"};
+                                         "--vary", "--images", "--image-size", "--palette", "--supersample",
+                                         "--view-elevation", "--view-distance", "--view-jitter"};
       for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++) takes |= !strcmp(o, with_value[k]);
       i += takes;
       continue;
@@ -511,8 +522,8 @@ static cJSON* recipe(const dataset* ds, const char* plant, int images) {
   if (images) {
     char size[32];
     snprintf(size, sizeof size, "%dx%d", ds->img_w, ds->img_h);
-    const char* tail[] = {"--camera", "orbit:{azimuth}:{elevation}", "--size", size, "--no-legend", "--depth",
-                          "--masks", "-o", "view.png"};
+    cli_view_recipe(&ds->view, a);
+    const char* tail[] = {"--size", size, "--no-legend", "--depth", "--masks", "-o", "view.png"};
     for (size_t k = 0; k < sizeof tail / sizeof *tail; k++) cJSON_AddItemToArray(a, cJSON_CreateString(tail[k]));
   } else {
     char out[32];
@@ -790,6 +801,7 @@ int cli_dataset(int argc, char** argv) {
   memset(&ds, 0, sizeof ds);
   ds.jobs = 1, ds.nshard = 1, ds.ext = "ply", ds.count = -1;
   ds.img_w = 640, ds.img_h = 480;
+  cli_view_opts_init(&ds.view);
   ds.argc = argc, ds.argv = argv;
   int image_size_given = 0;
   ds.progress = po.progress;
@@ -798,6 +810,7 @@ int cli_dataset(int argc, char** argv) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       fputs(dataset_usage, stdout);
+      fputs(cli_view_help, stdout);
       fputs(cli_cloud_help, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;
@@ -806,6 +819,9 @@ int cli_dataset(int argc, char** argv) {
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     r = cli_cloud_opt(&co, "dataset", argc, argv, &i);
+    if (r < 0) return EXIT_USAGE;
+    if (r > 0) continue;
+    r = cli_view_opt(&ds.view, "dataset", argc, argv, &i);
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     const char* val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -866,6 +882,9 @@ int cli_dataset(int argc, char** argv) {
     return cli_usage_error("dataset", "--cloud-seed does not apply to a dataset: each item's cloud is seeded by its "
                            "item seed (from --seed)");
   if (image_size_given && !ds.images) return cli_usage_error("dataset", "--image-size goes with --images N");
+  if (ds.view.given && !ds.images)
+    return cli_usage_error("dataset", "the picture options (--no-shadows, --palette, --view-*, --vary-light, "
+                                      "--vary-background, ...) go with --images N");
   // no output may replace an input: the dataset writes manifest.json and item_* in DIR
   const char* ins[2] = {po.path, co.scanners_file};
   for (int k = 0; k < 2; k++) {

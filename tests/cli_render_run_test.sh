@@ -318,5 +318,46 @@ for i in 0 1 2 3; do
 done
 if [ "$same" = 1 ]; then ok "views do not depend on --jobs"; else bad "views do not depend on --jobs"; fi
 
+# pictures for vision work: render options and views that vary (issue 12, item 16); every view is
+# made again by the manifest's recipe with the fields of its record, byte for byte
+expect "view options without images" 2 "$V" dataset "$T/p.lpy" --count 1 --vary-light -o "$T/dsx"
+expect "bad view distance" 2 "$V" dataset "$T/p.lpy" --count 1 --images 1 --view-distance 2:1 -o "$T/dsx"
+expect "bad view jitter" 2 "$V" dataset "$T/p.lpy" --count 1 --images 1 --view-jitter 3 -o "$T/dsx"
+expect "bad view elevation" 2 "$V" dataset "$T/p.lpy" --count 1 --images 1 --view-elevation 10:95 -o "$T/dsx"
+expect "dataset with varied views" 0 "$V" dataset "$T/p.lpy" --count 2 --points 300 --images 3 --image-size 80x60 \
+  --view-elevation 5:60 --view-distance 0.7:1.5 --view-jitter 0.4 --vary-light --vary-background --palette natural \
+  --no-shadows --supersample 1 --jobs 2 -o "$T/dsv"
+check "varied views: records, recipe, same bytes" - "$V" "$T/dsv" "$T" <<'EOF'
+import filecmp, json, subprocess, sys
+v, d, t = sys.argv[1:4]
+m = json.load(open(d + "/manifest.json"))
+argv = m["images"]["regenerate_argv"]
+for opt in ("--no-shadows", "--palette", "--supersample", "--eye", "--lookat", "--light", "--sky-rgb", "--floor-rgb"):
+    assert opt in argv, (opt, argv)
+lights, skies, n = set(), set(), 0
+for item in m["items"]:
+    rec = json.load(open(f"{d}/item_{item['index']:06d}.json"))  # exact numbers
+    for view in rec["images"]:
+        assert 5 <= view["elevation"] <= 60 and 0.7 <= view["distance"] <= 1.5, view
+        assert -180 <= view["light"][0] <= 180 and 15 <= view["light"][1] <= 75, view["light"]
+        assert all(0 <= c <= 1 for c in view["sky"] + view["floor"])
+        lights.add(tuple(view["light"]))
+        skies.add(tuple(view["sky"]))
+        f = {"seed": str(item["seed"])}
+        for k in ("eye", "lookat", "up", "light", "sky", "floor"):
+            f[k] = ",".join(repr(float(x)) for x in view[k])
+        a = [v] + argv[1:-1] + [f"{t}/vagain.png"]
+        for key, val in f.items():
+            a = [x.replace("{" + key + "}", val) for x in a]
+        assert not any("{" in x for x in a), a
+        subprocess.run(a, check=True)
+        for role, ext in (("color", "png"), ("label", "label.png"), ("depth", "depth.png"), ("instance", "instance.png")):
+            assert filecmp.cmp(f"{t}/vagain.{ext}", f"{d}/{view[role]}", shallow=False), view[role]
+        side = json.load(open(f"{d}/{view['camera']}"))
+        assert side["palette"] == "natural"
+        n += 1
+assert n == 6 and len(lights) == 6 and len(skies) == 6, (n, len(lights), len(skies))
+EOF
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
