@@ -35,6 +35,7 @@ typedef struct cli_plant_opts {
   double curve_step;       // --curve-step (m) for curves files, < 0: the file's or the default
   double curve_connect;    // --curve-connect (m), < 0: the file's or the default
   double curve_distance;   // --curve-distance (m), < 0: the file's or the default
+  int engine;              // --engine auto|native|python (vd_lsys_engine), VD_LSYS_AUTO by default
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
@@ -53,6 +54,7 @@ typedef struct cli_grow_info {
   int64_t* sym_count;       // per-symbol module counts (nsym), owned (free with vd_free)
   char** sym_name;          // per-symbol names (nsym), owned
   double seconds_derive, seconds_turtle;
+  const char* engine;       // the engine that ran the .lpy file ("native", "python"), NULL otherwise
 } cli_grow_info;
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err);
 // Free what cli_load_plant put in info.

@@ -17,6 +17,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
     return NULL;
   }
   snprintf(ls->file, sizeof ls->file, "%s", name ? name : "");
+  ls->engine = VD_LSYS_NATIVE;
   vd_arena_init(&ls->arena, 1 << 16);
   vm_budget(ls, 0);
   ls->max_depth[SEC_DECOMPOSITION] = 1;
@@ -73,6 +74,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
 
 void vd_lsys_destroy(vd_lsystem* ls) {
   if (!ls) return;
+  lsys_py_free(ls);
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
   vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);
@@ -104,12 +106,15 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   vd_free(ls, sizeof *ls);
 }
 
-vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsystem** out, vd_error* err) {
+// parse with one engine (VD_LSYS_NATIVE or VD_LSYS_PYTHON); lsys_engine.c chooses
+vd_status lsys_parse_with(const char* text, size_t len, const char* name, int engine, vd_lsystem** out,
+                          vd_error* err) {
   *out = NULL;
   vd_error local = {0};
   if (!err) err = &local;
   vd_lsystem* ls = lsys_new(name, err);
   if (!ls) return VD_ERR_NOMEM;
+  ls->engine = engine;
   // a NUL byte inside the text is a binary file, not L-Py
   const char* nul = memchr(text, 0, len);
   if (nul) {
@@ -134,16 +139,6 @@ vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsyst
   return VD_OK;
 }
 
-vd_status vd_lsys_load(const char* path, vd_lsystem** out, vd_error* err) {
-  char* text;
-  size_t len;
-  *out = NULL;
-  vd_status st = vd_file_read(path, &text, &len, err);
-  if (st) return st;
-  st = vd_lsys_parse(text, len, path, out, err);
-  vd_free(text, len + 1);
-  return st;
-}
 
 vd_lsys_def vd_lsys_def_default(void) {
   vd_lsys_def d;
@@ -185,6 +180,13 @@ static int assigned_at_top(const vd_lsystem* ls, int slot) {
 }
 
 vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* text, vd_error* err) {
+  if (ls->py) {
+    vd_error local = {0};
+    ls->err = err ? err : &local;
+    vd_status st = lsys_py_set_global(ls, name, text);
+    ls->err = NULL;
+    return st;
+  }
   int slot = global_slot(ls, name, (int)strlen(name), 0);
   if (slot < 0 || !assigned_at_top(ls, slot))
     return vd_error_set(err, VD_ERR_NAME, ls->file, 0, 0, "--set %s: the file defines no global '%s'", name, name);
@@ -226,6 +228,7 @@ vd_status vd_lsys_set_global(vd_lsystem* ls, const char* name, const char* text,
 }
 
 vd_status vd_lsys_get_global(const vd_lsystem* ls, const char* name, double* value_out) {
+  if (ls->py) return lsys_py_get_global((vd_lsystem*)ls, name, value_out);
   int slot = global_slot((vd_lsystem*)ls, name, (int)strlen(name), 0);
   if (slot < 0) return VD_ERR_NAME;
   value v = ls->gval[slot];
@@ -247,6 +250,7 @@ static vd_status run_toplevel(vd_lsystem* ls, uint64_t seed) {
   ls->backward = 0;
   ls->discard_requested = 0;
   ls->frame_displayed = 0;
+  if (ls->py) return lsys_py_run_toplevel(ls, seed);
   for (int i = 0; i < ls->nscalar; i++) ls->gval[ls->scalar_slot[i]] = ls->scalar_val[i];
   for (stmt* s = ls->top; s; s = s->next) {
     if (s->op == S_ASSIGN && s->is_global && ls->gdef[s->slot].has_override) {
@@ -265,6 +269,17 @@ static vd_status run_toplevel(vd_lsystem* ls, uint64_t seed) {
 }
 
 int vd_lsys_derivation_length(const vd_lsystem* ls) {
+  if (ls->py) {
+    vd_lsystem* mls = (vd_lsystem*)ls;
+    vd_error local = {0};
+    mls->err = &local;
+    int n = 1;
+    lsys_py_enter(mls);
+    if (run_toplevel(mls, 0) != VD_OK || lsys_py_dlength_eval(mls, &n) != VD_OK) n = 1;
+    lsys_py_leave(mls);
+    mls->err = NULL;
+    return n;
+  }
   if (!ls->derivation_length) return 1;
   value v;
   vd_lsystem* mls = (vd_lsystem*)ls;
@@ -295,6 +310,7 @@ static int find_hook(vd_lsystem* ls, const char* name) {
 }
 
 static vd_status call_hook(vd_lsystem* ls, int fi) {
+  if (ls->py) return VD_OK;  // the Python engine calls its hooks by name (lsys_py_hook)
   if (fi < 0) return VD_OK;
   func* f = ls->funcs[fi];
   if (f->nparam != 0)
@@ -306,6 +322,7 @@ static vd_status call_hook(vd_lsystem* ls, int fi) {
 
 // release a run's scratch, make sure a failure has a message, detach the error sink
 static vd_status end_run(vd_lsystem* ls, vd_status st, vd_lstring* tmp, lsys_pass* P) {
+  if (ls->py) lsys_py_leave(ls);
   vd_lstring_free(tmp);
   lsys_pass_free(P);
   if (st && ls->err->status == VD_OK) vd_error_set(ls->err, st, ls->file, 0, 0, "%s", vd_status_str(st));
@@ -358,13 +375,19 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   memset(&P, 0, sizeof P);
   P.max_modules = d.max_modules;
   vd_status st = VD_OK;
+  if (ls->py) {
+    lsys_py_enter(ls);
+    lsys_py_reset_objects(ls);
+  }
   if (out->src) {
     vd_free(out->src, sizeof(int64_t) * (size_t)out->cap);
     out->src = NULL;
   }
   if ((st = run_toplevel(ls, d.seed))) goto done;
   int steps = d.steps;
-  if (steps < 0) {
+  if (steps < 0 && ls->py) {
+    if ((st = lsys_py_dlength_eval(ls, &steps))) goto done;
+  } else if (steps < 0) {
     steps = 1;
     if (ls->derivation_length) {
       value v;
@@ -394,7 +417,9 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   }
   {
     vm_out vo = {out, 0, d.max_modules, 0, 0};
-    if (ls->axiom) {
+    if (ls->py) {
+      st = lsys_py_emit_axiom(ls, &vo);
+    } else if (ls->axiom) {
       st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
     } else if (ls->axiom_body) {
       int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
@@ -414,6 +439,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) goto done;
   ls->iteration = 0;
   if ((st = call_hook(ls, ls->hook_start))) goto done;
+  if (ls->py && (st = lsys_py_hook(ls, "Start", out, &tmp, d.max_modules))) goto done;
   if (ls->opt_axiom_decomposition && !lsys_section_empty(ls, SEC_DECOMPOSITION)) {
     int dm = 0;
     if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
@@ -428,6 +454,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     ls->iteration = step;
     ls->frame_displayed = step == steps - 1;
     if ((st = call_hook(ls, ls->hook_starteach))) goto done;
+    if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, &tmp, d.max_modules))) goto done;
     // useGroup() and backward() take effect at the next step
     if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) {
       vm_error(ls, st, 0, 0, "out of memory");
@@ -443,6 +470,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
       if (dm) matching = 1;
     }
     if (!(discard && ls->discard_requested) && (st = call_hook(ls, ls->hook_endeach))) goto done;
+    if (ls->py && (st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules))) goto done;
     if (discard) {
       if (ls->discard_requested) {
         ls->discard_requested = 0;
@@ -455,10 +483,13 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
         has_saved = 1;
       }
     }
+    // the Python engine's objects no module refers to any more (a saved string keeps its own)
+    if (ls->py && !has_saved) lsys_py_gc(ls, out);
     if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
     if (ls->stop_requested) break;  // Stop(): L-Py ends here, without End()
   }
   if (step == steps && (st = call_hook(ls, ls->hook_end))) goto done;
+  if (ls->py && step == steps && (st = lsys_py_hook(ls, "End", out, &tmp, d.max_modules))) goto done;
 done:
   return end_run(ls, st, &tmp, &P);
 }
@@ -475,6 +506,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   P.max_modules = d.max_modules;
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;
+  if (ls->py) lsys_py_enter(ls);
   // interpretation rules of the group in use at the end of the derivation, read forward
   if ((st = lsys_build_index(ls, ls->current_group, 0))) {
     vm_error(ls, st, 0, 0, "out of memory");
