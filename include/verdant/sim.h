@@ -295,6 +295,14 @@ typedef struct vd_sim_data {
   int* seg_start;          // current start node: seg_node[2s] or its spare after breaking (nseg)
   vd_sim_collider collider[VD_SIM_MAX_COLLIDERS];  // external colliders
   int ncollider;           // colliders in use
+  // what the plant did to each collider in the last vd_sim_step: minus the momentum its contacts
+  // (normal pushes and friction) gave the plant, per second of the step (the reaction a robot
+  // link feels; two-way coupling)
+  vd_vec3 collider_force[VD_SIM_MAX_COLLIDERS];   // force on collider k (N)
+  vd_vec3 collider_torque[VD_SIM_MAX_COLLIDERS];  // its moment about collider k's pos (N m)
+  int collider_pass[VD_SIM_MAX_COLLIDERS];  // a node collider k does not touch, -1 none (a fruit
+                                            // held between a gripper's fingers); set to -1 by
+                                            // vd_sim_add_collider
   vd_sim_tie* tie;         // user ties (ntie, capacity cap_tie)
   int ntie, cap_tie;
   vd_sim_event* event;     // fracture events since the last reset (nevent, at most nseg)

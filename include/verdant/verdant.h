@@ -21,5 +21,6 @@
 #include "verdant/render.h"
 #include "verdant/sim.h"
 #include "verdant/collide.h"
+#include "verdant/robot.h"
 
 #endif
