@@ -177,6 +177,41 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   return st;
 }
 
+vd_status vdpy_grow_file(const char* path, uint64_t seed, int steps, char* const* sets, int nset,
+                         vd_plant_spec** out, vd_error* err) {
+  grow_args a;
+  memset(&a, 0, sizeof a);
+  a.def = vd_lsys_def_default();
+  a.def.max_modules = 50000000;
+  a.def.seed = seed;
+  a.def.steps = steps;
+  a.curve[0] = a.curve[1] = a.curve[2] = -1;
+  snprintf(a.path, sizeof a.path, "%s", path);
+  // "NAME=VALUE" overrides, split into the arrays grow_run reads
+  char(*names)[128] = nset ? vd_calloc((size_t)nset, sizeof *names) : NULL;
+  char** values = nset ? vd_calloc((size_t)nset, sizeof *values) : NULL;
+  if (nset && (!names || !values)) {
+    vd_free(names, (size_t)nset * sizeof *names);
+    vd_free(values, (size_t)nset * sizeof *values);
+    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  }
+  for (int i = 0; i < nset; i++) {
+    const char* eq = strchr(sets[i], '=');
+    size_t n = eq ? (size_t)(eq - sets[i]) : strlen(sets[i]);
+    snprintf(names[i], sizeof names[i], "%.*s", (int)(n < 127 ? n : 127), sets[i]);
+    values[i] = eq ? (char*)eq + 1 : (char*)"";
+  }
+  a.nset = nset, a.set_name = names, a.set_value = values;
+  grow_out o;
+  memset(&o, 0, sizeof o);
+  vd_status st = grow_run(&a, &o, err);
+  if (!st) *out = o.spec, o.spec = NULL;
+  grow_out_free(&o);
+  vd_free(names, (size_t)nset * sizeof *names);
+  vd_free(values, (size_t)nset * sizeof *values);
+  return st;
+}
+
 // the derivation's summary: modules, module_counts (by symbol, in symbol order), seconds
 static PyObject* grow_info(const grow_out* o, int lsys) {
   if (!lsys) return PyDict_New();

@@ -47,7 +47,7 @@ __version__ = _verdant.version
 
 __all__ = [
     "grow", "load", "read_cloud", "read_png", "render", "Plant", "Mesh", "Cloud", "Sim",
-    "Renderer",
+    "Renderer", "HarvestEnv",
     "Error", "ParseError", "UnsupportedError", "UndefinedNameError", "WrongTypeError",
     "BadValueError", "ModelAssertionError", "LimitError", "FileError", "FormatError",
     "OutOfMemoryError", "ArgumentError",
@@ -309,6 +309,8 @@ def render(objects, *, camera="orbit", azimuth=-60, elevation=20, eye=None, look
 
 
 _verdant._register(plant=Plant, mesh=Mesh, cloud=Cloud)
+
+from .env import HarvestEnv  # noqa: E402  (needs Plant and Renderer above)
 
 
 def grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=None, max_ops=None,
