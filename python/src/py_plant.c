@@ -492,6 +492,13 @@ static PyGetSetDef plant_getset[] = {
     {NULL, NULL, NULL, NULL, NULL},
 };
 
+// a mesh with the plant's label table as OBJ (with its MTL) or PLY (binary unless ascii)
+static vd_status write_mesh(const vd_mesh* mesh, const vd_model* m, const char* out, int obj, int ascii,
+                            vd_error* err) {
+  return obj ? vd_geom_write_obj(mesh, m->labels, m->nlabel, out, err)
+             : vd_geom_write_ply(mesh, m->labels, m->nlabel, out, !ascii, err);
+}
+
 // write the spec (JSON) or the rest shape's tessellation (OBJ with MTL, PLY), as `verdant grow -o`
 static PyObject* plant_save(vdpy_plant* p, PyObject* args, PyObject* kw) {
   static char* names[] = {"path", "ascii", NULL};
@@ -511,8 +518,7 @@ static PyObject* plant_save(vdpy_plant* p, PyObject* args, PyObject* kw) {
     vd_mesh mesh;
     st = vd_geom_tessellate(p->model, NULL, NULL, &mesh, &err);
     if (!st) {
-      st = obj ? vd_geom_write_obj(&mesh, p->model->labels, p->model->nlabel, out, &err)
-               : vd_geom_write_ply(&mesh, p->model->labels, p->model->nlabel, out, !ascii, &err);
+      st = write_mesh(&mesh, p->model, out, obj, ascii, &err);
       vd_mesh_free(&mesh);
     }
   }
@@ -643,8 +649,7 @@ static PyObject* mesh_save(vdpy_mesh* m, PyObject* args, PyObject* kw) {
   vd_error err = {0};
   vd_status st;
   Py_BEGIN_ALLOW_THREADS
-  st = obj ? vd_geom_write_obj(&m->mesh, pm->labels, pm->nlabel, out, &err)
-           : vd_geom_write_ply(&m->mesh, pm->labels, pm->nlabel, out, !ascii, &err);
+  st = write_mesh(&m->mesh, pm, out, obj, ascii, &err);
   Py_END_ALLOW_THREADS
   if (st) return vdpy_raise(st, &err);
   Py_RETURN_NONE;
