@@ -14,6 +14,8 @@ from conftest import SRC
 HERE = os.path.join(SRC, "data", "scenes")
 MINI = os.path.join(HERE, "mini_harvest.json")    # a small tomato, the Lite 6, 0.15 s episodes
 PICK = os.path.join(HERE, "mini_pick.json")       # the same with 6 s episodes and a faster pull
+# the sanitized build (make test SANITIZE=1) runs ten times slower: fewer episodes there
+EPISODES = 10 if os.environ.get("VERDANT_SANITIZE") else 100
 
 
 def test_random_policy_100_episodes():
@@ -22,7 +24,7 @@ def test_random_policy_100_episodes():
     obs, info = env.reset(seed=0)
     assert env.observation_space.contains(obs)
     episodes, targets, returns = 0, set(), []
-    for ep in range(100):
+    for ep in range(EPISODES):
         if ep:
             obs, info = env.reset()
         assert info["episode"] == ep and not info["detached"]
@@ -40,7 +42,7 @@ def test_random_policy_100_episodes():
         assert info["summary"]["steps"] == steps and info["reason"]
         episodes += 1
         returns.append(total)
-    assert episodes == 100 and len(targets) > 1          # random reachable targets
+    assert episodes == EPISODES and len(targets) > 1     # random reachable targets
     # the same seed, the same episodes
     env2 = verdant.HarvestEnv(MINI)
     env2.reset(seed=0)
