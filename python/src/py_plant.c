@@ -33,6 +33,7 @@ typedef struct grow_args {
   int* label_id;         // --label ids (nlabel)
   char (*label_name)[VD_LABEL_NAME_MAX];  // --label names
   double curve[3];       // curve step, connect, distance (m), < 0: file's or default
+  vd_lsys_engine engine; // who runs the file's Python (--engine)
 } grow_args;
 
 // What grow() made.
@@ -152,7 +153,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
     if (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0)
       return vd_error_set(err, VD_ERR_ARG, name, 0, 0, "curve_* options apply to curves files only");
     vd_lsystem* ls;
-    vd_status st = vd_lsys_parse(a->text, len, name, &ls, err);
+    vd_status st = vd_lsys_parse_engine(a->text, len, name, a->engine, &ls, err);
     if (st) return st;
     st = grow_lsys(a, ls, name, out, err);
     vd_lsys_destroy(ls);
@@ -170,7 +171,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   if (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0)
     return vd_error_set(err, VD_ERR_ARG, a->path, 0, 0, "curve_* options apply to curves files only");
   vd_lsystem* ls;
-  vd_status st = vd_lsys_load(a->path, &ls, err);
+  vd_status st = vd_lsys_load_engine(a->path, a->engine, &ls, err);
   if (st) return st;
   st = grow_lsys(a, ls, a->path, out, err);
   vd_lsys_destroy(ls);
@@ -239,7 +240,7 @@ static PyObject* set_text(PyObject* v, const char* name) {
 
 PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   static const char* const names[] = {"seed", "steps", "set", "labels", "max_modules", "max_ops",
-                                      "curve_step", "curve_connect", "curve_distance", NULL};
+                                      "curve_step", "curve_connect", "curve_distance", "engine", NULL};
   PyObject* source;
   if (!PyArg_ParseTuple(args, "O:grow", &source) || !vdpy_kw_check(kw, "grow", names)) return NULL;
   grow_args a;
@@ -278,6 +279,14 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   if ((o = vdpy_kw(kw, "max_ops"))) {
     if (!vdpy_i64(o, "max_ops", 0, INT64_MAX, &v)) return NULL;
     a.def.max_ops = v;
+  }
+  if ((o = vdpy_kw(kw, "engine"))) {
+    char e[16];
+    if (!vdpy_str(o, "engine", e, sizeof e)) return NULL;
+    if (!strcmp(e, "auto")) a.engine = VD_LSYS_AUTO;
+    else if (!strcmp(e, "native")) a.engine = VD_LSYS_NATIVE;
+    else if (!strcmp(e, "python")) a.engine = VD_LSYS_PYTHON;
+    else return vdpy_arg_error("engine expects 'auto', 'native' or 'python', got '%s'", e);
   }
   const char* curve_names[3] = {"curve_step", "curve_connect", "curve_distance"};
   for (int k = 0; k < 3; k++)
