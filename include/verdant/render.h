@@ -159,6 +159,30 @@ vd_status vd_render_set_look(vd_renderer* r, const vd_render_look* look, vd_erro
 // Set the robot's joint positions (MuJoCo qpos, nq values) for the next frames.
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err);
 
+// What MuJoCo makes of an MJCF file (a robot, a plant from vd_geom_export, a scene including
+// both), loaded as the renderer loads a robot and brought to its first state (mj_forward); no
+// OpenGL context is needed.
+typedef struct vd_mjcf_info {
+  int nbody, ngeom, nmesh, njoint; // sizes of the model (the world body counted)
+  int nbody_prefix;                // bodies whose names start with the prefix
+  int ngeom_prefix;                // geoms of those bodies
+  int ncontact;                    // contacts of the first state
+  int ncontact_prefix;             // of them, between a geom of a prefix body and one of a body
+                                   // that is neither a prefix body nor the world (a robot's)
+} vd_mjcf_info;
+
+// Load an MJCF file with MuJoCo and count what it holds (prefix Nullable: no prefix counts).
+// VD_ERR_IO when it cannot be opened, VD_ERR_FORMAT with MuJoCo's message (file:line) when it does
+// not load, VD_ERR_VALUE for a MuJoCo error after loading.
+vd_status vd_render_mjcf_info(const char* path, const char* prefix, vd_mjcf_info* info,
+                              vd_error* err);
+
+// Write an MJCF scene that includes the MJCF files parts (nparts: a robot, a plant from
+// vd_geom_export, ...), each named relative to the scene's folder (MuJoCo 2.2.2 puts that folder
+// in front of every included name). VD_ERR_IO when a part or the scene's folder cannot be found.
+vd_status vd_render_mjcf_scene(const char* scene, const char* const* parts, int nparts,
+                               vd_error* err);
+
 // ---------------------------------------------------------------------------------------------
 // what is drawn
 

@@ -2,6 +2,7 @@
 // The renderer's lifetime: defaults, the OpenGL context, the stage model (floor, sky) written as
 // MJCF into MuJoCo's in-memory file system or a robot's MJCF, MuJoCo's scene and context, image
 // buffers.
+#define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -108,33 +109,37 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
                : "");
 }
 
+// load an MJCF file (under a trap); NULL with *st and err set on failure, the message on one
+// line with the line number where MuJoCo's parser gives one
+static mjModel* load_mjcf(const char* path, const char* what, vd_status* st, vd_error* err) {
+  char msg[1000] = "";
+  FILE* f = fopen(path, "rb");
+  if (!f) {
+    *st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot open: %s", strerror(errno));
+    return NULL;
+  }
+  fclose(f);
+  mjModel* m = mj_loadXML(path, NULL, msg, sizeof msg);
+  if (!m) {
+    // MuJoCo's message spans lines ("XML parse error 7:\nError=... Line number=5: ...")
+    long line = 0;
+    const char* ln = strstr(msg, "Line number=");
+    if (ln) line = strtol(ln + 12, NULL, 10);
+    for (char* c = msg; *c; c++)
+      if (*c == '\n' || *c == '\r') *c = ' ';
+    size_t n = strlen(msg);
+    while (n && msg[n - 1] == ' ') msg[--n] = 0;
+    *st = vd_error_set(err, VD_ERR_FORMAT, path, line > 0 && line < 1000000000 ? (int)line : 0, 0,
+                       "%s: %s", what, msg);
+  }
+  return m;
+}
+
 // load the stage from memory, or the robot from its file; NULL with *st and err set on failure
 static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
   char msg[1000] = "";
   mjModel* m = NULL;
-  if (r->def.robot_mjcf) {
-    FILE* f = fopen(r->robot_path, "rb");
-    if (!f) {
-      *st = vd_error_set(err, VD_ERR_IO, r->robot_path, 0, 0, "cannot open: %s", strerror(errno));
-      return NULL;
-    }
-    fclose(f);
-    m = mj_loadXML(r->robot_path, NULL, msg, sizeof msg);
-    if (!m) {
-      // MuJoCo's message spans lines ("XML parse error 7:\nError=... Line number=5: ..."): one
-      // line, with the line number where the parser gives one
-      long line = 0;
-      const char* ln = strstr(msg, "Line number=");
-      if (ln) line = strtol(ln + 12, NULL, 10);
-      for (char* c = msg; *c; c++)
-        if (*c == '\n' || *c == '\r') *c = ' ';
-      size_t n = strlen(msg);
-      while (n && msg[n - 1] == ' ') msg[--n] = 0;
-      *st = vd_error_set(err, VD_ERR_FORMAT, r->robot_path, line > 0 && line < 1000000000 ? (int)line : 0, 0,
-                          "robot MJCF: %s", msg);
-    }
-    return m;
-  }
+  if (r->def.robot_mjcf) return load_mjcf(r->robot_path, "robot MJCF", st, err);
   char xml[4096];
   int len = stage_xml(&r->def, xml, sizeof xml);
   r->vfs = vd_malloc(sizeof *r->vfs);
@@ -395,4 +400,95 @@ vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, v
   mj_forward(r->m, r->d);
   vd_mj_trap_end(&trap);
   return VD_OK;
+}
+
+vd_status vd_render_mjcf_info(const char* path, const char* prefix, vd_mjcf_info* info,
+                              vd_error* err) {
+  memset(info, 0, sizeof *info);
+  vd_mj_trap_install();
+  vd_mj_trap trap;
+  mjModel* volatile m = NULL;
+  mjData* volatile d = NULL;
+  vd_status st = VD_OK;
+  if (VD_MJ_TRY(&trap)) {
+    m = load_mjcf(path, "MJCF", &st, err);
+    if (m) {
+      d = mj_makeData(m);
+      mj_forward(m, d);
+      info->nbody = m->nbody, info->ngeom = m->ngeom, info->nmesh = m->nmesh;
+      info->njoint = m->njnt, info->ncontact = d->ncon;
+      size_t np = prefix ? strlen(prefix) : 0;
+      // bodies named with the prefix, their geoms, and their contacts with other moving parts
+      for (int b = 1; b < m->nbody; b++) {
+        const char* name = mj_id2name(m, mjOBJ_BODY, b);
+        info->nbody_prefix += np && name && !strncmp(name, prefix, np);
+      }
+      for (int g = 0; g < m->ngeom; g++) {
+        const char* name = mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]);
+        info->ngeom_prefix += np && name && !strncmp(name, prefix, np);
+      }
+      for (int c = 0; c < d->ncon; c++) {
+        int b1 = m->geom_bodyid[d->contact[c].geom1], b2 = m->geom_bodyid[d->contact[c].geom2];
+        const char* n1 = mj_id2name(m, mjOBJ_BODY, b1);
+        const char* n2 = mj_id2name(m, mjOBJ_BODY, b2);
+        int p1 = np && n1 && !strncmp(n1, prefix, np), p2 = np && n2 && !strncmp(n2, prefix, np);
+        info->ncontact_prefix += (p1 && !p2 && b2 > 0) || (p2 && !p1 && b1 > 0);
+      }
+    }
+    vd_mj_trap_end(&trap);
+  } else {
+    st = vd_mj_trap_status(&trap, err);
+  }
+  if (d) mj_deleteData(d);
+  if (m) mj_deleteModel(m);
+  return st;
+}
+
+// the path of file relative to folder dir (both absolute, normalised by realpath) into buf
+static void relative_path(const char* dir, const char* file, char* buf, size_t cap) {
+  // the common leading components
+  size_t i = 0, last = 0;
+  while (dir[i] && file[i] && dir[i] == file[i]) {
+    if (dir[i] == '/') last = i;
+    i++;
+  }
+  if (!dir[i] && file[i] == '/') last = i; // dir is a whole prefix of file's folder
+  size_t n = 0;
+  buf[0] = 0;
+  // one "../" per component of dir beyond the common part
+  for (const char* c = dir + last; *c; c++)
+    if (*c == '/' && c[1]) n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "../");
+  if (!dir[last] || !dir[last + 1]) n = 0, buf[0] = 0; // dir ends at the common part
+  snprintf(buf + (n < cap ? n : cap - 1), n < cap ? cap - n : 1, "%s", file + last + 1);
+}
+
+vd_status vd_render_mjcf_scene(const char* scene, const char* const* parts, int nparts,
+                               vd_error* err) {
+  // the scene's folder, absolute
+  char dir[4096], sc[4096];
+  snprintf(sc, sizeof sc, "%s", scene);
+  char* slash = strrchr(sc, '/');
+  const char* folder = slash ? (slash == sc ? "/" : (*slash = 0, sc)) : ".";
+  if (!realpath(folder, dir))
+    return vd_error_set(err, VD_ERR_IO, scene, 0, 0, "cannot open its folder: %s", strerror(errno));
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, scene, err);
+  if (st) return st;
+  fprintf(f.fp, "<mujoco model=\"verdant_scene\">\n");
+  for (int k = 0; k < nparts && !st; k++) {
+    char abs[4096], rel[8192];
+    if (!realpath(parts[k], abs)) {
+      st = vd_error_set(err, VD_ERR_IO, parts[k], 0, 0, "cannot open: %s", strerror(errno));
+      break;
+    }
+    // MuJoCo 2.2.2 puts the scene's folder in front of every included name, absolute or not
+    relative_path(dir, abs, rel, sizeof rel);
+    fprintf(f.fp, "  <include file=\"%s\"/>\n", rel);
+  }
+  fprintf(f.fp, "</mujoco>\n");
+  if (st) {
+    vd_outfile_abort(&f);
+    return st;
+  }
+  return vd_outfile_commit(&f, err);
 }
