@@ -109,6 +109,8 @@ const char* cli_plant_help =
     "      --label ID=NAME   name a label id (repeatable; the file's LABELS come first)\n"
     "      --max-modules N   largest L-string allowed (default 50000000)\n"
     "      --max-ops N       interpreter work allowed: loop iterations + calls (default 1e9)\n"
+    "      --engine E        who runs the file's Python: auto (default: native when the file\n"
+    "                        stays in the native subset, else python), native, python\n"
     "      --curve-step M    curves files: dense sampling step (m; default 0.001)\n"
     "      --curve-connect M curves files: largest branch gap, sigma_connect (m; default 0.01)\n"
     "      --curve-distance M\n"
@@ -185,6 +187,17 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
       return -1;
     }
     o->max_modules = v;
+    return 1;
+  }
+  if (!strcmp(a, "--engine")) {
+    CLI_TAKE();
+    if (!strcmp(val, "auto")) o->engine = VD_LSYS_AUTO;
+    else if (!strcmp(val, "native")) o->engine = VD_LSYS_NATIVE;
+    else if (!strcmp(val, "python")) o->engine = VD_LSYS_PYTHON;
+    else {
+      cli_usage_error(cmd, "--engine expects auto, native or python, got '%s'", val);
+      return -1;
+    }
     return 1;
   }
   if (!strcmp(a, "--max-ops")) {
@@ -307,8 +320,9 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0)
     return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
   vd_lsystem* ls;
-  st = vd_lsys_load(o->path, &ls, err);
+  st = vd_lsys_load_engine(o->path, (vd_lsys_engine)o->engine, &ls, err);
   if (st) return st;
+  info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
   for (int i = 0; !st && i < o->nset; i++) {
     char name[128];
     const char* eq = strchr(o->set[i], '=');

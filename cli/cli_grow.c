@@ -61,6 +61,7 @@ static int print_stats(const vd_plant_spec* p, const cli_grow_info* info) {
   if (!root) return 0;
   vd_plant_stats ps;
   vd_plant_spec_stats(p, &ps);
+  if (info->engine) cJSON_AddStringToObject(root, "engine", info->engine);
   cJSON_AddNumberToObject(root, "modules", (double)info->modules);
   cJSON* mc = cJSON_AddObjectToObject(root, "module_counts");
   for (int k = 0; k < info->nsym; k++)

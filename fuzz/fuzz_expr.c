@@ -31,7 +31,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   int64_t before = vd_alloc_bytes();
   vd_error err = {0};
   vd_lsystem* ls = NULL;
-  if (vd_lsys_parse(text, len, "expr.lpy", &ls, &err) == VD_OK) {
+  if (vd_lsys_parse_engine(text, len, "expr.lpy", VD_LSYS_NATIVE, &ls, &err) == VD_OK) {
     vd_lsys_def def = vd_lsys_def_default();
     def.steps = 1;
     def.max_modules = 20000;

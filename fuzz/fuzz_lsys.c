@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: an .lpy file through the whole L-system path. Parse, derive a few steps
 // under a small module limit, interpret, run the turtle into a plant spec and compile it; every
-// object is freed and the verdant allocator must be back where it started.
+// object is freed and the verdant allocator must be back where it started. The native engine only:
+// fuzz input is never run as Python.
 #include "fuzz_common.h"
 
 int LLVMFuzzerInitialize(int* argc, char*** argv);
@@ -28,7 +29,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   vd_error err = {0};
   vd_lsystem* ls = NULL;
   // parse: any status is fine, only a crash or a leak is a finding
-  if (vd_lsys_parse((const char*)data, size, "fuzz.lpy", &ls, &err) == VD_OK) {
+  if (vd_lsys_parse_engine((const char*)data, size, "fuzz.lpy", VD_LSYS_NATIVE, &ls, &err) == VD_OK) {
     // derive the file's derivation length, stopped after 3 steps, under small work limits
     vd_lsys_def def = vd_lsys_def_default();
     def.steps = -1;

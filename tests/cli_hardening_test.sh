@@ -87,7 +87,7 @@ head -c 2000 "$T/plant.json" >"$T/cut.json"
 expect "grow: syntax error" 2 "$V" grow "$T/syntax.lpy" -o "$T/g.json"
 expect_err "grow: syntax error names file:line:col" "syntax.lpy:3:[0-9]+: "
 no_output "grow: no output after a syntax error" "$T/g.json"
-expect "grow: unsupported construct" 2 "$V" grow "$T/unsupported.lpy" --stats
+expect "grow: unsupported construct" 2 "$V" grow "$T/unsupported.lpy" --engine native --stats
 expect_err "grow: unsupported names file:line:col" "unsupported.lpy:1:[0-9]+: unsupported"
 expect "grow: missing file" 2 "$V" grow "$T/missing.lpy" --stats
 expect_err "grow: missing file named" "missing.lpy: cannot open"

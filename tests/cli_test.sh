@@ -26,8 +26,20 @@ if ls "$T"/bad.json* >/dev/null 2>&1; then bad "no output after error"; else ok 
 
 # unsupported construct names its line
 printf 'x = [1, 2]\nAxiom: A\n' >"$T/unsup.lpy"
-expect "unsupported exit 2" 2 "$V" grow "$T/unsup.lpy" --stats
+expect "unsupported exit 2" 2 "$V" grow "$T/unsup.lpy" --engine native --stats
 expect_err "unsupported message" "unsup.lpy:1:[0-9]+: unsupported"
+# beyond the native subset the Python engine runs the file (auto), reported in --stats
+expect "python engine runs it" 0 "$V" grow "$T/unsup.lpy" --stats
+if grep -q '"engine":.*"python"' "$T/out"; then ok "stats name the python engine"; else bad "stats name the python engine"; fi
+printf 'Axiom: A\nproduction:\nA --> AB\n' >"$T/nat.lpy"
+expect "native file, native engine" 0 "$V" grow "$T/nat.lpy" -n 3 --stats
+if grep -q '"engine":.*"native"' "$T/out"; then ok "stats name the native engine"; else bad "stats name the native engine"; fi
+expect "forced python engine" 0 "$V" grow "$T/unsup.lpy" --engine python --stats
+expect "bad --engine" 2 "$V" grow "$T/unsup.lpy" --engine perl --stats
+# the README's Python engine examples
+expect "python engine example" 0 "$V" grow "$SRC/data/python_bud.lpy" --stats
+if grep -q '"engine":.*"python"' "$T/out" && grep -q '"fruit":.*1' "$T/out"; then ok "python example stats"; else bad "python example stats"; fi
+expect "forced python engine on tree.lpy" 0 "$V" grow "$SRC/data/tree.lpy" --engine python --stats
 
 # limits: a clear error, not an out-of-memory death
 printf 'Axiom: A\nproduction:\nA --> AA\n' >"$T/exp.lpy"

@@ -7,11 +7,11 @@
 #include "test.h"
 #include "verdant/lsys.h"
 
-// parse and derive src (steps -1 = the file's), format the result into buf
+// parse (the native engine) and derive src (steps -1 = the file's), format the result into buf
 static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, vd_error* e) {
   vd_lsystem* ls;
   buf[0] = 0;
-  vd_status st = vd_lsys_parse(src, strlen(src), "t.lpy", &ls, e);
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", VD_LSYS_NATIVE, &ls, e);
   if (st) return st;
   vd_lsys_def d = vd_lsys_def_default();
   d.steps = steps;

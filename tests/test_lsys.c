@@ -6,11 +6,11 @@
 #include "test.h"
 #include "verdant/lsys.h"
 
-// derive `src` with steps (-1 = file's) and seed; return the formatted string in buf
+// derive `src` with the native engine, steps (-1 = file's) and seed; return the formatted string in buf
 static vd_status derive_str(const char* src, int steps, uint64_t seed, char* buf, size_t cap, vd_error* e) {
   vd_lsystem* ls;
   buf[0] = 0;
-  vd_status st = vd_lsys_parse(src, strlen(src), "t.lpy", &ls, e);
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", VD_LSYS_NATIVE, &ls, e);
   if (st) return st;
   vd_lsys_def d = vd_lsys_def_default();
   d.steps = steps;
@@ -408,7 +408,7 @@ TEST(lsys, binary_and_empty_input) {
   CHECK_STATUS(vd_lsys_parse(bin, sizeof bin, "b", &ls, &e), VD_ERR_SYNTAX, e);
   CHECK(ls == NULL);
   vd_error e2 = {0};
-  CHECK_STATUS(vd_lsys_parse("", 0, "empty", &ls, &e2), VD_ERR_SYNTAX, e2);
+  CHECK_STATUS(vd_lsys_parse_engine("", 0, "empty", VD_LSYS_NATIVE, &ls, &e2), VD_ERR_SYNTAX, e2);
   vd_error e3 = {0};
   CHECK_STATUS(vd_lsys_load("/nonexistent.lpy", &ls, &e3), VD_ERR_IO, e3);
 }

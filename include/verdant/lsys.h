@@ -161,11 +161,35 @@ typedef struct vd_lsys_def {
 // Default derivation settings (see vd_lsys_def).
 vd_lsys_def vd_lsys_def_default(void);
 
-// Parse L-Py text; name is the file name used in errors (Nullable).
+// Parse L-Py text; name is the file name used in errors (Nullable). The engine is chosen
+// automatically (VD_LSYS_AUTO).
 vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsystem** out,
                         vd_error* err);
-// Read and parse an .lpy file.
+// Read and parse an .lpy file (engine chosen automatically).
 vd_status vd_lsys_load(const char* path, vd_lsystem** out, vd_error* err);
+
+// Which engine runs a file's Python: the native subset interpreter (fast) or embedded CPython
+// (any Python, PlantGL-like objects). Both share the parser's rules, the derivation, the
+// L-string layout and the turtle.
+typedef enum vd_lsys_engine {
+  VD_LSYS_AUTO = 0,  // native when the whole file is in the native subset, else Python
+  VD_LSYS_NATIVE,    // the native subset only (unsupported constructs are errors)
+  VD_LSYS_PYTHON     // embedded CPython for all of the file's Python
+} vd_lsys_engine;
+// Parse with a given engine (VD_LSYS_AUTO: native, then Python when the native parse stops at
+// a construct beyond its subset).
+vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name,
+                               vd_lsys_engine engine, vd_lsystem** out, vd_error* err);
+// Read and parse an .lpy file with a given engine.
+vd_status vd_lsys_load_engine(const char* path, vd_lsys_engine engine, vd_lsystem** out,
+                              vd_error* err);
+// The engine that runs ls (VD_LSYS_NATIVE or VD_LSYS_PYTHON).
+vd_lsys_engine vd_lsys_get_engine(const vd_lsystem* ls);
+// "auto", "native" or "python".
+const char* vd_lsys_engine_name(vd_lsys_engine e);
+// 1 when the embedded CPython engine can start in this process (its standard library found),
+// else 0 with the reason in why (Nullable, cap bytes).
+int vd_lsys_python_available(char* why, size_t cap);
 // Free an lsystem (NULL is fine).
 void vd_lsys_destroy(vd_lsystem* ls);
 // Replace global `name` by the value of the Python expression `text` (--set NAME=TEXT).
@@ -180,6 +204,15 @@ int vd_lsys_derivation_length(const vd_lsystem* ls);
 // `derivation length` (or def->steps) production steps with decomposition; the result is the
 // derived string (before interpretation) in *out, which is overwritten.
 vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err);
+// Derive step by step (growth loops): begin resets the globals (with --set overrides), runs the
+// Start hook and puts the axiom into *out; each vd_lsys_derive_step then applies one production
+// step with decomposition (StartEach/EndEach hooks) to s in place and sets s->src[j] to the
+// index, in the string before the step, of the module that module j came from, so a caller can
+// follow each module through the steps. def->steps is not read; the same seed gives the same
+// strings as vd_lsys_derive. VD_ERR_VALUE after Stop() was called.
+vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err);
+// One derivation step of a run started by vd_lsys_derive_begin (see there).
+vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* s, vd_error* err);
 // Apply interpretation (homomorphism) rules to a derived string; out->src maps each module back
 // to its module in `in`.
 vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lstring* in,
@@ -195,6 +228,9 @@ char* vd_lsys_format(const vd_lsystem* ls, const vd_lstring* s, char* buf, size_
 // Parse an L-string written in the file's module names, with constant parameters.
 vd_status vd_lsys_parse_lstring(vd_lsystem* ls, const char* text, vd_lstring* out, vd_error* err);
 
+// Python objects inside L-strings (the Python engine's lists, vectors, curves...) are NaN-boxed
+// handles: 1 when v is one.
+int vd_lsys_value_is_obj(double v);
 // Strings inside L-strings are NaN-boxed: test and extract the string id of a value.
 int vd_lsys_value_is_str(double v);
 // String text of a NaN-boxed value, or NULL when it is not a string of this lsystem.

@@ -43,6 +43,7 @@ typedef struct grow_out {
   int64_t* sym_count;    // per symbol (nsym), vd_malloc
   char (*sym_name)[64];  // per symbol (nsym), vd_malloc
   double seconds_derive, seconds_turtle;
+  const char* engine;    // the engine that ran an .lpy ("native", "python"), NULL for files
 } grow_out;
 
 static void grow_out_free(grow_out* o) {
@@ -97,6 +98,7 @@ static vd_status grow_json(const grow_args* a, const char* text, size_t len, con
 static vd_status grow_lsys(const grow_args* a, vd_lsystem* ls, const char* name, grow_out* out,
                            vd_error* err) {
   vd_status st = VD_OK;
+  out->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
   for (int i = 0; !st && i < a->nset; i++) st = vd_lsys_set_global(ls, a->set_name[i], a->set_value[i], err);
   if (st) return st;
   out->spec = vd_plant_spec_create();
@@ -186,8 +188,9 @@ static PyObject* grow_info(const grow_out* o, int lsys) {
     Py_XDECREF(v);
   }
   if (!counts) return NULL;
-  return Py_BuildValue("{s:L,s:N,s:{s:d,s:d}}", "modules", (long long)o->modules, "module_counts",
-                       counts, "seconds", "derive", o->seconds_derive, "turtle", o->seconds_turtle);
+  return Py_BuildValue("{s:s,s:L,s:N,s:{s:d,s:d}}", "engine", o->engine ? o->engine : "native", "modules",
+                       (long long)o->modules, "module_counts", counts, "seconds", "derive", o->seconds_derive,
+                       "turtle", o->seconds_turtle);
 }
 
 // set= values: str as written, numbers, booleans, lists and tuples by their repr

@@ -118,7 +118,7 @@ class Plant(_verdant.Plant):
 
     @property
     def stats(self):
-        """The summary of `verdant grow --stats`: modules, module_counts, nodes, segments,
+        """The summary of `verdant grow --stats`: engine (.lpy only), modules, module_counts, nodes, segments,
         spheres, leaves, meshes, instances, labels (organ instances per label name), bbox_min,
         bbox_max (m), total_length (m)."""
         import numpy as np
@@ -132,6 +132,7 @@ class Plant(_verdant.Plant):
         per_label = np.unique(np.unique(keys) >> 32, return_counts=True)
         count = dict(zip(per_label[0].tolist(), per_label[1].tolist()))
         return {
+            **({"engine": info["engine"]} if "engine" in info else {}),
             "modules": info.get("modules", 0),
             "module_counts": info.get("module_counts", {}),
             "nodes": geo["nodes"], "segments": geo["segments"], "spheres": geo["spheres"],

@@ -165,6 +165,7 @@ static const char* type_name(value v) {
     case V_FUNC: return "function";
     case V_BUILTIN: return "builtin function";
     case V_NS: return "module";
+    case V_OBJ: return "object";
     default: return "undefined";
   }
 }
@@ -221,6 +222,9 @@ vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col
 value param_to_value(double d) {
   int sid = lsys_unbox_str(d);
   if (sid >= 0) return (value){V_STR, sid};
+  uint32_t oid;
+  unsigned epoch;
+  if (isnan(d) && lsys_unbox_obj(d, &oid, &epoch)) return (value){V_OBJ, oid};
   if (d == floor(d) && fabs(d) < 9007199254740992.0) return v_int(d);
   return v_num(d);
 }
@@ -601,6 +605,9 @@ vd_status vm_eval(vd_lsystem* ls, const expr* e, value* frame, value* out) {
       if (vm_eval(ls, e->b, frame, &a)) return ls->err->status;
       return vm_eval(ls, value_truthy(a) ? e->a : e->c, frame, out);
     case E_CALL: return eval_call(ls, e, frame, out);
+    case E_PYSRC:
+      if (ls->py) return lsys_py_eval(ls, e, out);
+      return vm_error(ls, VD_ERR_UNSUPPORTED, e->line, e->col, "unsupported: Python source outside the Python engine");
     case E_ATTR: {
       if (vm_eval(ls, e->a, frame, &a)) return ls->err->status;
       const char* attr = ls->str[e->slot];

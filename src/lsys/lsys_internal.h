@@ -18,7 +18,8 @@ typedef enum vtype {
   V_FUNC,     // n = user function index
   V_BUILTIN,  // n = builtin id
   V_NS,       // n = namespace id (NS_MATH, NS_RANDOM)
-  V_UNDEF     // a global slot that has no value yet
+  V_UNDEF,    // a global slot that has no value yet
+  V_OBJ       // n = a boxed Python object handle (the Python engine's object table)
 } vtype;
 
 typedef struct value {
@@ -52,7 +53,8 @@ typedef enum eop {
   E_COND,      // a if b else c: a = then, b = cond, c = else
   E_CALL,      // fn(args): a = callee expression
   E_BUILTIN,   // direct builtin call: slot = builtin id
-  E_ATTR       // namespace attribute (math.pi): k holds the resolved value
+  E_ATTR,      // namespace attribute (math.pi): k holds the resolved value
+  E_PYSRC      // Python engine: source text of an expression, k = its string id (V_STR)
 } eop;
 
 enum { CMP_LT, CMP_LE, CMP_GT, CMP_GE, CMP_EQ, CMP_NE };
@@ -178,6 +180,7 @@ typedef struct rule {
   int group;      // rule group (0 = always active)
   int is_static;  // -static-> / @static: L-Py evaluates the successor once
   int line;
+  int pyfn;       // Python engine: index of the rule's function (lsys_py.c), -1 native
 } rule;
 
 // A consider:/ignore: filter: the symbols listed, and whether they are ignored or the only
@@ -210,12 +213,27 @@ typedef struct global_def {
   int has_override;
 } global_def;
 
+// A logical line of the file: physical lines joined while brackets are open (parser, Python engine).
+typedef struct lsys_line {
+  const char* s;  // text without the indentation
+  int len;
+  int lineno;     // 1-based physical line where it starts
+  int col0;       // 1-based column of s[0]
+  int indent;     // indentation width (tabs to multiples of 8)
+  int blank;      // only whitespace or a comment
+  int lastline;   // physical line where it ends
+} lsys_line;
+
+// The engines that run a file's Python (vd_lsys_engine without AUTO).
+typedef struct lsys_py lsys_py;
+
 typedef struct toplevel {
   stmt* body;  // top-level statements in file order
 } toplevel;
 
 struct vd_lsystem {
   char file[256];
+  lsys_py* py;             // Python engine state (NULL for the native engine)
   vd_arena arena;          // all parse structures
   symtab syms;
   // strings
@@ -237,6 +255,7 @@ struct vd_lsystem {
   tmpl* axiom;             // line axiom (or NULL)
   stmt* axiom_body;        // functional axiom (or NULL)
   int axiom_nlocal;
+  int engine;              // VD_LSYS_NATIVE or VD_LSYS_PYTHON
   expr* derivation_length; // NULL = 1
   expr* max_depth_expr[SEC_COUNT];  // `maximum depth:` of decomposition / interpretation (NULL = 1)
   int max_depth[SEC_COUNT];  // its value in this run
@@ -284,6 +303,7 @@ struct vd_lsystem {
   int frame_displayed;     // the step is the last one (L-Py draws a frame then)
   int discard_requested;   // DiscardNewString(): the step's result is dropped
   int call_depth;
+  int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
   int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
@@ -306,6 +326,9 @@ int str_intern(vd_lsystem* ls, const char* s, int len);
 vd_status str_intern_error(vd_lsystem* ls, int id, int line, int col);
 double lsys_box_str(int id);
 int lsys_unbox_str(double v);
+// Python engine objects in L-strings: NaN-boxed handles (slot id and epoch) into lsys_py's table.
+double lsys_box_obj(uint32_t id, unsigned epoch);
+int lsys_unbox_obj(double v, uint32_t* id, unsigned* epoch);
 int global_slot(vd_lsystem* ls, const char* name, int len, int create);
 
 // lstring building (int64 capacities, max_modules limit)
@@ -317,6 +340,9 @@ int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src);
 
 // parser
 vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len);
+// parse text with one engine (VD_LSYS_NATIVE or VD_LSYS_PYTHON) into a new lsystem
+vd_status lsys_parse_with(const char* text, size_t len, const char* name, int engine, vd_lsystem** out,
+                          vd_error* err);
 expr* lsys_parse_expr_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 tmpl* lsys_parse_tmpl_text(vd_lsystem* ls, const char* text, int len, int line, int col);
 
@@ -410,5 +436,54 @@ value ns_constant(int ns, const char* name, int len, int* found);
 int value_truthy(value v);
 vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col);
 value param_to_value(double d);
+
+// ---------------------------------------------------------------------------------------------
+// the Python engine (lsys_py.c: CPython bridge and run time; lsys_pysrc.c: the file's Python
+// source). Only these two files include Python.h. Every function below is a no-op or an
+// error for the native engine (ls->py == NULL).
+
+// parse time: the parser hands over the Python parts of the file
+vd_status lsys_py_parse_begin(vd_lsystem* ls, const char* text, size_t len);
+vd_status lsys_py_parse_end(vd_lsystem* ls, size_t init_at);
+// the parameters of a template module, s[*pos] = '(': each an E_PYSRC expression (at most
+// max) into params; *pos moves after the ')'. Returns the count, or -1 with the error set.
+int lsys_py_params(vd_lsystem* ls, const char* s, int len, int* pos, int lineno, int col0,
+                   expr** params, int max);
+// an expression as Python source (E_PYSRC), a trailing comment dropped; NULL with the error set
+expr* lsys_py_expr(vd_lsystem* ls, const char* s, int len, int lineno, int col);
+// evaluate an E_PYSRC expression in the current run's namespace (a number, bool or str)
+vd_status lsys_py_eval(vd_lsystem* ls, const expr* e, value* out);
+// a top-level statement (with its indented block) starting at lines[*li]; advances *li
+vd_status lsys_py_toplevel(vd_lsystem* ls, const lsys_line* lines, int nline, int* li);
+// the body of rule r whose header is lines[*li]: successor r->succ, or the Python after the
+// header's ':' (body_at) and the indented lines below; names: the pattern variables in slot order
+vd_status lsys_py_rule(vd_lsystem* ls, rule* r, const char* const* names, const int* lens,
+                       int nnames, const lsys_line* lines, int nline, int* li, int body_at);
+// the axiom: a template, or the indented block below lines[*li] (advances *li)
+vd_status lsys_py_axiom(vd_lsystem* ls, const tmpl* t, const lsys_line* lines, int nline, int* li);
+// `derivation length:` text
+vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno);
+
+// run time
+void lsys_py_free(vd_lsystem* ls);
+// take the engine (process-wide lock and the GIL) for ls; lsys_py_leave gives it back
+void lsys_py_enter(vd_lsystem* ls);
+void lsys_py_leave(vd_lsystem* ls);
+// run the prologue (trailer, top-level code) in a fresh namespace, random seeded with seed
+vd_status lsys_py_run_toplevel(vd_lsystem* ls, uint64_t seed);
+vd_status lsys_py_dlength_eval(vd_lsystem* ls, int* steps);
+vd_status lsys_py_emit_axiom(vd_lsystem* ls, vm_out* out);
+vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, vm_out* out);
+// call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
+// the current string (an End hook may return a new one). Missing hooks are fine.
+vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
+// drop objects that no module of s refers to any more (after a step)
+void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
+// release every object (a new derivation starts)
+void lsys_py_reset_objects(vd_lsystem* ls);
+vd_status lsys_py_set_global(vd_lsystem* ls, const char* name, const char* text);
+vd_status lsys_py_get_global(vd_lsystem* ls, const char* name, double* out);
+// repr() of an object parameter into buf (cap bytes); "None" for a stale handle
+void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 
 #endif

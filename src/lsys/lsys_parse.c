@@ -19,14 +19,7 @@
 // ---------------------------------------------------------------------------------------------
 // logical lines
 
-typedef struct pline {
-  const char* s;  // text without the indentation
-  int len;
-  int lineno;     // 1-based physical line where it starts
-  int col0;       // 1-based column of s[0]
-  int indent;     // indentation width (tabs to multiples of 8)
-  int blank;      // only whitespace or a comment
-} pline;
+typedef lsys_line pline;  // lsys_internal.h: the Python engine reads them too
 
 typedef struct parser {
   vd_lsystem* ls;
@@ -64,18 +57,38 @@ static int word_at(const char* s, int len, int i, const char* w) {
   return i + n == len || !(isalnum((unsigned char)s[i + n]) || s[i + n] == '_');
 }
 
+// the end of a triple-quoted string closed by three q from s[i]: the index after it, or -1
+static int triple_end(const char* s, int len, int i, char q) {
+  for (; i + 2 < len; i++) {
+    if (s[i] == '\\') {
+      i++;
+      continue;
+    }
+    if (s[i] == q && s[i + 1] == q && s[i + 2] == q) return i + 3;
+  }
+  return -1;
+}
+
 // bracket balance change of a physical line, ignoring strings and comments. In L-strings
 // (after produce/nproduce, after -->, on Axiom:/ignore:/consider: lines) only parentheses
 // count: [ ] { } are modules there, and a trailing \ is the RollR module, not a continuation.
-static int bracket_delta(const char* s, int len, int* backslash, int header) {
+// *tq: the quote of a triple-quoted string open at the start of the line (0 if none), and at
+// its end (Python docstrings span lines).
+static int bracket_delta(const char* s, int len, int* backslash, int header, char* tq) {
   int d = 0;
   char q = 0;
   int lstr = header;  // a rule header: brackets are modules in its patterns
   *backslash = 0;
+  int start = 0;
+  if (*tq) {
+    start = triple_end(s, len, 0, *tq);
+    if (start < 0) return 0;  // the whole line is inside the string
+    *tq = 0;
+  }
   static const char* lstr_lines[] = {"Axiom:", "axiom:", "ignore:", "consider:"};
   for (size_t k = 0; k < sizeof lstr_lines / sizeof lstr_lines[0]; k++)
     if (len >= (int)strlen(lstr_lines[k]) && memcmp(s, lstr_lines[k], strlen(lstr_lines[k])) == 0) lstr = 1;
-  for (int i = 0; i < len; i++) {
+  for (int i = start; i < len; i++) {
     char c = s[i];
     if (q) {
       if (c == '\\') i++;
@@ -86,6 +99,15 @@ static int bracket_delta(const char* s, int len, int* backslash, int header) {
     if (!lstr && (word_at(s, len, i, "produce") || word_at(s, len, i, "nproduce") ||
                   (i + 3 <= len && memcmp(s + i, "-->", 3) == 0)))
       lstr = 1;
+    if ((c == '\'' || c == '"') && i + 2 < len && s[i + 1] == c && s[i + 2] == c) {
+      int e = triple_end(s, len, i + 3, c);
+      if (e < 0) {
+        *tq = c;
+        return d;
+      }
+      i = e - 1;
+      continue;
+    }
     if (c == '\'' || c == '"') q = c;
     else if (c == '(' || (!lstr && (c == '[' || c == '{'))) d++;
     else if (c == ')' || (!lstr && (c == ']' || c == '}'))) d--;
@@ -132,7 +154,7 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
       *init_at = start;
       break;
     }
-    pline L = {s + k, n - k, lineno, k + 1, ind, is_blank(s + k, n - k)};
+    pline L = {s + k, n - k, lineno, k + 1, ind, is_blank(s + k, n - k), lineno};
     // rule sections: their header lines (at the section's rule indentation) hold patterns,
     // where [ ] { } are modules; the indented bodies are Python
     int header = 0;
@@ -157,10 +179,12 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
         header = ind <= rule_indent;
       }
     }
-    // join continuation lines while brackets are open or the line ends with a backslash
+    // join continuation lines while brackets are open, the line ends with a backslash or a
+    // triple-quoted string goes on
     int bs = 0;
-    int depth = L.blank ? 0 : bracket_delta(L.s, L.len, &bs, header);
-    if (depth > 0 || bs) {
+    char tq = 0;
+    int depth = L.blank ? 0 : bracket_delta(L.s, L.len, &bs, header, &tq);
+    if (depth > 0 || bs || tq) {
       // copy into the arena, joining with spaces
       size_t cap = (size_t)L.len + 1;
       char* buf = NULL;
@@ -173,14 +197,14 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
         while (blen > 0 && isspace((unsigned char)buf[blen - 1])) blen--;
         blen--;  // drop the backslash
       }
-      while ((depth > 0 || bs) && pos < len) {
+      while ((depth > 0 || bs || tq) && pos < len) {
         size_t s2 = pos;
         while (pos < len && text[pos] != '\n') pos++;
         size_t e2 = pos;
         if (pos < len) pos++;
         lineno++;
         if (e2 > s2 && text[e2 - 1] == '\r') e2--;
-        int d2 = bracket_delta(text + s2, (int)(e2 - s2), &bs, header);
+        int d2 = bracket_delta(text + s2, (int)(e2 - s2), &bs, header, &tq);
         depth += d2;
         // strip a trailing comment from the piece before joining
         size_t piece = e2 - s2;
@@ -211,11 +235,14 @@ static vd_status split_lines(parser* P, const char* text, size_t len, size_t* in
         }
         buf = nb;
       }
+      if (tq)
+        return perr(ls, VD_ERR_SYNTAX, L.lineno, L.col0, "unterminated triple-quoted string");
       if (depth > 0)
         return perr(ls, VD_ERR_SYNTAX, L.lineno, L.col0, "unclosed bracket at end of file");
       L.s = buf;
       L.len = (int)blen;
     }
+    L.lastline = lineno;
     if (!vd_grow((void**)&P->lines, &P->capline, P->nline + 1, sizeof(pline)))
       return perr(ls, VD_ERR_NOMEM, lineno, 1, "out of memory");
     P->lines[P->nline++] = L;
@@ -936,7 +963,18 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     m->line = lineno;
     m->col = mcol;
     if (sym == VD_SYM_CUT) t->has_cut = 1;
-    if (pos < len && s[pos] == '(') {
+    if (pos < len && s[pos] == '(' && ls->engine == VD_LSYS_PYTHON) {
+      // the Python engine: parameters stay Python source for CPython
+      expr* params[64];
+      int np = lsys_py_params(ls, s, len, &pos, lineno, col0, params, 64);
+      if (np < 0) goto fail;
+      m->nparam = np;
+      if (np) {
+        m->param = aalloc(ls, sizeof(expr*) * (size_t)np);
+        if (!m->param) goto fail;
+        memcpy(m->param, params, sizeof(expr*) * (size_t)np);
+      }
+    } else if (pos < len && s[pos] == '(') {
       lexer L;
       lx_init(&L, ls, s, len, lineno, col0, pos + 1);
       if (lx_next(&L)) goto fail;
@@ -2089,6 +2127,19 @@ static vd_status parse_rule(parser* P, int* li, int section, int group) {
       colon = m + 6;
     }
   }
+  if (ls->engine == VD_LSYS_PYTHON) {
+    // the Python engine: the successor or the body becomes a Python function of the pattern
+    // variables
+    if (arrow >= 0) {
+      r->succ = parse_tmpl(ls, &sc, s, len, arrow + arrow_len, ln->lineno, ln->col0);
+      if (!r->succ) goto fail;
+    }
+    st = lsys_py_rule(ls, r, sc.names, sc.lens, sc.n, P->lines, P->nline, li, arrow >= 0 ? -1 : colon + 1);
+    if (st) goto done;
+    r->nlocal = sc.n;
+    st = add_rule(ls, r);
+    goto done;
+  }
   if (arrow >= 0) {
     r->succ = parse_tmpl(ls, &sc, s, len, arrow + arrow_len, ln->lineno, ln->col0);
     if (!r->succ) goto fail;
@@ -2228,6 +2279,18 @@ static vd_status parse_toplevel_stmt(parser* P, int* li) {
   vd_lsystem* ls = P->ls;
   pline* ln = &P->lines[*li];
   int a;
+  if (ls->engine == VD_LSYS_PYTHON) {
+    // the Python engine: CPython runs the statement; a literal LABELS dict is read here too
+    if (starts_kw(ln, "LABELS", &a)) {
+      int p = a;
+      while (p < ln->len && is_space(ln->s[p])) p++;
+      if (p < ln->len && ln->s[p] == '=' && (p + 1 >= ln->len || ln->s[p + 1] != '=')) {
+        vd_error keep = *ls->err;
+        if (parse_labels_dict(P, ln, p + 1)) *ls->err = keep;  // not a literal dict: Python's
+      }
+    }
+    return lsys_py_toplevel(ls, P->lines, P->nline, li);
+  }
   if (starts_kw(ln, "import ", &a) || starts_kw(ln, "from ", &a)) {
     vd_status st = parse_import(P, ln);
     (*li)++;
@@ -2468,6 +2531,7 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
   size_t init_at;
   vd_status st = split_lines(&P, text, len, &init_at);
   if (st) goto done;
+  if (ls->engine == VD_LSYS_PYTHON && (st = lsys_py_parse_begin(ls, text, len))) goto done;
   int section = -1, group = 0, rule_indent = -1;
   int li = 0;
   while (li < P.nline) {
@@ -2479,7 +2543,11 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
     int a;
     // keyword lines
     if (starts_kw_colon(ln, "Axiom", &a) || starts_kw_colon(ln, "axiom", &a)) {
-      if (!rest_blank(ln, a)) {
+      if (ls->engine == VD_LSYS_PYTHON) {
+        tmpl* t = NULL;
+        if (!rest_blank(ln, a) && !(t = parse_tmpl(ls, NULL, ln->s, ln->len, a, ln->lineno, ln->col0))) goto fail;
+        if ((st = lsys_py_axiom(ls, t, P.lines, P.nline, &li))) goto done;
+      } else if (!rest_blank(ln, a)) {
         ls->axiom = parse_tmpl(ls, NULL, ln->s, ln->len, a, ln->lineno, ln->col0);
         if (!ls->axiom) goto fail;
         li++;
@@ -2505,6 +2573,11 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
       section = -1;
       continue;
     }
+    if (starts_kw_colon(ln, "derivation length", &a) && ls->engine == VD_LSYS_PYTHON) {
+      if ((st = lsys_py_dlength(ls, ln->s + a, ln->len - a, ln->lineno))) goto done;
+      li++;
+      continue;
+    }
     if (starts_kw_colon(ln, "derivation length", &a)) {
       ls->derivation_length = lsys_parse_expr_text(ls, ln->s + a, ln->len - a, ln->lineno, ln->col0 + a);
       if (!ls->derivation_length) goto fail;
@@ -2527,7 +2600,9 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
         goto done;
       }
       // an expression (L-Py evaluates it after the top-level code): `maximum depth: N`
-      ls->max_depth_expr[section] = lsys_parse_expr_text(ls, ln->s + a, ln->len - a, ln->lineno, ln->col0 + a);
+      ls->max_depth_expr[section] = ls->engine == VD_LSYS_PYTHON
+                                        ? lsys_py_expr(ls, ln->s + a, ln->len - a, ln->lineno, ln->col0 + a)
+                                        : lsys_parse_expr_text(ls, ln->s + a, ln->len - a, ln->lineno, ln->col0 + a);
       if (!ls->max_depth_expr[section]) goto fail;
       li++;
       continue;
@@ -2593,6 +2668,16 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
       goto done;
     }
     if ((st = parse_toplevel_stmt(&P, &li))) goto done;
+  }
+  if (ls->engine == VD_LSYS_PYTHON) {
+    // the trailer runs as Python; its L-system options (matching, early return) apply here too
+    if (init_at < len) {
+      int line0 = 1;
+      for (size_t k = 0; k < init_at; k++) line0 += text[k] == '\n';
+      if ((st = parse_options(ls, text + init_at, len - init_at, line0))) goto done;
+    }
+    st = lsys_py_parse_end(ls, init_at);
+    goto done;
   }
   if (!ls->axiom && !ls->axiom_body) {
     st = perr(ls, VD_ERR_SYNTAX, P.nline ? P.lines[P.nline - 1].lineno : 1, 1, "the file has no 'Axiom:'");

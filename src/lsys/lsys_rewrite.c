@@ -396,7 +396,9 @@ static inline __attribute__((always_inline)) int apply_try(vd_lsystem* ls, const
     if (ok) {
       int64_t mark = out->n;
       vm_out vo = {out, in->src ? in->src[b] : b, max_modules, 0, 0};
-      if (r->succ) {
+      if (ls->py) {
+        *st = lsys_py_apply_rule(ls, r, frame, &vo);
+      } else if (r->succ) {
         *st = vm_emit_tmpl(ls, r->succ, frame, &vo);
         vo.produced = 1;
       } else {
@@ -502,7 +504,9 @@ static vd_status step_simple(vd_lsystem* ls, int sec, const lsys_mctx* M, vd_lst
           vo.src = src;
           vo.produced = vo.nproduced = 0;
           vd_status st;
-          if (r->succ) {
+          if (ls->py) {
+            st = lsys_py_apply_rule(ls, r, frame, &vo);
+          } else if (r->succ) {
             st = vm_emit_tmpl(ls, r->succ, frame, &vo);
             vo.produced = 1;
           } else {

@@ -127,6 +127,31 @@ int lsys_unbox_str(double v) {
   return (int)(bits & 0xffffffffu);
 }
 
+// Python engine objects: tag, 8-bit epoch, 32-bit slot
+#define OBJ_TAG 0x7ffc5e0000000000ull
+
+double lsys_box_obj(uint32_t id, unsigned epoch) {
+  uint64_t bits = OBJ_TAG | ((uint64_t)(epoch & 0xffu) << 32) | (uint64_t)id;
+  double d;
+  memcpy(&d, &bits, sizeof d);
+  return d;
+}
+
+int lsys_unbox_obj(double v, uint32_t* id, unsigned* epoch) {
+  uint64_t bits;
+  memcpy(&bits, &v, sizeof bits);
+  if ((bits & STR_MASK) != OBJ_TAG) return 0;
+  *id = (uint32_t)(bits & 0xffffffffu);
+  *epoch = (unsigned)((bits >> 32) & 0xffu);
+  return 1;
+}
+
+int vd_lsys_value_is_obj(double v) {
+  uint32_t id;
+  unsigned e;
+  return lsys_unbox_obj(v, &id, &e);
+}
+
 int vd_lsys_value_is_str(double v) { return lsys_unbox_str(v) >= 0; }
 
 const char* vd_lsys_value_str(const vd_lsystem* ls, double v) {
@@ -306,10 +331,12 @@ char* vd_lsys_format(const vd_lsystem* ls, const vd_lstring* s, char* buf, size_
     int np = vd_lstring_nparam(s, i);
     for (int k = 0; k < np && n < cap; k++) {
       double v = s->val[s->par[i] + k];
-      char num[64];
+      char num[256];
       const char* str = vd_lsys_value_str(ls, v);
       if (str)
         snprintf(num, sizeof num, "'%s'", str);
+      else if (ls && ls->py && vd_lsys_value_is_obj(v))
+        lsys_py_repr(ls, v, num, sizeof num);
       else
         fmt_num(v, num, sizeof num);
       n += (size_t)snprintf(buf + n, cap - n, "%s%s%s", k == 0 ? "(" : ",", num, k == np - 1 ? ")" : "");

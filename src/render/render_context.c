@@ -109,37 +109,14 @@ static int stage_xml(const vd_render_def* d, char* buf, size_t cap) {
                : "");
 }
 
-// load an MJCF file (under a trap); NULL with *st and err set on failure, the message on one
-// line with the line number where MuJoCo's parser gives one
-static mjModel* load_mjcf(const char* path, const char* what, vd_status* st, vd_error* err) {
-  char msg[1000] = "";
-  FILE* f = fopen(path, "rb");
-  if (!f) {
-    *st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot open: %s", strerror(errno));
-    return NULL;
-  }
-  fclose(f);
-  mjModel* m = mj_loadXML(path, NULL, msg, sizeof msg);
-  if (!m) {
-    // MuJoCo's message spans lines ("XML parse error 7:\nError=... Line number=5: ...")
-    long line = 0;
-    const char* ln = strstr(msg, "Line number=");
-    if (ln) line = strtol(ln + 12, NULL, 10);
-    for (char* c = msg; *c; c++)
-      if (*c == '\n' || *c == '\r') *c = ' ';
-    size_t n = strlen(msg);
-    while (n && msg[n - 1] == ' ') msg[--n] = 0;
-    *st = vd_error_set(err, VD_ERR_FORMAT, path, line > 0 && line < 1000000000 ? (int)line : 0, 0,
-                       "%s: %s", what, msg);
-  }
-  return m;
-}
-
 // load the stage from memory, or the robot from its file; NULL with *st and err set on failure
 static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
   char msg[1000] = "";
   mjModel* m = NULL;
-  if (r->def.robot_mjcf) return load_mjcf(r->robot_path, "robot MJCF", st, err);
+  if (r->def.robot_mjcf) {
+    *st = vd_mj_load_xml(r->robot_path, "robot MJCF", &m, err);
+    return m;
+  }
   char xml[4096];
   int len = stage_xml(&r->def, xml, sizeof xml);
   r->vfs = vd_malloc(sizeof *r->vfs);
@@ -411,7 +388,9 @@ vd_status vd_render_mjcf_info(const char* path, const char* prefix, vd_mjcf_info
   mjData* volatile d = NULL;
   vd_status st = VD_OK;
   if (VD_MJ_TRY(&trap)) {
-    m = load_mjcf(path, "MJCF", &st, err);
+    mjModel* loaded = NULL;
+    st = vd_mj_load_xml(path, "MJCF", &loaded, err);
+    m = loaded;
     if (m) {
       d = mj_makeData(m);
       mj_forward(m, d);

@@ -1,0 +1,350 @@
+// SPDX-License-Identifier: MIT
+// pyengine: the Python engine (embedded CPython) on small .lpy texts of our own: classes,
+// lists and numpy values as module parameters, seeded random, hooks, errors at their lines,
+// --set, the automatic engine choice, and the same strings as the native engine on the
+// native subset.
+#include <pthread.h>
+#include <stdlib.h>
+
+#include "test.h"
+#include "verdant/lsys.h"
+
+// derive src with an engine; the formatted string in buf
+static vd_status derive_with(const char* src, vd_lsys_engine eng, int steps, uint64_t seed, char* buf, size_t cap,
+                             vd_error* e) {
+  vd_lsystem* ls;
+  buf[0] = 0;
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "py.lpy", eng, &ls, e);
+  if (st) return st;
+  vd_lsys_def d = vd_lsys_def_default();
+  d.steps = steps;
+  d.seed = seed;
+  d.max_ops = 100000000;  // runaway code stops after 10 s
+  vd_lstring s = vd_lstring_empty();
+  st = vd_lsys_derive(ls, &d, &s, e);
+  if (!st) vd_lsys_format(ls, &s, buf, cap);
+  vd_lstring_free(&s);
+  vd_lsys_destroy(ls);
+  return st;
+}
+
+#define CHECK_PY(src, steps, expected)                                                            \
+  do {                                                                                             \
+    char b_[8192];                                                                                 \
+    vd_error e_ = {0};                                                                             \
+    CHECK_STATUS(derive_with(src, VD_LSYS_PYTHON, steps, 0, b_, sizeof b_, &e_), VD_OK, e_);       \
+    CHECK_STR(b_, expected);                                                                       \
+  } while (0)
+
+static int python_here(void) {
+  char why[256];
+  if (vd_lsys_python_available(why, sizeof why)) return 1;
+  fprintf(stderr, "  (no Python engine here: %s)\n", why);
+  return 0;
+}
+
+TEST(pyengine, classes_and_lists_as_parameters) {
+  if (!python_here()) return;
+  const char* src =
+      "class Bud:\n"
+      "    def __init__(self, age):\n"
+      "        self.age = age\n"
+      "    def older(self):\n"
+      "        return Bud(self.age + 1)\n"
+      "    def __repr__(self):\n"
+      "        return 'Bud(%d)' % self.age\n"
+      "def grow(l):\n"
+      "    return [x * 2 for x in l]\n"
+      "Axiom: A(Bud(0), [1, 2])\n"
+      "derivation length: 2\n"
+      "production:\n"
+      "A(b, l) :\n"
+      "    if b.age < 1:\n"
+      "        produce F(len(l)) [ +(30) A(b.older(), grow(l)) ] A(b.older(), l + [5])\n"
+      "    else:\n"
+      "        produce F(sum(l))\n"
+      "endlsystem\n";
+  CHECK_PY(src, -1, "F(2)[+(30)F(6)]F(8)");
+  CHECK_PY(src, 1, "F(2)[+(30)A(Bud(1),[2, 4])]A(Bud(1),[1, 2, 5])");
+}
+
+TEST(pyengine, tuples_dicts_strings_big_ints) {
+  if (!python_here()) return;
+  const char* src =
+      "Axiom: A((1, 'x'), {'k': 2.5}, 'leaf', 2**70, True)\n"
+      "production:\n"
+      "A(t, d, s, n, b) --> B(t[0] + d['k'], s.upper(), n % 1000, b, n // 2**69)\n";
+  CHECK_PY(src, 1, "B(3.5,'LEAF',424,1,2)");
+}
+
+TEST(pyengine, numpy_copy_math) {
+  if (!python_here()) return;
+  const char* src =
+      "import numpy as np\n"
+      "from copy import deepcopy\n"
+      "import math\n"
+      "M = np.array([[1.0, 2.0], [3.0, 4.0]])\n"
+      "Axiom: A(M, [[1], [2]])\n"
+      "production:\n"
+      "A(m, l) :\n"
+      "    l2 = deepcopy(l)\n"
+      "    l2[0].append(9)\n"
+      "    produce B(float(np.linalg.det(m)), np.int64(7), len(l[0]), len(l2[0]), math.floor(m.sum()))\n";
+  CHECK_PY(src, 1, "B(-2.0000000000000004,7,1,2,10)");
+}
+
+TEST(pyengine, seeded_random_is_cpython_and_repeats) {
+  if (!python_here()) return;
+  // CPython's random.seed(42); random() is 0.6394267984578837; the native engine agrees
+  const char* src =
+      "from random import *\n"
+      "Axiom: A(random())\n"
+      "production:\n"
+      "A(x) --> A(x) B(uniform(0, 1), randint(1, 6), gauss(0, 1))\n";
+  char a[4096], b[4096], c[4096], n[4096];
+  vd_error e = {0};
+  CHECK_STATUS(derive_with(src, VD_LSYS_PYTHON, 3, 42, a, sizeof a, &e), VD_OK, e);
+  CHECK_STATUS(derive_with(src, VD_LSYS_PYTHON, 3, 42, b, sizeof b, &e), VD_OK, e);
+  CHECK_STATUS(derive_with(src, VD_LSYS_PYTHON, 3, 43, c, sizeof c, &e), VD_OK, e);
+  CHECK_STATUS(derive_with(src, VD_LSYS_NATIVE, 3, 42, n, sizeof n, &e), VD_OK, e);
+  CHECK_STR(a, b);
+  CHECK(strcmp(a, c) != 0);
+  CHECK(strncmp(a, "A(0.6394267984578837)", 21) == 0);
+  CHECK_STR(a, n);  // same generator, same algorithms: the two engines draw the same numbers
+}
+
+// the same lsystem text derived on several threads at once gives each thread the serial result
+typedef struct job {
+  const char* src;
+  uint64_t seed;
+  char out[4096];
+  vd_status st;
+} job;
+
+static void* run_job(void* arg) {
+  job* j = arg;
+  vd_error e = {0};
+  j->st = derive_with(j->src, VD_LSYS_PYTHON, 6, j->seed, j->out, sizeof j->out, &e);
+  return NULL;
+}
+
+TEST(pyengine, threads_keep_their_random_streams) {
+  if (!python_here()) return;
+  const char* src =
+      "import random\n"
+      "Axiom: A(0)\n"
+      "production:\n"
+      "A(x) :\n"
+      "    if random.random() < 0.7: produce A(x + 1) [ B(random.randint(0, 99)) ]\n"
+      "    else: produce A(x)\n";
+  job serial[4], par[4];
+  for (int k = 0; k < 4; k++) {
+    serial[k].src = par[k].src = src;
+    serial[k].seed = par[k].seed = (uint64_t)k;
+    run_job(&serial[k]);
+  }
+  pthread_t th[4];
+  for (int k = 0; k < 4; k++) pthread_create(&th[k], NULL, run_job, &par[k]);
+  for (int k = 0; k < 4; k++) pthread_join(th[k], NULL);
+  for (int k = 0; k < 4; k++) {
+    CHECK_INT(serial[k].st, VD_OK);
+    CHECK_INT(par[k].st, VD_OK);
+    CHECK_STR(par[k].out, serial[k].out);
+  }
+  CHECK(strcmp(serial[0].out, serial[1].out) != 0);
+}
+
+TEST(pyengine, same_strings_as_native_on_the_subset) {
+  if (!python_here()) return;
+  static const char* files[] = {"data/abop_1_9.lpy", "data/abop_fig1_24a.lpy", "data/signal.lpy", "data/tree.lpy",
+                                "data/tomato.lpy", "data/lilac.lpy"};
+  for (size_t f = 0; f < sizeof files / sizeof files[0]; f++) {
+    char* text;
+    size_t len;
+    vd_error e = {0};
+    REQUIRE(vd_file_read(vdt_path(files[f]), &text, &len, &e) == VD_OK);
+    vd_lsystem *ln, *lp;
+    CHECK_STATUS(vd_lsys_parse_engine(text, len, files[f], VD_LSYS_NATIVE, &ln, &e), VD_OK, e);
+    CHECK_STATUS(vd_lsys_parse_engine(text, len, files[f], VD_LSYS_PYTHON, &lp, &e), VD_OK, e);
+    vd_free(text, len + 1);
+    if (!ln || !lp) {
+      vd_lsys_destroy(ln);
+      vd_lsys_destroy(lp);
+      continue;
+    }
+    CHECK_INT(vd_lsys_get_engine(ln), VD_LSYS_NATIVE);
+    CHECK_INT(vd_lsys_get_engine(lp), VD_LSYS_PYTHON);
+    vd_lsys_def d = vd_lsys_def_default();
+    d.seed = 5;
+    vd_lstring a = vd_lstring_empty(), b = vd_lstring_empty(), ga = vd_lstring_empty(), gb = vd_lstring_empty();
+    CHECK_STATUS(vd_lsys_derive(ln, &d, &a, &e), VD_OK, e);
+    CHECK_STATUS(vd_lsys_derive(lp, &d, &b, &e), VD_OK, e);
+    CHECK_STATUS(vd_lsys_interpret(ln, &d, &a, &ga, &e), VD_OK, e);
+    CHECK_STATUS(vd_lsys_interpret(lp, &d, &b, &gb, &e), VD_OK, e);
+    // identical layout: symbols by name, parameter values bit for bit
+    int same = a.n == b.n && ga.n == gb.n;
+    for (int64_t i = 0; same && i < a.n; i++) {
+      same = !strcmp(vd_lsys_symbol_name(ln, a.sym[i]), vd_lsys_symbol_name(lp, b.sym[i])) &&
+             vd_lstring_nparam(&a, i) == vd_lstring_nparam(&b, i);
+      for (int k = 0; same && k < vd_lstring_nparam(&a, i); k++) {
+        double x = a.val[a.par[i] + k], y = b.val[b.par[i] + k];
+        same = vd_lsys_value_is_str(x) ? !strcmp(vd_lsys_value_str(ln, x), vd_lsys_value_str(lp, y)) : x == y;
+      }
+    }
+    if (!same) vdt_fail(__FILE__, __LINE__, "%s: the engines derive different strings", files[f]);
+    vd_lstring_free(&a);
+    vd_lstring_free(&b);
+    vd_lstring_free(&ga);
+    vd_lstring_free(&gb);
+    vd_lsys_destroy(ln);
+    vd_lsys_destroy(lp);
+  }
+}
+
+TEST(pyengine, automatic_choice) {
+  if (!python_here()) return;
+  vd_lsystem* ls;
+  vd_error e = {0};
+  const char* native = "Axiom: A\nproduction:\nA --> AB\n";
+  CHECK_STATUS(vd_lsys_parse(native, strlen(native), "n.lpy", &ls, &e), VD_OK, e);
+  CHECK_INT(vd_lsys_get_engine(ls), VD_LSYS_NATIVE);
+  vd_lsys_destroy(ls);
+  const char* list = "x = [1, 2]\nAxiom: A(x[1])\n";
+  CHECK_STATUS(vd_lsys_parse(list, strlen(list), "l.lpy", &ls, &e), VD_OK, e);
+  CHECK_INT(vd_lsys_get_engine(ls), VD_LSYS_PYTHON);
+  vd_lsys_destroy(ls);
+  // a name the file does not define (PlantGL's Vector3) goes to Python too
+  const char* pgl = "from openalea.plantgl.all import *\nAxiom: A(Vector3(1, 2, 3).x)\n";
+  CHECK_STATUS(vd_lsys_parse(pgl, strlen(pgl), "p.lpy", &ls, &e), VD_OK, e);
+  CHECK_INT(vd_lsys_get_engine(ls), VD_LSYS_PYTHON);
+  vd_lsys_destroy(ls);
+  CHECK_STR(vd_lsys_engine_name(VD_LSYS_PYTHON), "python");
+  CHECK_STR(vd_lsys_engine_name(VD_LSYS_NATIVE), "native");
+}
+
+TEST(pyengine, hooks_with_the_lstring) {
+  if (!python_here()) return;
+  const char* src =
+      "count = 0\n"
+      "def StartEach():\n"
+      "    global count\n"
+      "    count += 1\n"
+      "def EndEach(lstring):\n"
+      "    assert len(lstring) == 2 ** (getIterationNb() + 1) * 2\n"
+      "def End(lstring):\n"
+      "    assert count == 3\n"
+      "    assert lstring[0].name == 'A' and lstring[-1].name == 'B'\n"
+      "    return lstring[:1] + lstring[-1:] + Lstring('C(1)') + [Module('D', count)]\n"
+      "Axiom: A B\n"
+      "derivation length: 3\n"
+      "production:\n"
+      "A --> A A\n"
+      "B --> B B\n";
+  CHECK_PY(src, -1, "ABC(1)D(3)");
+}
+
+TEST(pyengine, produce_forms) {
+  if (!python_here()) return;
+  const char* src =
+      "def helper(n):\n"
+      "    for i in range(n):\n"
+      "        nproduce F(i)\n"
+      "Axiom: A(3)\n"
+      "production:\n"
+      "A(n) :\n"
+      "    helper(n)\n"
+      "    s = makestring(B(n) C)\n"
+      "    nsproduce(s)\n"
+      "    produce(D(n, [n]))\n"
+      "B --> *\n";
+  CHECK_PY(src, 1, "F(0)F(1)F(2)B(3)CD(3,[3])");
+}
+
+TEST(pyengine, errors_name_the_file_line) {
+  if (!python_here()) return;
+  struct {
+    const char* src;
+    vd_status st;
+    int line;
+  } cases[] = {
+      {"Axiom: A\nproduction:\nA :\n    x = undefined_thing + 1\n    produce B\n", VD_ERR_NAME, 4},
+      {"Axiom: A\nproduction:\nA :\n    x = [1,\n    produce B\n", VD_ERR_SYNTAX, 4},
+      {"class K:\n    def f(self):\n        return 1 / 0\nAxiom: A(K().f())\n", VD_ERR_VALUE, 3},
+      {"Axiom: A\nproduction:\nA :\n    assert 1 == 2, 'no'\n", VD_ERR_ASSERT, 4},
+      {"import no_such_module_here\nAxiom: A\n", VD_ERR_UNSUPPORTED, 1},
+      {"x = [1]\nAxiom: A\nproduction:\nA :\n    while True:\n        x.append(1)\n        x.pop()\n",
+       VD_ERR_LIMIT, 0},
+      {"x = [1]\n", VD_ERR_SYNTAX, 1},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    vd_lsystem* ls;
+    vd_error e = {0};
+    vd_status st = vd_lsys_parse_engine(cases[i].src, strlen(cases[i].src), "err.lpy", VD_LSYS_PYTHON, &ls, &e);
+    if (st == VD_OK) {
+      vd_lsys_def d = vd_lsys_def_default();
+      d.steps = 1;
+      d.max_ops = 1000;  // the runaway loop: 1 s without progress
+      vd_lstring s = vd_lstring_empty();
+      st = vd_lsys_derive(ls, &d, &s, &e);
+      vd_lstring_free(&s);
+      vd_lsys_destroy(ls);
+    }
+    if (st != cases[i].st || (cases[i].line && e.line != cases[i].line) || strcmp(e.file, "err.lpy") != 0) {
+      char eb[700];
+      vdt_fail(__FILE__, __LINE__, "case %d: %s line %d, expected %s line %d (%s)", (int)i, vd_status_str(st), e.line,
+               vd_status_str(cases[i].st), cases[i].line, vd_error_format(&e, eb, sizeof eb));
+    }
+  }
+}
+
+TEST(pyengine, set_global) {
+  if (!python_here()) return;
+  const char* src =
+      "N = [1, 2]\n"
+      "K = len(N)\n"
+      "Axiom: A(K, N)\n";
+  vd_lsystem* ls;
+  vd_error e = {0};
+  REQUIRE(vd_lsys_parse_engine(src, strlen(src), "s.lpy", VD_LSYS_PYTHON, &ls, &e) == VD_OK);
+  CHECK_STATUS(vd_lsys_set_global(ls, "N", "[1, 2, 3]", &e), VD_OK, e);
+  vd_error e2 = {0};
+  CHECK_STATUS(vd_lsys_set_global(ls, "missing", "1", &e2), VD_ERR_NAME, e2);
+  vd_lstring s = vd_lstring_empty();
+  CHECK_STATUS(vd_lsys_derive(ls, NULL, &s, &e), VD_OK, e);
+  char buf[256] = "";
+  vd_lsys_format(ls, &s, buf, sizeof buf);
+  CHECK_STR(buf, "A(3,[1, 2, 3])");
+  double k = 0;
+  CHECK_INT(vd_lsys_get_global(ls, "K", &k), VD_OK);
+  CHECK_NEAR(k, 3, 0);
+  vd_lstring_free(&s);
+  vd_lsys_destroy(ls);
+}
+
+TEST(pyengine, objects_are_released_after_each_step) {
+  if (!python_here()) return;
+  // 200 steps, each replacing a growing list: the table holds only the live ones
+  const char* src =
+      "import sys\n"
+      "Axiom: A([0])\n"
+      "production:\n"
+      "A(l) --> A(l + [len(l)])\n"
+      "interpretation:\n"
+      "A(l) --> F(len(l))\n";
+  char buf[256];
+  vd_error e = {0};
+  CHECK_STATUS(derive_with(src, VD_LSYS_PYTHON, 200, 0, buf, sizeof buf, &e), VD_OK, e);
+  CHECK(strncmp(buf, "A([0, 1, 2,", 11) == 0);
+  vd_lsystem* ls;
+  REQUIRE(vd_lsys_parse_engine(src, strlen(src), "g.lpy", VD_LSYS_PYTHON, &ls, &e) == VD_OK);
+  vd_lsys_def d = vd_lsys_def_default();
+  d.steps = 200;
+  vd_lstring s = vd_lstring_empty(), g = vd_lstring_empty();
+  CHECK_STATUS(vd_lsys_derive(ls, &d, &s, &e), VD_OK, e);
+  CHECK_STATUS(vd_lsys_interpret(ls, &d, &s, &g, &e), VD_OK, e);
+  REQUIRE(g.n == 1);
+  CHECK_NEAR(g.val[0], 201, 0);
+  vd_lstring_free(&s);
+  vd_lstring_free(&g);
+  vd_lsys_destroy(ls);
+}
