@@ -115,23 +115,12 @@ int cli_export(int argc, char** argv) {
     goto done;
   }
   if (check) {
-    // the plant alone, or in a scene beside the robot (written next to the output, then removed)
-    char scene[4200];
-    const char* load = out;
-    if (with) {
-      snprintf(scene, sizeof scene, "%s.scene.xml", out);
-      const char* parts[2] = {with, out};
-      if ((st = vd_render_mjcf_scene(scene, parts, 2, &err))) {
-        code = cli_report("export", &err, st);
-        goto done;
-      }
-      load = scene;
-    }
+    // the plant alone, or in a scene with the robot
+    const char* parts[2] = {with ? with : out, out};
     char prefix[64];
     snprintf(prefix, sizeof prefix, "%s/", def.name);
     vd_mjcf_info mi;
-    st = vd_render_mjcf_info(load, prefix, &mi, &err);
-    if (with) remove(scene);
+    st = vd_render_mjcf_info(with ? parts : parts + 1, with ? 2 : 1, prefix, &mi, &err);
     if (st) {
       code = cli_report("export", &err, st);
       goto done;

@@ -39,6 +39,12 @@ assert arm["plant_robot_contacts"] > 0 and far["plant_robot_contacts"] == 0, (ar
 PY
 then ok "mjcf loads, alone and with the arm"; else bad "mjcf loads, alone and with the arm"; fi
 if ls "$T"/*.scene.xml >/dev/null 2>&1; then bad "no scene left behind"; else ok "no scene left behind"; fi
+# the Lite 6, whose MJCF includes its gripper's
+if [ -f "$SRC/data/robots/lite6.xml" ]; then
+  expect "export mjcf with the Lite 6" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.xml" \
+    --check-with "$SRC/data/robots/lite6.xml"
+  if grep -Eq '"plant_bodies":[[:space:]]+[1-9]' "$T/out" && grep -Eq '"joints":[[:space:]]+[1-9]' "$T/out"; then ok "Lite 6 scene loads"; else bad "Lite 6 scene loads: $(head -c 300 "$T/out")"; fi
+fi
 
 # URDF and SDF, with their meshes as OBJ files; the standard checkers when installed
 expect "export urdf" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.urdf"

@@ -66,7 +66,7 @@ TEST(export, mjcf_loads_with_an_arm) {
   REQUIRE(m);
   int norg, nprim;
   organs(m, &norg, &nprim);
-  char path[512], scene[512];
+  char path[512];
   snprintf(path, sizeof path, "%s/plant.xml", vdt_tmpdir());
   vd_export_def def = vd_export_def_default();
   vd_error err = {0};
@@ -74,7 +74,8 @@ TEST(export, mjcf_loads_with_an_arm) {
   // alone: the world, the plant's root body, one body per organ; a geom per primitive, a mesh
   // per spec mesh; no joints
   vd_mjcf_info mi;
-  CHECK_STATUS(vd_render_mjcf_info(path, "plant/", &mi, &err), VD_OK, err);
+  const char* alone[1] = {path};
+  CHECK_STATUS(vd_render_mjcf_info(alone, 1, "plant/", &mi, &err), VD_OK, err);
   CHECK_INT(mi.nbody, 2 + norg);
   CHECK_INT(mi.nbody_prefix, norg);
   CHECK_INT(mi.ngeom, nprim);
@@ -88,11 +89,9 @@ TEST(export, mjcf_loads_with_an_arm) {
   for (int k = 0; k < 2; k++) {
     const char* robot = vdt_path(robots[k]);
     if (access(robot, R_OK) != 0) continue;
-    snprintf(scene, sizeof scene, "%s/scene%d.xml", vdt_tmpdir(), k);
     const char* parts[2] = {robot, path};
-    CHECK_STATUS(vd_render_mjcf_scene(scene, parts, 2, &err), VD_OK, err);
     vd_mjcf_info both;
-    CHECK_STATUS(vd_render_mjcf_info(scene, "plant/", &both, &err), VD_OK, err);
+    CHECK_STATUS(vd_render_mjcf_info(parts, 2, "plant/", &both, &err), VD_OK, err);
     CHECK_INT(both.nbody_prefix, norg);
     CHECK_INT(both.ngeom_prefix, nprim);
     CHECK(both.njoint > 0);
@@ -102,8 +101,8 @@ TEST(export, mjcf_loads_with_an_arm) {
   // moved away from the arm (plant at 3 m): no contact with it
   def.pos = vd_v3(3, 0, 0);
   CHECK_STATUS(vd_geom_export(m, NULL, &def, path, &err), VD_OK, err);
-  snprintf(scene, sizeof scene, "%s/scene0.xml", vdt_tmpdir());
-  CHECK_STATUS(vd_render_mjcf_info(scene, "plant/", &mi, &err), VD_OK, err);
+  const char* arm[2] = {vdt_path("data/robots/arm6.xml"), path};
+  CHECK_STATUS(vd_render_mjcf_info(arm, 2, "plant/", &mi, &err), VD_OK, err);
   CHECK_INT(mi.ncontact_prefix, 0);
   // the capsule of the first segment runs between its nodes with its mean radius
   char* text = slurp(path);
@@ -121,9 +120,11 @@ TEST(export, mjcf_loads_with_an_arm) {
   REQUIRE(f);
   fputs("<mujoco><worldbody><geom type=\"sphere\"/></worldbody>", f);
   fclose(f);
-  CHECK_STATUS(vd_render_mjcf_info(path, NULL, &mi, &err), VD_ERR_FORMAT, err);
+  CHECK_STATUS(vd_render_mjcf_info(alone, 1, NULL, &mi, &err), VD_ERR_FORMAT, err);
   CHECK(strstr(err.file, "plant.xml") != NULL);
-  CHECK_STATUS(vd_render_mjcf_info("/nonexistent/x.xml", NULL, &mi, &err), VD_ERR_IO, err);
+  const char* missing[2] = {"/nonexistent/x.xml", path};
+  CHECK_STATUS(vd_render_mjcf_info(missing, 1, NULL, &mi, &err), VD_ERR_IO, err);
+  CHECK_STATUS(vd_render_mjcf_info(missing, 2, NULL, &mi, &err), VD_ERR_IO, err);
   vd_model_destroy(m);
 }
 

@@ -171,17 +171,14 @@ typedef struct vd_mjcf_info {
                                    // that is neither a prefix body nor the world (a robot's)
 } vd_mjcf_info;
 
-// Load an MJCF file with MuJoCo and count what it holds (prefix Nullable: no prefix counts).
-// VD_ERR_IO when it cannot be opened, VD_ERR_FORMAT with MuJoCo's message (file:line) when it does
-// not load, VD_ERR_VALUE for a MuJoCo error after loading.
-vd_status vd_render_mjcf_info(const char* path, const char* prefix, vd_mjcf_info* info,
-                              vd_error* err);
-
-// Write an MJCF scene that includes the MJCF files parts (nparts: a robot, a plant from
-// vd_geom_export, ...), each named relative to the scene's folder (MuJoCo 2.2.2 puts that folder
-// in front of every included name). VD_ERR_IO when a part or the scene's folder cannot be found.
-vd_status vd_render_mjcf_scene(const char* scene, const char* const* parts, int nparts,
-                               vd_error* err);
+// Load MJCF files with MuJoCo and count what they hold (prefix Nullable: no prefix counts): one
+// file as it is; several (a robot and a plant from vd_geom_export) in a scene that includes each,
+// made in memory with the files of their folders (MuJoCo 2.2.2 resolves every include against
+// the top file's folder, so a robot that includes its gripper would not load from a scene file
+// elsewhere). VD_ERR_IO when a file cannot be opened, VD_ERR_FORMAT with MuJoCo's message when it
+// does not load, VD_ERR_VALUE for a MuJoCo error after loading.
+vd_status vd_render_mjcf_info(const char* const* files, int nfiles, const char* prefix,
+                              vd_mjcf_info* info, vd_error* err);
 
 // ---------------------------------------------------------------------------------------------
 // what is drawn
