@@ -256,3 +256,14 @@ TEST(lpy, nproduce_in_a_def) {
           "Axiom: A(1)\nproduction:\nA(x) :\n  two(x)\n  one()\n",
           1, "B(1)B(2)C");
 }
+
+TEST(lpy, absent_or_empty_axiom_and_spacing) {
+  // no Axiom: (a rule set) and an empty Axiom: give an empty string, as in L-Py
+  DERIVES("production:\nA --> B\n", 1, "");
+  DERIVES("Axiom:\nproduction:\nA --> B\n", 1, "");
+  // spaces between a module name and its parameters, in successors, patterns and declarations
+  DERIVES("module Leaf (a, b)\nAxiom: Leaf (1, 2) F (3)\nproduction:\nLeaf (a, b) --> Leaf (b, a)\n", 1,
+          "Leaf(2,1)F(3)");
+  // a non-ASCII character is one module; u'' strings are plain strings
+  DERIVES("Axiom: A(u'\xc3\xa9') \xc3\xa9\nproduction:\n\xc3\xa9 --> B\n", 1, "A('\xc3\xa9')B");
+}

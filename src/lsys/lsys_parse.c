@@ -349,7 +349,11 @@ static vd_status lx_next(lexer* L) {
   if (isalpha((unsigned char)c) || c == '_') {
     int p = L->pos;
     while (p < L->len && (isalnum((unsigned char)s[p]) || s[p] == '_')) p++;
-    // string prefixes r'', b'', f'' are not supported
+    // string prefixes r'', b'', f'' are not supported (u'' is a plain string in Python 3)
+    if (p == L->pos + 1 && (c == 'u' || c == 'U') && p < L->len && (s[p] == '\'' || s[p] == '"')) {
+      L->pos = p;
+      return lx_next(L);
+    }
     if (p < L->len && (s[p] == '\'' || s[p] == '"') && p - L->pos <= 2)
       return perr(L->ls, VD_ERR_UNSUPPORTED, L->lineno, L->col0 + L->pos,
                   "unsupported: prefixed string literal");
@@ -918,13 +922,22 @@ static int read_module_name(vd_lsystem* ls, const char* s, int len, int* pos, in
     perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unexpected '%c' where a module name was expected", c);
     return -1;
   }
-  if ((unsigned char)c < 32 || (unsigned char)c >= 127) {
-    perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unexpected character (byte 0x%02x) in an L-string",
-         (unsigned char)c);
+  // a non-ASCII character (UTF-8, as Python 3 reads the file) is one module, like an ASCII one
+  int clen = 1;
+  unsigned char u = (unsigned char)c;
+  if (u >= 0xC2 && u <= 0xF4) {
+    clen = u >= 0xF0 ? 4 : u >= 0xE0 ? 3 : 2;
+    for (int k = 1; k < clen; k++)
+      if (p + k >= len || ((unsigned char)s[p + k] & 0xC0) != 0x80) clen = 0;
+  } else if (u < 32 || u >= 127) {
+    clen = 0;
+  }
+  if (!clen) {
+    perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unexpected character (byte 0x%02x) in an L-string", u);
     return -1;
   }
-  int id = sym_intern(ls, s + p, 1, 0);
-  *pos = p + 1;
+  int id = sym_intern(ls, s + p, clen, 0);
+  *pos = p + clen;
   if (id < 0) perr(ls, VD_ERR_NOMEM, lineno, col0 + p, "out of memory");
   return id;
 }
@@ -963,6 +976,12 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     m->line = lineno;
     m->col = mcol;
     if (sym == VD_SYM_CUT) t->has_cut = 1;
+    {
+      // L-Py allows spaces between a module's name and its parameters: `MyGC (a, b)`
+      int q = pos;
+      while (q < len && is_space(s[q])) q++;
+      if (q < len && s[q] == '(') pos = q;
+    }
     if (pos < len && s[pos] == '(' && ls->engine == VD_LSYS_PYTHON) {
       // the Python engine: parameters stay Python source for CPython
       expr* params[64];
@@ -1331,6 +1350,11 @@ static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, in
     }
     m->kind = PK_MOD;
     m->sym = sym;
+    {
+      int q = pos;  // `A (x)`: spaces before the parameters, as in L-Py
+      while (q < b && is_space(s[q])) q++;
+      if (q < b && s[q] == '(') pos = q;
+    }
     if (pos < b && s[pos] == '(') {
       if (!parse_pattern_params(ls, sc, s, pos, b, lineno, col0, m, &par)) return 0;
       pos = par;
@@ -1891,6 +1915,8 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
     while (p < ln->len && !is_space(s[p]) && s[p] != ',' && s[p] != '(' && s[p] != ':' && s[p] != '#') p++;
     if (p == a) return perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + p, "expected a module name");
     if (sym_intern(ls, s + a, p - a, 1) < 0) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+    while (p < ln->len && is_space(s[p]) && p + 1 < ln->len && (is_space(s[p + 1]) || s[p + 1] == '(')) p++;
+    if (p < ln->len && is_space(s[p]) && p + 1 < ln->len && s[p + 1] == '(') p++;
     if (p < ln->len && s[p] == '(') {
       int depth = 0;
       while (p < ln->len) {
@@ -2556,8 +2582,12 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
         int j = li + 1;
         while (j < P.nline && P.lines[j].blank) j++;
         if (j >= P.nline || P.lines[j].indent <= ln->indent) {
-          st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + a, "expected an axiom after 'Axiom:'");
-          goto done;
+          // an empty axiom (L-Py accepts it: the derivation has nothing to rewrite)
+          ls->axiom = lsys_parse_tmpl_text(ls, "", 0, ln->lineno, ln->col0 + a);
+          if (!ls->axiom) goto fail;
+          li++;
+          section = -1;
+          continue;
         }
         scope sc;
         memset(&sc, 0, sizeof sc);
@@ -2680,8 +2710,14 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
     goto done;
   }
   if (!ls->axiom && !ls->axiom_body) {
-    st = perr(ls, VD_ERR_SYNTAX, P.nline ? P.lines[P.nline - 1].lineno : 1, 1, "the file has no 'Axiom:'");
-    goto done;
+    // no Axiom: with rules: an empty axiom (L-Py's default; such files are rule sets for
+    // composition); with no rules either, nothing says it is an L-system
+    if (ls->nrule == 0) {
+      st = perr(ls, VD_ERR_SYNTAX, P.nline ? P.lines[P.nline - 1].lineno : 1, 1, "the file has no 'Axiom:' and no rules");
+      goto done;
+    }
+    ls->axiom = lsys_parse_tmpl_text(ls, "", 0, 1, 1);
+    if (!ls->axiom) goto fail;
   }
   if (init_at < len) {
     int line0 = 1;
