@@ -80,6 +80,11 @@ static const char* sim_help_output =
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
     "                          axis), kinetic_energy (J), events, steps_per_second, ...\n"
+    "      --batch N           run N plants side by side: item i grown with the seed drawn from\n"
+    "                          (--seed, i) as dataset does (the same plant N times for a plant\n"
+    "                          file); --stats prints one record per item, -o DIR writes\n"
+    "                          DIR/item_NNNNNN/ (plant.json, events.csv); frames are not written\n"
+    "      --jobs J            items run at once (threads), default 1\n"
     "      --profile           time each stage of the steps and the frame output; --stats then\n"
     "                          has stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
     "                          project, velocity, fracture, frames)\n";
@@ -240,6 +245,7 @@ typedef struct sim_opts {
   double duration;
   int duration_set;
   int settle, statics, stats, profile;
+  int batch, jobs;
   double ke_tol;
   const char* frames;
   double fps;
@@ -595,6 +601,10 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--batch")) {
+      NUM(o->batch, x_ >= 1 && x_ <= 1e6 && x_ == floor(x_), "an integer in 1..1000000");
+    } else if (!strcmp(a, "--jobs")) {
+      NUM(o->jobs, x_ >= 1 && x_ <= 1024 && x_ == floor(x_), "an integer in 1..1024");
     } else if (!strcmp(a, "--profile")) {
       o->profile = 1;
     } else if (a[0] == '-' && a[1]) {
@@ -643,6 +653,190 @@ static int check_clash(const sim_opts* o) {
   return cli_check_outputs("sim", outs, nout, ins, nin);
 }
 
+// ---------------------------------------------------------------------------------------------
+// batches: N items side by side (--batch N --jobs J)
+
+// one item's result
+typedef struct batch_item {
+  uint64_t seed;
+  vd_status st;
+  vd_error err;
+  int64_t steps;
+  double time, wall, max_disp, ke;
+  int nevent, nseg;
+  int64_t nwarning;
+} batch_item;
+
+// item i's seed from (master, i), as `verdant dataset` draws it: the same plant for the same item
+static uint64_t batch_seed(uint64_t master, int i) {
+  vd_rng r;
+  vd_rng_stream(&r, master, (uint64_t)i);
+  uint64_t hi = vd_rng_u32(&r), lo = vd_rng_u32(&r);
+  return ((hi << 32) | lo) & ((1ull << 53) - 1);
+}
+
+// grow, build and run item i; its outputs go to DIR/item_NNNNNN/ with -o DIR
+static void batch_run(const sim_opts* o, int i, double nsteps, const double* wind, int nwind, vd_sdf* const* sdf,
+                      batch_item* r) {
+  cli_plant_opts po = o->po;
+  po.seed = r->seed;
+  po.progress = 0;
+  vd_plant_spec* spec = NULL;
+  vd_model* plant = NULL;
+  vd_sim_model* m = NULL;
+  vd_sim_data* d = NULL;
+  cli_grow_info info;
+  vd_error* err = &r->err;
+  vd_status st = cli_load_plant(&po, &spec, &info, err);
+  if (!st) cli_grow_info_free(&info);
+  if (!st) st = vd_plant_compile(spec, &plant, err);
+  if (!st) st = vd_sim_build(plant, &o->def, &m, err);
+  if (!st) {
+    vd_vec3 g = m->opt.gravity;
+    m->opt = o->opt;
+    m->opt.gravity = g;
+    m->opt.wind_series = wind;
+    m->opt.nwind = nwind;
+    m->opt.threads = 1;  // one item, one thread
+    d = vd_sim_data_create(m);
+    if (!d) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  pull pl[16];
+  memcpy(pl, o->pull, sizeof pl);
+  for (int k = 0; !st && k < o->npull; k++) {
+    pl[k].node = vd_sim_find_organ(m, plant, pl[k].organ, pl[k].instance);
+    if (pl[k].node < 0)
+      st = vd_error_set(err, VD_ERR_VALUE, o->po.path, 0, 0, "item %d: no organ '%s' in the plant", i, pl[k].organ);
+    else if (pl[k].move && (pl[k].tie = vd_sim_add_tie(d, pl[k].node, d->node_pos[pl[k].node], 1e-5)) < 0)  // NOLINT(clang-analyzer-core.NullDereference): d exists whenever st is VD_OK
+      st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  int probe_id[16];
+  if (!st) {
+    if (!o->no_ground) {
+      vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o->ground), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
+      vd_sim_add_collider(d, &c);
+    }
+    for (int k = 0; k < o->nmesh; k++) {
+      vd_sim_collider c = {VD_SIM_MESH, {0, 0, 0}, o->mesh_pos[k], vd_quat_identity(), vd_v3(0, 0, 0), sdf[k]};
+      vd_sim_add_collider(d, &c);
+    }
+    for (int k = 0; k < o->nprobe; k++) {
+      vd_sim_collider c = {VD_SIM_SPHERE, {o->probe[k].r, 0, 0}, o->probe[k].p0, vd_quat_identity(), vd_v3(0, 0, 0), NULL};
+      probe_id[k] = vd_sim_add_collider(d, &c);
+    }
+  }
+  double t0 = cli_now();
+  if (!st && (o->settle || o->statics)) {
+    vd_sim_settle_def sd = vd_sim_settle_def_default();
+    sd.statics = o->statics;
+    sd.ke_tol = o->ke_tol;
+    st = vd_sim_settle(m, d, &sd, NULL, NULL);
+  }
+  // the run with probes and pulls, as a single run drives them
+  double start = st ? 0 : d->time, total = o->duration, ramp = o->ramp_set ? o->ramp : total;
+  int64_t steps0 = st ? 0 : d->nstep;
+  for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
+    double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
+    for (int k = 0; k < o->npull; k++) {
+      if (pl[k].move)
+        d->tie[pl[k].tie].target = vd_madd(m->node_pos0[pl[k].node], pl[k].v, f);
+      else
+        d->node_force[pl[k].node] = vd_scale(pl[k].v, f);
+    }
+    for (int k = 0; k < o->nprobe; k++) {
+      const probe* pr = &o->probe[k];
+      double t1 = pr->t1 < 0 ? total : pr->t1, s = (t + m->opt.dt - pr->t0) / (t1 - pr->t0);
+      s = s < 0 ? 0 : s > 1 ? 1 : s;
+      vd_sim_set_collider_pose(m, d, probe_id[k], vd_add(pr->p0, vd_scale(vd_sub(pr->p1, pr->p0), s)), vd_quat_identity());
+    }
+    st = vd_sim_step(m, d);
+    if (st) vd_error_set(err, st, "", 0, 0, "item %d became unstable at t = %.4f s", i, d->time);
+  }
+  r->wall = cli_now() - t0;
+  if (d) {
+    r->steps = d->nstep - steps0, r->time = d->time, r->nevent = d->nevent, r->nwarning = d->nwarning;
+    r->max_disp = vd_sim_max_displacement(m, d, NULL), r->ke = vd_sim_kinetic_energy(m, d), r->nseg = m->nseg;
+  }
+  // the item's folder: the final plant and its events
+  if (!st && o->out) {
+    char dir[4200], path[4300];
+    snprintf(dir, sizeof dir, "%s/item_%06d", o->out, i);
+    if (mkdir(dir, 0777) && errno != EEXIST)
+      st = vd_error_set(err, VD_ERR_IO, dir, 0, 0, "cannot create the folder: %s", strerror(errno));
+    if (!st) st = write_events(d, plant, dir, err);
+    if (!st && (st = vd_sim_to_spec(m, d, spec))) vd_error_set(err, st, "", 0, 0, "out of memory writing the final plant");
+    snprintf(path, sizeof path, "%s/plant.json", dir);
+    if (!st) st = cli_write_plant(spec, path, 0, err);
+  }
+  r->st = st;
+  vd_sim_data_destroy(d);
+  vd_sim_model_destroy(m);
+  vd_model_destroy(plant);
+  vd_plant_spec_destroy(spec);
+}
+
+// --batch: the items on --jobs threads, then one record each (item order) with --stats
+static int sim_batch(const sim_opts* o, double nsteps) {
+  vd_error err = {0};
+  double* wind = NULL;
+  int nwind = 0, code = EXIT_OK, n = o->batch, jobs = o->jobs > 0 ? o->jobs : 1;
+  vd_sdf* sdf[8] = {NULL};
+  vd_status st = o->wind_file ? vd_sim_read_wind(o->wind_file, &wind, &nwind, &err) : VD_OK;
+  for (int k = 0; !st && k < o->nmesh; k++) st = load_mesh_sdf(o->mesh_path[k], &sdf[k], &err);
+  if (!st && o->out && mkdir(o->out, 0777) && errno != EEXIST)
+    st = vd_error_set(&err, VD_ERR_IO, o->out, 0, 0, "cannot create the output folder: %s", strerror(errno));
+  batch_item* r = st ? NULL : vd_calloc((size_t)n, sizeof *r);
+  if (!st && !r) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (st) {
+    code = cli_report("sim", &err, st);
+    goto done;
+  }
+  for (int i = 0; i < n; i++) r[i].seed = batch_seed(o->po.seed, i);
+  double t0 = cli_now();
+#pragma omp parallel for num_threads(jobs) schedule(dynamic, 1)
+  for (int i = 0; i < n; i++) batch_run(o, i, nsteps, wind, nwind, sdf, &r[i]);
+  double wall = cli_now() - t0;
+  // bad input (the first item's) is exit 2, a failed item exit 1
+  for (int i = 0; i < n && code == EXIT_OK; i++)
+    if (r[i].st) code = cli_report("sim", &r[i].err, r[i].st) == EXIT_USAGE ? EXIT_USAGE : EXIT_FAIL;
+  if (o->stats) {
+    cJSON* root = cJSON_CreateObject();
+    cJSON* items = cJSON_AddArrayToObject(root, "items");
+    int64_t steps = 0;
+    for (int i = 0; i < n; i++) {
+      cJSON* it = cJSON_CreateObject();
+      char num[32];
+      snprintf(num, sizeof num, "%llu", (unsigned long long)r[i].seed);
+      cJSON_AddNumberToObject(it, "item", i);
+      cJSON_AddRawToObject(it, "seed", num);
+      cJSON_AddBoolToObject(it, "ok", r[i].st == VD_OK);
+      cJSON_AddNumberToObject(it, "segments", r[i].nseg);
+      cJSON_AddNumberToObject(it, "steps", (double)r[i].steps);
+      cJSON_AddNumberToObject(it, "time", r[i].time);
+      cJSON_AddNumberToObject(it, "max_displacement", r[i].max_disp);
+      cJSON_AddNumberToObject(it, "kinetic_energy", r[i].ke);
+      cJSON_AddNumberToObject(it, "nevents", r[i].nevent);
+      cJSON_AddNumberToObject(it, "warnings", (double)r[i].nwarning);
+      cJSON_AddNumberToObject(it, "wall_seconds", r[i].wall);
+      cJSON_AddItemToArray(items, it);
+      steps += r[i].steps;
+    }
+    cJSON_AddNumberToObject(root, "jobs", jobs);
+    cJSON_AddNumberToObject(root, "wall_seconds", wall);
+    cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
+    cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * o->opt.dt / wall : 0);
+    char* text = cJSON_Print(root);
+    cJSON_Delete(root);
+    if (text) fputs(text, stdout), fputc('\n', stdout), cJSON_free(text);
+    else code = EXIT_FAIL;
+  }
+done:
+  vd_free(r, (size_t)n * sizeof *r);
+  vd_free(wind, (size_t)nwind * 4 * sizeof(double));
+  for (int k = 0; k < 8; k++) vd_sdf_destroy(sdf[k]);
+  return code;
+}
+
 int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
@@ -672,6 +866,11 @@ int cli_sim(int argc, char** argv) {
   if (nsteps > o.max_steps)
     return cli_usage_error("sim", "--duration %g s at --dt %g s is %.4g steps, more than --max-steps %.0f", o.duration,
                            o.opt.dt, nsteps, o.max_steps);
+  if (o.batch) {
+    if (o.final) return cli_usage_error("sim", "--final writes one plant: with --batch use -o DIR");
+    return sim_batch(&o, nsteps);
+  }
+  if (o.jobs) return cli_usage_error("sim", "--jobs needs --batch N (one plant's step: --threads)");
   // load, compile, build
   vd_error err = {0};
   vd_plant_spec* spec = NULL;

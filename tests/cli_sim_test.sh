@@ -34,6 +34,20 @@ expect "sim unknown option" 2 "$V" sim "$T/p.lpy" --stats --bogus
 expect "sim bad dt" 2 "$V" sim "$T/p.lpy" --stats --dt -1
 expect_err "bad dt named" "--dt"
 expect "sim bad solver" 2 "$V" sim "$T/p.lpy" --stats --solver magic
+# batches: items seeded from (--seed, i), the same bytes with any number of jobs; --jobs alone is
+# a usage error
+expect "sim jobs without batch" 2 "$V" sim "$T/p.lpy" --stats --jobs 2
+expect "sim batch one job" 0 "$V" sim "$SRC/data/arabidopsis.lpy" --batch 3 --jobs 1 --duration 0.05 -o "$T/b1" --stats
+json_check "sim batch records" "len(d['items']) == 3 and all(i['ok'] and i['steps'] == 50 for i in d['items']) and len({i['segments'] for i in d['items']}) > 1"
+expect "sim batch two jobs" 0 "$V" sim "$SRC/data/arabidopsis.lpy" --batch 3 --jobs 2 --duration 0.05 -o "$T/b2"
+if cmp -s "$T/b1/item_000002/plant.json" "$T/b2/item_000002/plant.json" && cmp -s "$T/b1/item_000000/events.csv" "$T/b2/item_000000/events.csv"; then
+  ok "sim batch same bytes for 1 and 2 jobs"
+else
+  bad "sim batch same bytes for 1 and 2 jobs"
+fi
+expect "sim threads same bytes" 0 "$V" sim "$SRC/data/tomato.lpy" --sag-free --duration 0.03 --threads 2 --final "$T/t2.json"
+expect "sim one thread" 0 "$V" sim "$SRC/data/tomato.lpy" --sag-free --duration 0.03 --threads 1 --final "$T/t1.json"
+if cmp -s "$T/t1.json" "$T/t2.json"; then ok "sim 1 and 2 threads same bytes"; else bad "sim 1 and 2 threads same bytes"; fi
 expect "sim bad bend measure" 2 "$V" sim "$T/p.lpy" --stats --bend-measure darboux
 expect_err "bad bend measure named" "--bend-measure"
 expect "sim quat bend measure" 0 "$V" sim "$T/p.lpy" --stats --bend-measure quat --duration 0.01

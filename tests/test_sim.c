@@ -691,3 +691,63 @@ TEST(sim, bend_jacobian) {
   }
   vd_model_destroy(pm);
 }
+
+// a tomato state with a probe through its crown at height z (m)
+static vd_sim_data* probed_state(vd_sim_model* m, double z) {
+  vd_sim_data* d = vd_sim_data_create(m);
+  vd_sim_collider g = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, 0), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
+  vd_sim_add_collider(d, &g);
+  vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.3, 0, z), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
+  vd_sim_add_collider(d, &p);
+  return d;
+}
+
+// move every state's probe and step them: one state at a time, or as a batch on 2 threads
+static void probe_steps(vd_sim_model* m, vd_sim_data** d, int n, int steps, int batch) {
+  for (int k = 0; k < steps; k++) {
+    for (int i = 0; i < n; i++)
+      vd_sim_set_collider_pose(m, d[i], 1, vd_v3(0.3 - 0.6 * k / steps, 0, 0.3 + 0.1 * i), vd_quat_identity());
+    if (batch)
+      CHECK(vd_sim_step_batch(m, d, n, 1, 2, NULL) == VD_OK);
+    else
+      for (int i = 0; i < n; i++) CHECK(vd_sim_step(m, d[i]) == VD_OK);
+  }
+}
+
+static int same_state(const vd_sim_model* m, const vd_sim_data* a, const vd_sim_data* b) {
+  return !memcmp(a->node_pos, b->node_pos, (size_t)m->nnode_all * sizeof(vd_vec3)) &&
+         !memcmp(a->seg_quat, b->seg_quat, (size_t)m->nseg * sizeof(vd_quat)) &&
+         !memcmp(a->seg_lambda, b->seg_lambda, (size_t)m->nseg * 6 * sizeof(double)) && a->nevent == b->nevent;
+}
+
+// the same bytes with 1, 2 and 3 threads for one state, and a batch of states on 2 threads
+// equal to the states stepped alone
+TEST(sim, threads_and_batch_same_bytes) {
+  vd_model* pm = grow("data/tomato.lpy", NULL);
+  CHECK(pm != NULL);
+  if (!pm) return;
+  vd_sim_def def = vd_sim_def_default();
+  def.sag_free = 1;
+  vd_sim_model* m = NULL;
+  vd_error e = {0};
+  CHECK_STATUS(vd_sim_build(pm, &def, &m, &e), VD_OK, e);
+  m->opt.wind = vd_v3(3, 0, 0);
+  vd_sim_data *d1 = probed_state(m, 0.35), *dt[2] = {probed_state(m, 0.35), probed_state(m, 0.35)};
+  probe_steps(m, &d1, 1, 30, 0);
+  for (int k = 0; k < 2; k++) {
+    m->opt.threads = 2 + k;
+    probe_steps(m, &dt[k], 1, 30, 0);
+    CHECK(same_state(m, d1, dt[k]));
+  }
+  m->opt.threads = 1;
+  vd_sim_data *solo[3], *batch[3];
+  for (int i = 0; i < 3; i++) solo[i] = probed_state(m, 0.3), batch[i] = probed_state(m, 0.3);
+  probe_steps(m, solo, 3, 20, 0);
+  probe_steps(m, batch, 3, 20, 1);
+  for (int i = 0; i < 3; i++) CHECK(same_state(m, solo[i], batch[i]));
+  CHECK(!same_state(m, solo[0], solo[2]));  // the probes differ: so do the states
+  for (int i = 0; i < 3; i++) vd_sim_data_destroy(solo[i]), vd_sim_data_destroy(batch[i]);
+  vd_sim_data_destroy(d1), vd_sim_data_destroy(dt[0]), vd_sim_data_destroy(dt[1]);
+  vd_sim_model_destroy(m);
+  vd_model_destroy(pm);
+}

@@ -363,6 +363,16 @@ void vd_sim_data_destroy(vd_sim_data* d);
 // VD_SIM_WARN_STRETCHED. The state never holds a non-finite number.
 vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d);
 
+// Step n states of one model (many episodes, parameter sweeps, batch learning): each state
+// d[i] takes nsteps steps as vd_sim_step would, the states split among `threads` threads
+// (OpenMP; each state on one thread, opt.threads is not used inside); the results are the same
+// bytes as stepping each state alone. st (Nullable, n) gets each state's status of its first
+// failing step (VD_OK when none); a failed state stops there. Returns VD_ERR_VALUE when any
+// state failed, else VD_OK. The caller may change colliders, forces and ties of each state
+// between calls.
+vd_status vd_sim_step_batch(const vd_sim_model* m, vd_sim_data** d, int n, int nsteps, int threads,
+                            vd_status* st);
+
 // Settling: what to run and when to stop.
 typedef struct vd_sim_settle_def {
   int statics;           // 1: solve the static equilibrium directly (quasi-static Newton steps)

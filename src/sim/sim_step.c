@@ -383,6 +383,22 @@ vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d) {
   return st;
 }
 
+vd_status vd_sim_step_batch(const vd_sim_model* m, vd_sim_data** d, int n, int nsteps, int threads,
+                            vd_status* st) {
+  int failed = 0;
+  if (threads < 1) threads = 1;
+  // one state per thread at a time; inner loops run on the calling thread (nested regions are
+  // serial), so each state's arithmetic is that of vd_sim_step alone
+#pragma omp parallel for num_threads(threads) if(threads > 1 && n > 1) schedule(dynamic, 1) reduction(| : failed)
+  for (int i = 0; i < n; i++) {
+    vd_status s = VD_OK;
+    for (int k = 0; k < nsteps && !s; k++) s = vd_sim_step(m, d[i]);
+    if (st) st[i] = s;
+    failed |= s != VD_OK;
+  }
+  return failed ? VD_ERR_VALUE : VD_OK;
+}
+
 vd_sim_settle_def vd_sim_settle_def_default(void) {
   vd_sim_settle_def s;
   s.statics = 0;
