@@ -37,6 +37,13 @@ cJSON* cli_sim_def_json(const vd_sim_def* def) {
   cJSON_AddItemToObject(o, "gravity", cJSON_CreateDoubleArray(g, 3));
   cJSON_AddNumberToObject(o, "stake_spacing", def->stake_spacing);
   cJSON_AddNumberToObject(o, "stake_stiffness", def->stake_stiffness);
+  // model choices of issue 13 (optional when read: runs made before have the defaults)
+  cJSON_AddStringToObject(o, "bend_measure", vd_sim_bend_name(def->bend_measure));
+  cJSON_AddNumberToObject(o, "leaf_segments", def->leaf_segments);
+  cJSON* csl = cJSON_AddObjectToObject(o, "class_segment_length");
+  for (int c = 0; c < VD_SIM_CLASS_COUNT; c++)
+    if (def->class_segment_length[c] > 0)
+      cJSON_AddNumberToObject(csl, vd_sim_class_name((vd_sim_class)c), def->class_segment_length[c]);
   cJSON* mats = cJSON_AddObjectToObject(o, "materials");
   for (int c = 0; c < VD_SIM_CLASS_COUNT; c++) {
     const vd_sim_material* mt = &def->material[c];
@@ -89,6 +96,26 @@ vd_status cli_sim_def_parse(const cJSON* o, const char* path, vd_sim_def* def, v
   if (!st) st = get_num(o, "stake_spacing", 0, &def->stake_spacing, path, "build", err);
   if (!st) st = get_num(o, "stake_stiffness", 0, &def->stake_stiffness, path, "build", err);
   if (st) return st;
+  const cJSON* bm = cJSON_GetObjectItemCaseSensitive(o, "bend_measure");
+  if (bm) {
+    int k = cJSON_IsString(bm) ? vd_sim_bend_parse(bm->valuestring) : -1;
+    if (k < 0) return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "build.bend_measure: expected \"log\" or \"quat\"");
+    def->bend_measure = (vd_sim_bend)k;
+  } else {
+    def->bend_measure = VD_SIM_BEND_QUAT;  // runs made before the log measure
+  }
+  if (cJSON_GetObjectItemCaseSensitive(o, "leaf_segments")) {
+    double ls = 0;
+    if ((st = get_num(o, "leaf_segments", 0, &ls, path, "build", err))) return st;
+    def->leaf_segments = (int)ls;
+  }
+  const cJSON* csl = cJSON_GetObjectItemCaseSensitive(o, "class_segment_length");
+  for (int c = 0; csl && c < VD_SIM_CLASS_COUNT; c++) {
+    const char* name = vd_sim_class_name((vd_sim_class)c);
+    if (cJSON_GetObjectItemCaseSensitive(csl, name) &&
+        (st = get_num(csl, name, 0, &def->class_segment_length[c], path, "build.class_segment_length", err)))
+      return st;
+  }
   const cJSON* g = cJSON_GetObjectItemCaseSensitive(o, "gravity");
   if (!cJSON_IsArray(g) || cJSON_GetArraySize(g) != 3)
     return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0,

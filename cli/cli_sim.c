@@ -34,8 +34,14 @@ static const char* sim_help =
     "      --sag-free          rest shape solved so that the modelled shape is the equilibrium\n"
     "      --stake S           tie the main stem to a fixed stake every S metres (greenhouse string)\n"
     "      --max-steps N       most time steps of a run, duration / dt (default 1000000000)\n"
+    ;
+static const char* sim_help_model =
     "model:\n"
-    "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
+    "      --segment-length [C=]S  rod segment length sigma_distance (m), default 0.02, or of\n"
+    "                          class C only (e.g. wood=0.05; model reduction)\n"
+    "      --leaves M          leaf blades as rod graphs (graph: midrib and two side veins,\n"
+    "                          default), the midrib alone (midrib) or rigid on their node (rigid)\n"
+    "      --leaf-segments K   segments per leaf vein (e.g. 2 or 3; default: by segment length)\n"
     "      --max-segments N    most rod segments of the model (default 1000000, about 2 kB each)\n"
     "      --bend-measure M    bend-twist strain: log (rotation vector, default) or quat\n"
     "                          (Kugelstadt & Schomer's Im(q), the model before 2026-11)\n"
@@ -496,7 +502,31 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
     } else if (!strcmp(a, "--stake")) {
       NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
     } else if (!strcmp(a, "--segment-length")) {
-      NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
+      // S for every class, or C=S for class C (model reduction: wood coarser than green stems)
+      VAL();
+      const char* eq = strchr(val, '=');
+      double x_;
+      char name[32];
+      size_t nl = eq ? (size_t)(eq - val) : 0;
+      if (nl >= sizeof name) nl = sizeof name - 1;
+      memcpy(name, val, nl);
+      name[nl] = 0;
+      vd_sim_class cls = eq ? vd_sim_class_parse(name) : VD_SIM_CLASS_COUNT;
+      if (eq && cls == VD_SIM_CLASS_COUNT) return cli_usage_error(cmd, "%s: unknown class '%s'", a, name);
+      if (!parse_num(eq ? eq + 1 : val, &x_) || !isfinite(x_) || !(x_ > 0))
+        return cli_usage_error(cmd, "%s expects a length > 0 (m) or CLASS=LENGTH, got '%s'", a, val);
+      if (eq)
+        o->def.class_segment_length[cls] = x_;
+      else
+        o->def.segment_length = x_;
+    } else if (!strcmp(a, "--leaves")) {
+      VAL();
+      if (!strcmp(val, "graph")) o->def.leaf_graphs = 1;
+      else if (!strcmp(val, "midrib")) o->def.leaf_graphs = 2;
+      else if (!strcmp(val, "rigid")) o->def.leaf_graphs = 0;
+      else return cli_usage_error(cmd, "--leaves expects graph, midrib or rigid, got '%s'", val);
+    } else if (!strcmp(a, "--leaf-segments")) {
+      NUM(o->def.leaf_segments, x_ >= 1 && x_ <= 1000 && x_ == floor(x_), "an integer in 1..1000");
     } else if (!strcmp(a, "--max-segments")) {
       NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
     } else if (!strcmp(a, "--bend-measure")) {
@@ -841,6 +871,7 @@ int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(sim_help, stdout);
+      fputs(sim_help_model, stdout);
       fputs(sim_help_output, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;

@@ -124,7 +124,11 @@ typedef struct vd_sim_def {
   double leaf_areal_density;      // mass of leaf lamina per area (kg/m^2)
   double leaf_vein_ratio;         // midrib radius at the leaf base / blade length (-)
   double leaf_plate_cd;           // drag coefficient of the lamina, normal flow (-)
-  int leaf_graphs;                // 1: leaf meshes become rod graphs; 0: rigid on their node
+  int leaf_graphs;                // leaf meshes: 1 rod graphs (midrib and two side veins), 2 the midrib
+                                  // alone, 0 rigid on their node (model reduction)
+  int leaf_segments;              // segments per leaf vein (e.g. 2 or 3), 0: by the segment length
+  double class_segment_length[VD_SIM_CLASS_COUNT];  // segment length per class (m), 0: segment_length
+                                  // (model reduction: wood coarser than green stems)
   int sag_free;                   // 1: rest shape solved so the modelled shape is in equilibrium
   vd_vec3 gravity;                // gravity used by sag_free and copied to opt.gravity (m/s^2)
   double stake_spacing;           // tie the main stem to a fixed stake every this length (m), 0 off
@@ -137,7 +141,7 @@ typedef struct vd_sim_def {
 //   segment_length 0.02 m, clamp_length 0.01 m, clamp_roots 1, leaf_graphs 1, sag_free 0,
 //   gravity (0, 0, -9.81) m/s^2, stake_spacing 0 m (off), stake_stiffness 1e4 N/m,
 //   max_segments 1000000 (a model and one state take about 2 kB per segment),
-//   bend_measure VD_SIM_BEND_LOG,
+//   bend_measure VD_SIM_BEND_LOG, leaf_segments 0, class_segment_length 0 (all: segment_length),
 //   leaf_areal_density 0.22 kg/m^2, leaf_vein_ratio 0.015, leaf_plate_cd 1.17;
 //   materials            E (Pa)   nu    rho (kg/m^3)  drag cd   fracture
 //     green stem         1e9      0.3   1000          1.2       never

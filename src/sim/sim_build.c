@@ -251,6 +251,12 @@ static vd_status check_def(const vd_sim_def* d, vd_error* err) {
   if (!(isfinite(d->stake_spacing) && d->stake_spacing >= 0)) BAD("sim: stake spacing must be >= 0 (m), got %g", d->stake_spacing);
   if (!(isfinite(d->stake_stiffness) && d->stake_stiffness > 0)) BAD("sim: stake stiffness must be > 0 (N/m), got %g", d->stake_stiffness);
   if (d->max_segments < 1) BAD("sim: max_segments must be >= 1, got %d", d->max_segments);
+  for (int c = 0; c < VD_SIM_CLASS_COUNT; c++)
+    if (!(isfinite(d->class_segment_length[c]) && d->class_segment_length[c] >= 0))
+      BAD("sim: segment length of '%s' must be >= 0 (m; 0: the segment length), got %g", class_names[c],
+          d->class_segment_length[c]);
+  if (d->leaf_graphs < 0 || d->leaf_graphs > 2) BAD("sim: leaf mode must be 0 (rigid), 1 (graphs) or 2 (midrib)");
+  if (d->leaf_segments < 0 || d->leaf_segments > 1000) BAD("sim: leaf segments must be in 0..1000, got %d", d->leaf_segments);
   if (d->bend_measure != VD_SIM_BEND_LOG && d->bend_measure != VD_SIM_BEND_QUAT)
     BAD("sim: unknown bend-twist measure %d", (int)d->bend_measure);
 #undef BAD
@@ -345,11 +351,17 @@ static vd_vec3 at_arc(const vd_vec3* pts, const double* cum, int k, double a, in
 
 // resample arc range [a0, a1] of a chain into rod segments starting at rod node start;
 // returns the last rod node (or -1 on failure). The chain's plant segments are segs[0..k-1].
+// segment length of material class c (m)
+static double sigma_of(const vd_sim_def* d, int c) {
+  return c >= 0 && c < VD_SIM_CLASS_COUNT && d->class_segment_length[c] > 0 ? d->class_segment_length[c]
+                                                                             : d->segment_length;
+}
+
 static int resample(bld* b, const int* segs, const vd_vec3* pts, const double* cum, int k, double a0,
                     double a1, int start, int fixed, int first_flags, int end_node_plant) {
   const vd_model* p = b->p;
   double len = a1 - a0;
-  int nrod = (int)floor(len / b->def->segment_length + 0.5);
+  int nrod = (int)floor(len / sigma_of(b->def, b->pclass[segs[0]]) + 0.5);
   if (nrod < 1) nrod = 1;
   if (fixed) nrod = 1;
   int prev = start;
@@ -474,7 +486,7 @@ static vd_status build_chains(bld* b) {
     if (cls == VD_SIM_ROOT && b->def->clamp_roots && b->node[start].fixed) {
       // roots stay in the soil: every rod segment fixed, for roots at the plant's base and
       // roots branching from a held node (the trunk's pot, another root)
-      int nrod = (int)floor(total / b->def->segment_length + 0.5);
+      int nrod = (int)floor(total / sigma_of(b->def, cls) + 0.5);
       if (nrod < 1) nrod = 1;
       last = start;
       for (int j = 0; j < nrod && last >= 0; j++) {
@@ -566,8 +578,10 @@ static int straight(bld* b, int a, vd_vec3 e, int nrod, double r0, double r1, in
   return prev;
 }
 
+// segments of a leaf vein of length len
 static int nsteps(const bld* b, double len) {
-  int k = (int)floor(len / b->def->segment_length + 0.5);
+  if (b->def->leaf_segments > 0) return b->def->leaf_segments;
+  int k = (int)floor(len / sigma_of(b->def, VD_SIM_LEAF) + 0.5);
   return k < 1 ? 1 : k;
 }
 
@@ -606,8 +620,8 @@ static vd_status leaf_graph(bld* b, int k, int* done) {
   int km = nsteps(b, len), first;
   int mid0 = b->nnode;  // midrib nodes are mid0 .. mid0 + km - 1 (node j = mid0 + j - 1)
   if (straight(b, a, VP(tip), km, r0, 0.7 * r0, label, inst, &first) < 0) return oom(b);
-  // side veins to the widest vertex on each side
-  for (int side = -1; side <= 1; side += 2) {
+  // side veins to the widest vertex on each side (not for the midrib alone)
+  for (int side = -1; side <= 1 && b->def->leaf_graphs == 1; side += 2) {
     int best = -1;
     double bd = 0.1 * len, btau = 0;
     for (int i = 0; i < nv; i++) {
@@ -1032,11 +1046,14 @@ vd_status vd_sim_build(const vd_model* plant, const vd_sim_def* def, vd_sim_mode
   // the axes alone, resampled, must fit the segment limit: say so before building anything
   double axes = 0;
   for (int t = 0; t < plant->nseg; t++) axes += plant->seg_len0[t];
-  if (axes / def->segment_length > def->max_segments)
+  double smin = def->segment_length;
+  for (int c = 0; c < VD_SIM_CLASS_COUNT; c++)
+    if (def->class_segment_length[c] > 0 && def->class_segment_length[c] < smin) smin = def->class_segment_length[c];
+  if (axes / smin > def->max_segments)
     return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0,
                         "sim: %.4g m of axes at a segment length of %g m make about %.3g rod segments, more than "
                         "the limit of %d; use a longer segment length or raise the segment limit",
-                        axes, def->segment_length, axes / def->segment_length, def->max_segments);
+                        axes, smin, axes / smin, def->max_segments);
   bld b;
   memset(&b, 0, sizeof b);
   b.p = plant, b.def = def, b.err = err;
