@@ -39,6 +39,9 @@ static const char* sim_help_model =
     "model:\n"
     "      --segment-length [C=]S  rod segment length sigma_distance (m), default 0.02, or of\n"
     "                          class C only (e.g. wood=0.05; model reduction)\n"
+    "      --active-radius R   region of interest (model reduction): only segments within R (m) of\n"
+    "                          --active-center X,Y,Z, of --active-organ ORGAN[#I] or else of the\n"
+    "                          first --probe's path are simulated; the rest is held as modelled\n"
     "      --leaves M          leaf blades as rod graphs (graph: midrib and two side veins,\n"
     "                          default), the midrib alone (midrib) or rigid on their node (rigid)\n"
     "      --leaf-segments K   segments per leaf vein (e.g. 2 or 3; default: by segment length)\n"
@@ -252,6 +255,8 @@ typedef struct sim_opts {
   int duration_set;
   int settle, statics, stats, profile;
   int batch, jobs;
+  int active_center_set;  // --active-center given
+  pull active_organ;      // --active-organ (organ[0] == 0: none)
   double ke_tol;
   const char* frames;
   double fps;
@@ -519,6 +524,20 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
         o->def.class_segment_length[cls] = x_;
       else
         o->def.segment_length = x_;
+    } else if (!strcmp(a, "--active-radius")) {
+      NUM(o->def.active_radius, x_ > 0, "a distance > 0 (m)");
+    } else if (!strcmp(a, "--active-center")) {
+      VAL();
+      double v[3];
+      if (!parse_list(val, v, 3)) return cli_usage_error(cmd, "--active-center expects X,Y,Z (m), got '%s'", val);
+      o->def.active_a = o->def.active_b = vd_v3(v[0], v[1], v[2]);
+      o->active_center_set = 1;
+    } else if (!strcmp(a, "--active-organ")) {
+      VAL();
+      char spec[80];
+      snprintf(spec, sizeof spec, "%s=0,0,0", val);
+      if (strlen(val) > 60 || !parse_pull(spec, &o->active_organ, 0))
+        return cli_usage_error(cmd, "--active-organ expects ORGAN or ORGAN#INSTANCE, got '%s'", val);
     } else if (!strcmp(a, "--leaves")) {
       VAL();
       if (!strcmp(val, "graph")) o->def.leaf_graphs = 1;
@@ -897,6 +916,11 @@ int cli_sim(int argc, char** argv) {
   if (nsteps > o.max_steps)
     return cli_usage_error("sim", "--duration %g s at --dt %g s is %.4g steps, more than --max-steps %.0f", o.duration,
                            o.opt.dt, nsteps, o.max_steps);
+  if (o.def.active_radius > 0 && !o.active_center_set && !o.active_organ.organ[0]) {
+    if (!o.nprobe)
+      return cli_usage_error("sim", "--active-radius needs --active-center, --active-organ or a --probe");
+    o.def.active_a = o.probe[0].p0, o.def.active_b = o.probe[0].p1;
+  }
   if (o.batch) {
     if (o.final) return cli_usage_error("sim", "--final writes one plant: with --batch use -o DIR");
     return sim_batch(&o, nsteps);
@@ -921,6 +945,19 @@ int cli_sim(int argc, char** argv) {
   if (!st) cli_grow_info_free(&info);
   if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
   if (!st) st = vd_plant_compile(spec, &plant, &err);
+  if (!st && o.def.active_radius > 0 && o.active_organ.organ[0]) {
+    // the region around an organ: where the whole plant's model puts it
+    vd_sim_def whole = o.def;
+    whole.active_radius = 0;
+    st = vd_sim_build(plant, &whole, &m, &err);
+    int n = st ? -1 : vd_sim_find_organ(m, plant, o.active_organ.organ, o.active_organ.instance);
+    if (!st && n < 0)
+      st = vd_error_set(&err, VD_ERR_VALUE, o.po.path, 0, 0, "--active-organ: no organ '%s' in the plant",
+                        o.active_organ.organ);
+    if (!st) o.def.active_a = o.def.active_b = m->node_pos0[n];
+    vd_sim_model_destroy(m);
+    m = NULL;
+  }
   if (!st) st = vd_sim_build(plant, &o.def, &m, &err);
   cli_blame_input(&err, o.po.path);
   if (!st) {

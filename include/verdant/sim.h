@@ -135,6 +135,11 @@ typedef struct vd_sim_def {
   double stake_stiffness;         // stiffness of each stake tie (N/m)
   int max_segments;               // most rod segments the model may have; larger is VD_ERR_LIMIT
   vd_sim_bend bend_measure;       // bend-twist strain measure
+  double active_radius;           // region of interest (model reduction), 0 off: segments with no node
+                                  // within this distance (m) of the segment active_a - active_b are
+                                  // held at the modelled shape (not simulated); a held segment's
+                                  // joint with a simulated parent still holds that parent (m)
+  vd_vec3 active_a, active_b;     // the region's axis: a point when equal, or a collider's path (m)
 } vd_sim_def;
 
 // Defaults (sources in docs/physics.md):
@@ -142,6 +147,7 @@ typedef struct vd_sim_def {
 //   gravity (0, 0, -9.81) m/s^2, stake_spacing 0 m (off), stake_stiffness 1e4 N/m,
 //   max_segments 1000000 (a model and one state take about 2 kB per segment),
 //   bend_measure VD_SIM_BEND_LOG, leaf_segments 0, class_segment_length 0 (all: segment_length),
+//   active_radius 0 (off), active_a = active_b = (0, 0, 0),
 //   leaf_areal_density 0.22 kg/m^2, leaf_vein_ratio 0.015, leaf_plate_cd 1.17;
 //   materials            E (Pa)   nu    rho (kg/m^3)  drag cd   fracture
 //     green stem         1e9      0.3   1000          1.2       never
@@ -202,6 +208,7 @@ vd_sim_opt vd_sim_opt_default(void);
 #define VD_SIM_LEAFSEG 4u    // part of a leaf rod graph
 #define VD_SIM_CONNECT 8u    // connector bridging a gap between a parent and its child
 #define VD_SIM_ABSCISSION 16u  // its joint with the parent is a pedicel abscission node
+#define VD_SIM_HELD 32u      // outside the region of interest: held (also VD_SIM_FIXED)
 
 // The rod model: compiled once, read-only. Arrays live in one block.
 typedef struct vd_sim_model {
@@ -258,6 +265,7 @@ typedef struct vd_sim_model {
   int main_tip;           // node at the end of the main axis (for tip_displacement), -1 if none
   double leaf_cd;         // drag coefficient of leaf laminae, normal flow (-)
   int nsagfree_clamped;   // joints whose sag-free rest curvature was out of reach (too heavy)
+  int nheld;              // segments held outside the region of interest
   vd_sim_bend bend_measure;  // bend-twist strain measure (from the def)
   double total_mass;      // sum of node masses (kg)
   size_t nbytes;          // size of the single allocation

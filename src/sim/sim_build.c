@@ -256,6 +256,9 @@ static vd_status check_def(const vd_sim_def* d, vd_error* err) {
       BAD("sim: segment length of '%s' must be >= 0 (m; 0: the segment length), got %g", class_names[c],
           d->class_segment_length[c]);
   if (d->leaf_graphs < 0 || d->leaf_graphs > 2) BAD("sim: leaf mode must be 0 (rigid), 1 (graphs) or 2 (midrib)");
+  if (!(isfinite(d->active_radius) && d->active_radius >= 0)) BAD("sim: active radius must be >= 0 (m), got %g", d->active_radius);
+  if (!(isfinite(d->active_a.x + d->active_a.y + d->active_a.z + d->active_b.x + d->active_b.y + d->active_b.z)))
+    BAD("sim: the region of interest is not finite");
   if (d->leaf_segments < 0 || d->leaf_segments > 1000) BAD("sim: leaf segments must be in 0..1000, got %d", d->leaf_segments);
   if (d->bend_measure != VD_SIM_BEND_LOG && d->bend_measure != VD_SIM_BEND_QUAT)
     BAD("sim: unknown bend-twist measure %d", (int)d->bend_measure);
@@ -1038,6 +1041,29 @@ static void bld_free(bld* b) {
   vd_free(b->vert_seg, ((size_t)p->nvert + 1) * sizeof(int));
 }
 
+// region of interest: segments with no node within active_radius of the region's axis are held
+// (fixed) with their end nodes, after everything else is built (sag-free and the compliances
+// are those of the whole plant: a simulated segment next to a held one keeps the joint's full
+// flexibility, and the held part is where the whole plant's equilibrium puts it)
+static void hold_outside(vd_sim_model* m, const vd_sim_def* def) {
+  vd_vec3 a = def->active_a, ab = vd_sub(def->active_b, def->active_a);
+  double l2 = vd_dot(ab, ab), r = def->active_radius;
+  for (int t = 0; t < m->nseg; t++) {
+    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
+    int inside = 0;
+    for (int e = 0; e < 2; e++) {
+      vd_vec3 x = m->node_pos0[m->seg_node[2 * t + e]];
+      double u = l2 > 0 ? vd_dot(vd_sub(x, a), ab) / l2 : 0;
+      u = u < 0 ? 0 : u > 1 ? 1 : u;
+      inside |= v_norm(vd_sub(x, vd_madd(a, ab, u))) <= r;
+    }
+    if (inside) continue;
+    m->seg_flags[t] |= VD_SIM_FIXED | VD_SIM_HELD;
+    m->node_fixed[m->seg_node[2 * t + 1]] = 1;
+    m->nheld++;
+  }
+}
+
 vd_status vd_sim_build(const vd_model* plant, const vd_sim_def* def, vd_sim_model** out, vd_error* err) {
   *out = NULL;
   VD_ASSERT(plant && def);
@@ -1094,6 +1120,7 @@ vd_status vd_sim_build(const vd_model* plant, const vd_sim_def* def, vd_sim_mode
     st = oom(&b);
     goto done;
   }
+  if (def->active_radius > 0) hold_outside(m, def);
   *out = m;
 done:
   bld_free(&b);

@@ -406,6 +406,53 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   for (int k = 0; k < 6; k++) L b->h[15 + k][l] = iw[k][l];
 }
 
+// region of interest: the joints of held children still hold slot s's body (lane l), as leaf
+// joints with a kinematic child: H += J_p^T alpha~'^-1 J_p, g += J_p^T alpha~'^-1 c' - J_p^T lambda
+// with J_p = -[[a, 0], [0, G]] (material rows); the linearisation is kept for the multipliers
+static void held_terms(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
+                       sim_blk* b, int l, int s) {
+  const sim_plan* p = &w->plan;
+  double h2 = ctx->h * ctx->h, gam = ctx->gamma;
+  for (int k = p->held_start[s]; k < p->held_start[s + 1]; k++) {
+    int c = p->held_seg[k];
+    sim_joint j;
+    sim_joint_eval(m, d, c, &j);
+    const double* lam = d->seg_lambda + 6 * c;
+    const double* cp = w->c_prev + 6 * c;
+    double* lin = p->held_lin + 30 * k;  // a (9), G (9), c' (6), alpha~' (6)
+    double cv[6], ap[6];
+    for (int i = 0; i < 6; i++) {
+      double at = j.alpha[i] / h2;
+      ap[i] = at / (1 + gam);
+      cv[i] = (j.c[i] + at * lam[i] + gam * (j.c[i] - (gam > 0 ? cp[i] : 0.0))) / (1 + gam);
+      if (i >= 3 && !j.bend) ap[i] = 1, cv[i] = 0;
+    }
+    memcpy(lin, j.a, 9 * sizeof(double));
+    memcpy(lin + 9, j.g, 9 * sizeof(double));
+    memcpy(lin + 18, cv, 6 * sizeof(double));
+    memcpy(lin + 24, ap, 6 * sizeof(double));
+    for (int i = 0; i < 3; i++)
+      for (int q = i; q < 3; q++) {
+        double sa = 0, sg = 0;
+        for (int r = 0; r < 3; r++) {
+          sa += j.a[3 * r + i] * j.a[3 * r + q] / ap[r];
+          sg += j.g[3 * r + i] * j.g[3 * r + q] / ap[3 + r];
+        }
+        b->h[SYM[i][q]][l] += sa;
+        b->h[15 + SYM[i][q]][l] += sg;
+      }
+    for (int i = 0; i < 3; i++) {
+      double ga = 0, gg = 0;
+      for (int r = 0; r < 3; r++) {
+        ga += j.a[3 * r + i] * (lam[r] - cv[r] / ap[r]);
+        gg += j.g[3 * r + i] * (lam[3 + r] - cv[3 + r] / ap[3 + r]);
+      }
+      b->g[i][l] += ga;
+      b->g[3 + i][l] += gg;
+    }
+  }
+}
+
 // add the children's contributions to slot s's body (lane l of block b), in their fixed order
 PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, sim_blk* b, int l, int s) {
   for (int k = p->kid_start[s]; k < p->kid_start[s + 1]; k++) {
@@ -573,7 +620,9 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
     eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l;
-      if (p->slot_seg[s] >= 0) gather_lane(d, p, b, l, s);
+      if (p->slot_seg[s] < 0) continue;
+      if (p->held_start[s + 1] > p->held_start[s]) held_terms(m, d, w, ctx, b, l, s);
+      gather_lane(d, p, b, l, s);
     }
     if (p->tip_block[bi])
       forward_kernel(b, 1);
@@ -723,6 +772,20 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     if (!ok) return 0;
     sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
   }
+  // held children's multipliers: dl = -(c' + J_p dy_p) / alpha~', J_p dy_p = -[a dx_p; G dth_p]
+  for (int s = 0; s < p->nslot && p->held_start[p->nslot] > 0; s++)
+    for (int k = p->held_start[s]; k < p->held_start[s + 1]; k++) {
+      const sim_blk* b = &p->blk[s / SIM_W];
+      const double* lin = p->held_lin + 30 * k;
+      double* lam = d->seg_lambda + 6 * p->held_seg[k];
+      int l = s % SIM_W;
+      for (int i = 0; i < 3; i++) {
+        double ax = 0, gt = 0;
+        for (int r = 0; r < 3; r++) ax += lin[3 * i + r] * b->dy[r][l], gt += lin[9 + 3 * i + r] * b->dy[3 + r][l];
+        lam[i] -= scale * (lin[18 + i] - ax) / lin[24 + i];
+        lam[3 + i] -= scale * (lin[21 + i] - gt) / lin[27 + i];
+      }
+    }
   for (int t = 0; t < nseg; t++) {
     if (!d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;
     int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;

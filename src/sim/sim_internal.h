@@ -263,6 +263,9 @@ typedef struct sim_plan {
   double* tie_h;             // ties on each slot's node, then on each spare: sum of h^2 / compliance (nslot + nspare)
   double* tie_g;             // ... and their residual sum c h^2 / compliance ((nslot + nspare) x 3)
   double* spare_dy;          // update of each spare node this iteration (nspare x 3)
+  int* held_start;           // held children of slot s (region of interest): held_seg[held_start[s] ..
+  int* held_seg;             // held_start[s + 1]), their joints hold the body (nslot + 1, nheld)
+  double* held_lin;          // their linearisation this iteration: a, G, c', alpha~' (nheld x 30)
   sim_blk* blk;              // the blocks (nblock, 64-byte aligned inside mem)
   sim_stat* stat;            // their model data (nblock, 64-byte aligned)
   void* mem;                 // one allocation for all of the above

@@ -62,6 +62,7 @@ typedef struct build {
   int* order;    // bodies in schedule order, -1 for padding lanes (grows by SIM_W per block)
   int norder;
   unsigned char* tips;  // per block
+  unsigned char* holds; // 1 for bodies with held children (not tips)
   int nblock;
   heap hp;
 } build;
@@ -91,19 +92,19 @@ static void schedule_part(build* b, int part) {
     for (int k = b->kstart[t]; k < b->kstart[t + 1]; k++) b->pending[t] += b->owner[b->kids[k]] == part;
   }
   b->hp.n = 0;
-  // bodies whose children are all elsewhere are ready at once
+  // bodies whose children are all elsewhere (or held) are ready at once
   for (int t = 0; t < b->ns; t++)
-    if (is_body(m, t) && b->owner[t] == part && b->kstart[t + 1] > b->kstart[t] && b->pending[t] == 0)
+    if (is_body(m, t) && b->owner[t] == part && (b->kstart[t + 1] > b->kstart[t] || b->holds[t]) && b->pending[t] == 0)
       heap_push(&b->hp, t);
   // tips (no children at all), in index order
   for (int t = 0; t < b->ns; t++) {
-    if (!is_body(m, t) || b->owner[t] != part || b->kstart[t + 1] > b->kstart[t]) continue;
+    if (!is_body(m, t) || b->owner[t] != part || b->kstart[t + 1] > b->kstart[t] || b->holds[t]) continue;
     b->order[b->norder++] = t;
     if (++lanes == SIM_W) close_block(b, lanes, 1), lanes = 0;
   }
   if (lanes) close_block(b, lanes, 1);
   for (int t = 0; t < b->ns; t++)
-    if (is_body(m, t) && b->owner[t] == part && b->kstart[t + 1] == b->kstart[t]) release(b, t, part);
+    if (is_body(m, t) && b->owner[t] == part && b->kstart[t + 1] == b->kstart[t] && !b->holds[t]) release(b, t, part);
   // list scheduling: a block takes the ready bodies farthest from the root; their parents may
   // become ready only for the next block
   int batch[SIM_W];
@@ -154,8 +155,13 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     st = VD_ERR_NOMEM;
     goto done;
   }
-  // parents, children (index order), depth and subtree size through the model's order
-  int nbody = 0;
+  // parents, children (index order), depth and subtree size through the model's order; bodies
+  // with held children (region of interest) are not tips: their joints add to the body matrix
+  int nbody = 0, nheld = 0;
+  for (int t = 0; t < ns; t++) {
+    int q = m->seg_parent[t];
+    if ((m->seg_flags[t] & VD_SIM_HELD) && q >= 0 && is_body(m, q)) nheld++, b.depth[q] = -1;
+  }
   for (int t = 0; t < ns; t++) {
     int q = m->seg_parent[t];
     b.par[t] = is_body(m, t) && q >= 0 && is_body(m, q) ? q : -1;
@@ -169,6 +175,13 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     for (int t = 0; t < ns; t++)
       if (b.par[t] >= 0) b.kids[fill[b.par[t]]++] = t;
   }
+  unsigned char* holds = vd_calloc(n1, 1);  // bodies with held children
+  if (!holds) {
+    st = VD_ERR_NOMEM;
+    goto done;
+  }
+  for (int t = 0; t < ns; t++) holds[t] = b.depth[t] < 0, b.depth[t] = 0;
+  b.holds = holds;
   for (int i = ns - 1; i >= 0; i--) {  // parents first
     int t = m->seg_order[i];
     if (is_body(m, t)) b.depth[t] = b.par[t] >= 0 ? b.depth[b.par[t]] + 1 : 0;
@@ -243,6 +256,8 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     size_t o_ks = TAKE(((size_t)nslot + 1) * I), o_kd = TAKE(((size_t)nkid + 1) * I), o_tb = TAKE((size_t)nblock + 1);
     size_t o_th = TAKE(((size_t)nslot + nsp) * sizeof(double)), o_tg = TAKE(((size_t)nslot + nsp) * 3 * sizeof(double));
     size_t o_sd = TAKE(((size_t)nsp + 1) * 3 * sizeof(double));
+    size_t o_hs = TAKE(((size_t)nslot + 1) * I), o_hg = TAKE(((size_t)nheld + 1) * I);
+    size_t o_hl = TAKE(((size_t)nheld + 1) * 30 * sizeof(double));
     size_t o_bk = TAKE((size_t)nblock * sizeof(sim_blk) + 64);
     size_t o_st = TAKE((size_t)nblock * sizeof(sim_stat) + 64);
 #undef TAKE
@@ -256,6 +271,7 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     p->part[nthread + 1] = nblock;
     p->slot_seg = (int*)(mem + o_ss), p->seg_slot = (int*)(mem + o_gs), p->par_slot = (int*)(mem + o_ps);
     p->kid_start = (int*)(mem + o_ks), p->kid_slot = (int*)(mem + o_kd), p->tip_block = (unsigned char*)(mem + o_tb);
+    p->held_start = (int*)(mem + o_hs), p->held_seg = (int*)(mem + o_hg), p->held_lin = (double*)(mem + o_hl);
     p->tie_h = (double*)(mem + o_th), p->tie_g = (double*)(mem + o_tg), p->spare_dy = (double*)(mem + o_sd);
     uintptr_t a = (uintptr_t)(mem + o_bk);
     p->blk = (sim_blk*)(mem + o_bk + ((64 - (a & 63)) & 63));
@@ -277,6 +293,16 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
       for (int k = b.kstart[t]; k < b.kstart[t + 1]; k++) p->kid_slot[nk++] = p->seg_slot[b.kids[k]];
     }
     p->kid_start[nslot] = nk;
+    // held children by slot, in segment index order
+    int nh = 0;
+    for (int s = 0; s < nslot; s++) {
+      int t = p->slot_seg[s];
+      p->held_start[s] = nh;
+      if (t < 0 || !holds[t]) continue;
+      for (int c = 0; c < ns; c++)
+        if ((m->seg_flags[c] & VD_SIM_HELD) && m->seg_parent[c] == t) p->held_seg[nh++] = c;
+    }
+    p->held_start[nslot] = nh;
     // the model's data of each lane
     for (int s = 0; s < nslot; s++) {
       sim_stat* sb = &p->stat[s / SIM_W];
@@ -296,5 +322,6 @@ done:
   vd_free(b.depth, n1 * I), vd_free(b.size, n1 * I), vd_free(b.owner, n1 * I);
   vd_free(b.pending, n1 * I), vd_free(b.order, nord * I), vd_free(b.tips, nord);
   vd_free(b.hp.v, n1 * I);
+  vd_free(b.holds, n1);
   return st;
 }

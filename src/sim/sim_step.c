@@ -261,7 +261,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   sim_stage(d, VD_SIM_STAGE_FORCES, &tp);
   if (c.gamma > 0)
     for (int t = 0; t < ns; t++)
-      if (!(m->seg_flags[t] & VD_SIM_FIXED)) sim_joint_values(m, d, t, w->c_prev + 6 * t);
+      if (!(m->seg_flags[t] & VD_SIM_FIXED) || (m->seg_flags[t] & VD_SIM_HELD)) sim_joint_values(m, d, t, w->c_prev + 6 * t);
   if (!c.statics) {
     // prediction: semi-implicit Euler on velocities, then positions and frames; air drag is
     // linearly implicit, m (v - v_n) = h (f_n - c (v - v_n)) with c = -dF/dv (w->node_drag):
