@@ -354,7 +354,7 @@ static vd_status eval_max_depth(vd_lsystem* ls, int sec) {
 static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, lsys_pass* P,
                                  int* matched) {
   lstr_clear(tmp);
-  if (!lstr_reserve(tmp, cur->n + 16, cur->par[cur->n] + 16) || (cur->src && !lstr_enable_src(tmp)))
+  if (!lstr_reserve(tmp, cur->n + 16, (cur->par ? cur->par[cur->n] : 0) + 16) || (cur->src && !lstr_enable_src(tmp)))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
   vd_status st = lsys_recursive(ls, sec, cur, tmp, P, ls->max_depth[sec], 0, matched);
   if (st) return st;
@@ -364,17 +364,75 @@ static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_ls
 
 static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 
-vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
-  vd_error local = {0};
-  ls->err = err ? err : &local;
+// StartInterpretation / EndInterpretation: what they produce is drawn before / after the string
+// (with source index src)
+static vd_status interpretation_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src,
+                                     int64_t max_modules) {
+  int fi = find_hook(ls, name);
+  if (fi < 0) return VD_OK;
+  func* f = ls->funcs[fi];
+  if (f->nparam != 0)
+    return vm_error(ls, VD_ERR_UNSUPPORTED, f->line, 1, "unsupported: hook %s(turtle) (the turtle object)", f->name);
+  vm_out vo = {out, src, max_modules, 0, 0};
+  vm_out* outer = ls->cur_out;
+  ls->cur_out = &vo;
+  value r;
+  vd_status st = vm_call_func(ls, fi, 0, NULL, &r, f->line, 1);
+  ls->cur_out = outer;
+  return st;
+}
+
+// the string through the interpretation rules, the hooks' modules around it; out->src maps
+// each module to the module of in it came from (in->n and in->n + 1 for the hooks)
+static vd_status interpret_into(vd_lsystem* ls, const vd_lstring* in, vd_lstring* out, lsys_pass* P) {
+  vd_status st = lsys_build_index(ls, ls->current_group, 0);  // interpretation reads forward
+  if (st) return vm_error(ls, st, 0, 0, "out of memory");
+  lstr_clear(out);
+  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16))
+    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  if ((st = interpretation_hook(ls, "StartInterpretation", out, in->n, P->max_modules))) return st;
+  int m = 0;
+  if ((st = lsys_recursive(ls, SEC_INTERPRETATION, in, out, P, ls->max_depth[SEC_INTERPRETATION], 0, &m))) return st;
+  return interpretation_hook(ls, "EndInterpretation", out, in->n + 1, P->max_modules);
+}
+
+// L-Py's environmental programs: before a step whose rules read query modules, the turtle
+// interprets the string and fills ?P ?H ?U ?L ?R with its position and frame (in the modules
+// the interpretation rules leave as they are)
+static vd_status query_pass(vd_lsystem* ls, vd_lstring* s, lsys_pass* P) {
+  vd_lstring* geo = &P->geo;
+  P->identity_bit = LSYS_SRC_IDENTITY;
+  vd_status st = interpret_into(ls, s, geo, P);
+  P->identity_bit = 0;
+  if (st) return st;
+  if ((st = lsys_turtle_query(ls, geo, ls->err))) return st;
+  for (int64_t k = 0; k < geo->n; k++) {
+    int32_t sym = geo->sym[k];
+    if (sym < VD_SYM_GETPOS || sym > VD_SYM_GETRIGHT || !(geo->src[k] & LSYS_SRC_IDENTITY)) continue;
+    int64_t j = geo->src[k] & ~LSYS_SRC_IDENTITY;
+    int64_t np = geo->par[k + 1] - geo->par[k];
+    memcpy(s->val + s->par[j], geo->val + geo->par[k], sizeof(double) * (size_t)np);
+  }
+  return VD_OK;
+}
+
+// the run's settings with defaults filled in; the interpreter budget starts
+static vd_lsys_def run_def(vd_lsystem* ls, const vd_lsys_def* def, lsys_pass* P) {
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
   vm_budget(ls, d.max_ops);
-  vd_lstring tmp = vd_lstring_empty();
-  lsys_pass P;
-  memset(&P, 0, sizeof P);
-  P.max_modules = d.max_modules;
+  memset(P, 0, sizeof *P);
+  P->max_modules = d.max_modules;
+  return d;
+}
+
+// the start of a run: top-level code, derivation length (steps Nullable), maximum depths, rule
+// index, hooks, axiom, Start hook and the axiom's decomposition; *early is set when L-Py returns
+// at once (no rule or no axiom)
+static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
+                           int* steps, int* early) {
   vd_status st = VD_OK;
+  *early = 0;
   if (ls->py) {
     lsys_py_enter(ls);
     lsys_py_reset_objects(ls);
@@ -383,67 +441,101 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     vd_free(out->src, sizeof(int64_t) * (size_t)out->cap);
     out->src = NULL;
   }
-  if ((st = run_toplevel(ls, d.seed))) goto done;
-  int steps = d.steps;
-  if (steps < 0 && ls->py) {
-    if ((st = lsys_py_dlength_eval(ls, &steps))) goto done;
-  } else if (steps < 0) {
-    steps = 1;
-    if (ls->derivation_length) {
-      value v;
-      if ((st = vm_eval(ls, ls->derivation_length, NULL, &v))) goto done;
-      if (!v_isnum(v) || v.n != floor(v.n) || v.n < 0 || v.n > 1e9) {
-        st = vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
-                      "derivation length must be a non-negative integer");
-        goto done;
+  if ((st = run_toplevel(ls, d->seed))) return st;
+  if (steps) {
+    *steps = d->steps;
+    if (*steps < 0 && ls->py) {
+      if ((st = lsys_py_dlength_eval(ls, steps))) return st;
+    } else if (*steps < 0) {
+      *steps = 1;
+      if (ls->derivation_length) {
+        value v;
+        if ((st = vm_eval(ls, ls->derivation_length, NULL, &v))) return st;
+        if (!v_isnum(v) || v.n != floor(v.n) || v.n < 0 || v.n > 1e9)
+          return vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
+                          "derivation length must be a non-negative integer");
+        *steps = (int)v.n;
       }
-      steps = (int)v.n;
     }
   }
-  if ((st = eval_max_depth(ls, SEC_DECOMPOSITION)) || (st = eval_max_depth(ls, SEC_INTERPRETATION))) goto done;
-  if ((st = lsys_build_index(ls, 0, ls->backward))) {
-    vm_error(ls, st, 0, 0, "out of memory");
-    goto done;
-  }
+  if ((st = eval_max_depth(ls, SEC_DECOMPOSITION)) || (st = eval_max_depth(ls, SEC_INTERPRETATION))) return st;
+  if ((st = lsys_build_index(ls, 0, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
   ls->hook_start = find_hook(ls, "Start");
   ls->hook_end = find_hook(ls, "End");
   ls->hook_starteach = find_hook(ls, "StartEach");
   ls->hook_endeach = find_hook(ls, "EndEach");
+  ls->steps_done = 0;
   // axiom
   lstr_clear(out);
-  if (!lstr_reserve(out, 64, 64)) {
-    st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-    goto done;
+  if (!lstr_reserve(out, 64, 64)) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  vm_out vo = {out, 0, d->max_modules, 0, 0};
+  if (ls->py) {
+    st = lsys_py_emit_axiom(ls, &vo);
+  } else if (ls->axiom) {
+    st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
+  } else if (ls->axiom_body) {
+    int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
+    value* frame = vd_malloc(sizeof(value) * (size_t)nl);
+    if (!frame) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
+    st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
+    vd_free(frame, sizeof(value) * (size_t)nl);
   }
-  {
-    vm_out vo = {out, 0, d.max_modules, 0, 0};
-    if (ls->py) {
-      st = lsys_py_emit_axiom(ls, &vo);
-    } else if (ls->axiom) {
-      st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
-    } else if (ls->axiom_body) {
-      int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
-      value* frame = vd_malloc(sizeof(value) * (size_t)nl);
-      if (!frame) {
-        st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-        goto done;
-      }
-      for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
-      st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
-      vd_free(frame, sizeof(value) * (size_t)nl);
-    }
-    if (st) goto done;
-  }
+  if (st) return st;
   // L-Py returns at once, without calling any hook, when there is no rule or no axiom (and
   // "Early return when no matching" is on, its default)
-  if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) goto done;
+  if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) {
+    *early = 1;
+    return VD_OK;
+  }
   ls->iteration = 0;
-  if ((st = call_hook(ls, ls->hook_start))) goto done;
-  if (ls->py && (st = lsys_py_hook(ls, "Start", out, &tmp, d.max_modules))) goto done;
+  if ((st = call_hook(ls, ls->hook_start))) return st;
+  if (ls->py && (st = lsys_py_hook(ls, "Start", out, tmp, d->max_modules))) return st;
   if (ls->opt_axiom_decomposition && !lsys_section_empty(ls, SEC_DECOMPOSITION)) {
     int dm = 0;
-    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
+    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, tmp, P, &dm))) return st;
   }
+  return VD_OK;
+}
+
+// one derivation step up to EndEach (excluded): StartEach, the query pass, productions,
+// decomposition; *matching tells whether a rule matched
+static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
+                          int* matching) {
+  ls->iteration = step;
+  ls->steps_done = step + 1;
+  ls->frame_displayed = last;
+  vd_status st = call_hook(ls, ls->hook_starteach);
+  if (st) return st;
+  if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, tmp, P->max_modules))) return st;
+  // useGroup() and backward() take effect at the next step
+  if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
+  if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
+    if (ls->has_query[SEC_PRODUCTION]) {
+      if ((st = query_pass(ls, out, P))) return st;
+      if ((st = lsys_build_index(ls, ls->current_group, ls->backward)))
+        return vm_error(ls, st, 0, 0, "out of memory");
+    }
+    if ((st = lsys_step(ls, SEC_PRODUCTION, out, tmp, P, matching))) return st;
+    lstr_swap(out, tmp);
+  }
+  if (!lsys_section_empty(ls, SEC_DECOMPOSITION)) {
+    int dm = 0;
+    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, tmp, P, &dm))) return st;
+    if (dm) *matching = 1;
+  }
+  return VD_OK;
+}
+
+vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  vd_lsys_def d = run_def(ls, def, &P);
+  vd_lstring tmp = vd_lstring_empty();
+  int steps = 0, early = 0;
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, &steps, &early);
+  if (st || early) goto done;
   int matching = 1, step = 0;
   // DiscardNewString() (L-Py's __lpyfuture__) drops a step's result for the string at the end
   // of the step before; it works through the EndEach that module provides (or decorates)
@@ -451,24 +543,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
                 (ls->hook_endeach < 0 || ls->funcs[ls->hook_endeach]->discard_wrapped);
   int has_saved = 0;
   for (; (matching || !ls->opt_early_return) && step < steps; step++) {
-    ls->iteration = step;
-    ls->frame_displayed = step == steps - 1;
-    if ((st = call_hook(ls, ls->hook_starteach))) goto done;
-    if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, &tmp, d.max_modules))) goto done;
-    // useGroup() and backward() take effect at the next step
-    if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) {
-      vm_error(ls, st, 0, 0, "out of memory");
-      goto done;
-    }
-    if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
-      if ((st = lsys_step(ls, SEC_PRODUCTION, out, &tmp, &P, &matching))) goto done;
-      lstr_swap(out, &tmp);
-    }
-    if (!lsys_section_empty(ls, SEC_DECOMPOSITION)) {
-      int dm = 0;
-      if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
-      if (dm) matching = 1;
-    }
+    if ((st = run_step(ls, step, step == steps - 1, out, &tmp, &P, &matching))) goto done;
     if (!(discard && ls->discard_requested) && (st = call_hook(ls, ls->hook_endeach))) goto done;
     if (ls->py && (st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules))) goto done;
     if (discard) {
@@ -494,35 +569,51 @@ done:
   return end_run(ls, st, &tmp, &P);
 }
 
+vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  vd_lsys_def d = run_def(ls, def, &P);
+  vd_lstring tmp = vd_lstring_empty();
+  int early = 0;
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, NULL, &early);
+  return end_run(ls, st, &tmp, &P);
+}
+
+vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* s, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  vd_lsys_def d = run_def(ls, def, &P);
+  vd_lstring tmp = vd_lstring_empty();
+  vd_status st = VD_OK;
+  int matching = 1;
+  if (ls->py) lsys_py_enter(ls);
+  if (global_slot(ls, "DiscardNewString", 16, 0) >= 0)
+    st = vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0, "unsupported: DiscardNewString() in a step-by-step derivation");
+  else if (ls->stop_requested)
+    st = vm_error(ls, VD_ERR_VALUE, 0, 0, "the L-system has stopped (Stop() was called): no more steps");
+  // every module names itself as its source; the passes carry that to what it becomes
+  if (!st && (!lstr_enable_src(s) || !lstr_enable_src(&tmp))) st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  for (int64_t i = 0; !st && s->src && i < s->n; i++) s->src[i] = i;
+  if (!st) st = run_step(ls, ls->steps_done, 0, s, &tmp, &P, &matching);
+  if (!st) st = call_hook(ls, ls->hook_endeach);
+  if (!st && ls->py) st = lsys_py_hook(ls, "EndEach", s, &tmp, d.max_modules);
+  if (!st && d.progress) d.progress(d.progress_user, ls->steps_done, ls->steps_done, s->n);
+  return end_run(ls, st, &tmp, &P);
+}
+
 vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lstring* in, vd_lstring* out,
                             vd_error* err) {
   vd_error local = {0};
   ls->err = err ? err : &local;
-  vd_lsys_def d = def ? *def : vd_lsys_def_default();
-  if (d.max_modules <= 0) d.max_modules = 50000000;
-  vm_budget(ls, d.max_ops);
   lsys_pass P;
-  memset(&P, 0, sizeof P);
-  P.max_modules = d.max_modules;
+  run_def(ls, def, &P);
   vd_lstring tmp = vd_lstring_empty();
-  vd_status st = VD_OK;
   if (ls->py) lsys_py_enter(ls);
   // interpretation rules of the group in use at the end of the derivation, read forward
-  if ((st = lsys_build_index(ls, ls->current_group, 0))) {
-    vm_error(ls, st, 0, 0, "out of memory");
-    goto done;
-  }
   if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
-  lstr_clear(out);
-  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16)) {
-    st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-    goto done;
-  }
-  {
-    int m = 0;
-    st = lsys_recursive(ls, SEC_INTERPRETATION, in, out, &P, ls->max_depth[SEC_INTERPRETATION], 0, &m);
-  }
-done:
+  vd_status st = interpret_into(ls, in, out, &P);
   return end_run(ls, st, &tmp, &P);
 }
 
