@@ -1960,11 +1960,37 @@ def _vd_curve(c, n=0):
     return [float(x) for p in pts for x in p], dim
 
 
-def _vd_function(f, n):
-    """n + 1 values of a function of [0, 1] (QuantisedFunction, a curve used as one, a callable)."""
+def _vd_guide(c, m):
+    """A guide for the turtle (PlantGL's TurtlePath): the curve's length (PlantGL's chords of its
+    stride), m + 1 points, unit tangents and unit normals at equal steps of normalised arc length
+    (through getArcLengthToUMapping, as PlantGL), and the dimension; None if c is not a curve."""
+    if not (isinstance(c, _Curve) or (hasattr(c, "getPointAt") and hasattr(c, "getArcLengthToUMapping"))):
+        return None
+    length = c.getLength()
+    f = c.getArcLengthToUMapping()
+    pts, tan, nrm = [], [], []
+    for i in range(m + 1):
+        u = f(i / m)
+        pts += list(c.getPointAt(u))
+        t = c.getTangentAt(u)
+        n = norm(t)
+        tan += [x / n for x in t] if n > 0 else list(t)
+        nn = c.getNormalAt(u) if hasattr(c, "getNormalAt") else t
+        k = norm(nn)
+        nrm += [x / k for x in nn] if k > 0 else list(nn)
+    return float(length), [float(x) for x in pts], [float(x) for x in tan], [float(x) for x in nrm], len(pts) // (m + 1)
+
+
+def _vd_function(f):
+    """(firstx, lastx, values) of a function for the turtle: a QuantisedFunction's own samples
+    (a curve used as a function is quantised first, as L-Py does); None otherwise."""
     if isinstance(f, _Curve):
         f = QuantisedFunction(f)
-    return [float(f(i / n)) for i in range(n + 1)]
+    if isinstance(f, QuantisedFunction):
+        return float(f.firstx), float(f.lastx), [float(v) for v in f.values]
+    if callable(f):
+        return 0.0, 1.0, [float(f(i / 100)) for i in range(101)]
+    return None
 
 
 def _vd_number(x):
