@@ -1451,8 +1451,9 @@ vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, i
     *closed = PyObject_IsTrue(PyTuple_GET_ITEM(r, 2)) == 1;
     int ok = p && t && a % 3 == 0 && b % 3 == 0 && a > 0 && b > 0;
     int* ti = ok ? vd_malloc(sizeof(int) * (size_t)b) : NULL;
+    double nvert = (double)(a - a % 3) / 3.0;  // vertices (a is a multiple of 3 here)
     for (int i = 0; ti && i < b; i++) {
-      if (!(t[i] >= 0 && t[i] < a / 3)) {
+      if (!(t[i] >= 0 && t[i] < nvert)) {
         vd_free(ti, sizeof(int) * (size_t)b);
         ti = NULL;
         break;

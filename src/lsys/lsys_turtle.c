@@ -551,11 +551,15 @@ static void tri(int* t, int k, int a, int b, int c) {
 // the run's data for object parameter k of the current module (fetched once); -1 on error
 static int get_curve(turtle* T, int k, int kind, int* out) {
   double key = T->p[k];
-  for (int c = 0; c < T->ncur; c++)
-    if (T->cur[c].kind == kind && memcmp(&T->cur[c].key, &key, sizeof key) == 0) {
+  uint64_t kb, cb;
+  memcpy(&kb, &key, sizeof kb);
+  for (int c = 0; c < T->ncur; c++) {
+    memcpy(&cb, &T->cur[c].key, sizeof cb);
+    if (T->cur[c].kind == kind && cb == kb) {
       *out = c;
       return VD_OK;
     }
+  }
   if (!vd_grow((void**)&T->cur, &T->cap_cur, T->ncur + 1, sizeof *T->cur)) return nomem(T);
   tcurve* c = &T->cur[T->ncur];
   memset(c, 0, sizeof *c);
@@ -613,7 +617,7 @@ static tguide* own_guide(turtle* T) {
 // SetGuide(curve, length[, yorientation, ccw]): follow curve over the next length (Turtle2DPath,
 // Turtle3DPath: start at the curve's start, heading (1,0) or (0,1) in 2D, (0,0,1) in 3D)
 static vd_status set_guide(turtle* T, int k, double length, int yorient, int ccw) {
-  int c;
+  int c = -1;
   vd_status st = get_curve(T, k, CUR_GUIDE, &c);
   if (st) return st;
   if (!(length > 0) || !isfinite(length)) return fail(T, VD_ERR_VALUE, "guide length %g must be positive", length);
@@ -839,7 +843,7 @@ static vd_status custom_geometry(turtle* T) {
     return VD_OK;
   }
   char why[256] = "";
-  if ((st = lsys_obj_mesh(T->ls, T->p[0], &xyz, &nv, &tr, &nt, &closed, why, sizeof why))) {
+  if (lsys_obj_mesh(T->ls, T->p[0], &xyz, &nv, &tr, &nt, &closed, why, sizeof why) != VD_OK) {
     // a material or an appearance only changes colours: nothing to draw
     vd_log(1, "turtle: module %lld '@g': %s; nothing drawn", (long long)T->i, why);
     return VD_OK;
@@ -862,7 +866,7 @@ static vd_status custom_geometry(turtle* T) {
 
 // SetContour(curve[, ccw]): the cross section of the following F and tubes
 static vd_status set_contour(turtle* T, int k, int ccw) {
-  int c;
+  int c = -1;
   vd_status st = get_curve(T, k, CUR_POINTS, &c);
   if (st) return st;
   T->t.contour = c;
