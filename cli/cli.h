@@ -175,6 +175,25 @@ struct cJSON* cli_sim_def_json(const vd_sim_def* def);
 vd_status cli_sim_def_parse(const struct cJSON* o, const char* path, vd_sim_def* def, vd_error* err);
 // Write one line of colliders.jsonl: the state's time and colliders.
 void cli_colliders_write(FILE* fp, const vd_sim_data* d);
+// The rod topology of a run (DIR/rod.json: what frames refer to, and how to rebuild the model).
+vd_status cli_rod_json_write(const vd_sim_model* m, const vd_model* plant, const vd_sim_def* def,
+                             const char* dir, vd_error* err);
+// A run's frames being written: DIR/frames.bin (or .jsonl) and DIR/colliders.jsonl.
+typedef struct cli_frames {
+  vd_outfile frames, colliders;
+  int frames_open, colliders_open, jsonl, watch, cwatch;  // zero the struct, watches -1
+  size_t fbuf_n;
+  unsigned char* bbuf;
+} cli_frames;
+// Open the frames files of a run folder (temporary names until cli_frames_end).
+vd_status cli_frames_begin(cli_frames* o, const vd_sim_model* m, const char* dir, int jsonl,
+                           vd_error* err);
+// Append one frame of state d; nonzero when a write has failed (the commit reports it).
+int cli_frames_write(cli_frames* o, const vd_sim_model* m, const vd_sim_data* d);
+// Commit both files (colliders only beside complete frames) and release the writer.
+vd_status cli_frames_end(cli_frames* o, vd_error* err);
+// Remove the temporary files and release the writer (after cli_frames_end: only releases).
+void cli_frames_abort(cli_frames* o);
 
 // A run folder opened for reading.
 typedef struct cli_run {
@@ -287,6 +306,7 @@ void cli_view_record(const cli_view_opts* v, const cli_view* view, struct cJSON*
 void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
 
 // Subcommands.
+int cli_harvest(int argc, char** argv);
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);
 int cli_dataset(int argc, char** argv);

@@ -330,142 +330,6 @@ static int parse_pull(const char* s, pull* p, int move) {
 // ---------------------------------------------------------------------------------------------
 // outputs
 
-typedef struct outputs {
-  vd_outfile frames, colliders;
-  int frames_open, colliders_open, jsonl, watch, cwatch;
-  float* fbuf;
-  size_t fbuf_n;
-  unsigned char* bbuf;
-} outputs;
-
-static void put_u32(unsigned char* b, uint32_t v) {
-  for (int k = 0; k < 4; k++) b[k] = (unsigned char)(v >> (8 * k));
-}
-
-static void put_f64(unsigned char* b, double d) {
-  uint64_t u;
-  memcpy(&u, &d, 8);
-  for (int k = 0; k < 8; k++) b[k] = (unsigned char)(u >> (8 * k));
-}
-
-static void put_f32(unsigned char* b, float f) {
-  uint32_t u;
-  memcpy(&u, &f, 4);
-  put_u32(b, u);
-}
-
-static vd_status frames_begin(outputs* o, const vd_sim_model* m, const char* dir, int jsonl, vd_error* err) {
-  char path[4096];
-  snprintf(path, sizeof path, "%s/frames.%s", dir, jsonl ? "jsonl" : "bin");
-  o->watch = cli_watch(path);
-  vd_status st = vd_outfile_open(&o->frames, path, err);
-  if (st) return st;
-  o->frames_open = 1;
-  o->jsonl = jsonl;
-  // the colliders' poses at the same instants (for pictures of the run)
-  snprintf(path, sizeof path, "%s/colliders.jsonl", dir);
-  o->cwatch = cli_watch(path);
-  if ((st = vd_outfile_open(&o->colliders, path, err))) return st;
-  o->colliders_open = 1;
-  if (!jsonl) {
-    // header: magic, version, node count, segment count, reserved (little-endian)
-    unsigned char h[24];
-    memcpy(h, "VDSIMFRM", 8);  // NOLINT(bugprone-not-null-terminated-result): an 8-byte magic, no NUL
-    put_u32(h + 8, VD_SIM_FRAMES_VERSION);
-    put_u32(h + 12, (uint32_t)m->nnode_all);
-    put_u32(h + 16, (uint32_t)m->nseg);
-    put_u32(h + 20, 0);
-    fwrite(h, 1, sizeof h, o->frames.fp);
-    o->fbuf_n = 8 + 4 * (3 * (size_t)m->nnode_all + 4 * (size_t)m->nseg) + (size_t)m->nseg;
-    o->bbuf = vd_malloc(o->fbuf_n);
-    if (!o->bbuf) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
-  }
-  return VD_OK;
-}
-
-// one frame; nonzero when a write has failed (a full disk: the run stops, the commit reports it)
-static int frames_write(outputs* o, const vd_sim_model* m, const vd_sim_data* d) {
-  FILE* f = o->frames.fp;
-  cli_colliders_write(o->colliders.fp, d);
-  if (o->jsonl) {
-    fprintf(f, "{\"t\":%.9g,\"pos\":[", d->time);
-    for (int i = 0; i < m->nnode_all; i++)
-      fprintf(f, "%s%.7g,%.7g,%.7g", i ? "," : "", d->node_pos[i].x, d->node_pos[i].y, d->node_pos[i].z);
-    fputs("],\"quat\":[", f);
-    for (int t = 0; t < m->nseg; t++)
-      fprintf(f, "%s%.7g,%.7g,%.7g,%.7g", t ? "," : "", d->seg_quat[t].w, d->seg_quat[t].x, d->seg_quat[t].y,
-              d->seg_quat[t].z);
-    fputs("],\"broken\":[", f);
-    int first = 1;
-    for (int t = 0; t < m->nseg; t++)
-      if (d->seg_broken[t]) fprintf(f, "%s%d", first ? "" : ",", t), first = 0;
-    fputs("]}\n", f);
-    return ferror(f) || ferror(o->colliders.fp);
-  }
-  unsigned char* b = o->bbuf;
-  put_f64(b, d->time);
-  b += 8;
-  for (int i = 0; i < m->nnode_all; i++, b += 12)
-    put_f32(b, (float)d->node_pos[i].x), put_f32(b + 4, (float)d->node_pos[i].y), put_f32(b + 8, (float)d->node_pos[i].z);
-  for (int t = 0; t < m->nseg; t++, b += 16) {
-    vd_quat q = d->seg_quat[t];
-    put_f32(b, (float)q.w), put_f32(b + 4, (float)q.x), put_f32(b + 8, (float)q.y), put_f32(b + 12, (float)q.z);
-  }
-  for (int t = 0; t < m->nseg; t++) *b++ = (unsigned char)(d->seg_broken[t] ? 1 : 0);  // NOLINT(clang-analyzer-core.NullDereference): bbuf exists for binary frames; JSONL returned above
-  fwrite(o->bbuf, 1, o->fbuf_n, f);
-  return ferror(f) || ferror(o->colliders.fp);
-}
-
-// the rod topology that frames refer to
-static vd_status write_rod_json(const vd_sim_model* m, const vd_model* plant, const vd_sim_def* def, const char* dir,
-                                vd_error* err) {
-  cJSON* root = cJSON_CreateObject();
-  if (!root) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  cJSON_AddStringToObject(root, "format", "verdant-rod");
-  cJSON_AddNumberToObject(root, "version", VD_SIM_FRAMES_VERSION);
-  cJSON_AddNumberToObject(root, "nodes", m->nnode_all);
-  cJSON_AddNumberToObject(root, "segments", m->nseg);
-  cJSON* np = cJSON_AddArrayToObject(root, "node_pos0");
-  for (int i = 0; i < m->nnode_all; i++) {
-    cJSON_AddItemToArray(np, cJSON_CreateNumber(m->node_pos0[i].x));
-    cJSON_AddItemToArray(np, cJSON_CreateNumber(m->node_pos0[i].y));
-    cJSON_AddItemToArray(np, cJSON_CreateNumber(m->node_pos0[i].z));
-  }
-  cJSON_AddItemToObject(root, "node_sphere", cJSON_CreateDoubleArray(m->node_sphere, m->nnode_all));
-  cJSON_AddItemToObject(root, "seg_node", cJSON_CreateIntArray(m->seg_node, 2 * m->nseg));
-  cJSON_AddItemToObject(root, "seg_spare", cJSON_CreateIntArray(m->seg_spare, m->nseg));
-  cJSON_AddItemToObject(root, "seg_radius", cJSON_CreateDoubleArray(m->seg_radius, m->nseg));
-  cJSON_AddItemToObject(root, "seg_label", cJSON_CreateIntArray(m->seg_label, m->nseg));
-  cJSON_AddItemToObject(root, "seg_instance", cJSON_CreateIntArray(m->seg_instance, m->nseg));
-  cJSON* cls = cJSON_AddArrayToObject(root, "seg_class");
-  for (int t = 0; t < m->nseg; t++) cJSON_AddItemToArray(cls, cJSON_CreateString(vd_sim_class_name(m->seg_class[t])));
-  cJSON* labels = cJSON_AddObjectToObject(root, "labels");
-  for (int k = 0; k < plant->nlabel; k++) {
-    char id[16];
-    snprintf(id, sizeof id, "%d", plant->labels[k].id);
-    cJSON_AddStringToObject(labels, id, plant->labels[k].name);
-  }
-  // what rebuilds this rod model: the initial plant and the build settings
-  cJSON_AddStringToObject(root, "initial_plant", "plant_initial.json");
-  cJSON_AddItemToObject(root, "build", cli_sim_def_json(def));
-  char* text = cJSON_PrintUnformatted(root);
-  cJSON_Delete(root);
-  if (!text) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  char path[4096];
-  snprintf(path, sizeof path, "%s/rod.json", dir);
-  vd_outfile f;
-  int w = cli_watch(path);
-  vd_status st = vd_outfile_open(&f, path, err);
-  if (!st) {
-    fputs(text, f.fp);
-    fputc('\n', f.fp);
-    st = vd_outfile_commit(&f, err);
-  }
-  cli_unwatch(w);
-  cJSON_free(text);
-  return st;
-}
-
 static const char* label_name(const vd_model* plant, int id) {
   const vd_label* l = vd_model_find_label(plant, id);
   return l ? l->name : "";
@@ -802,7 +666,7 @@ int cli_sim(int argc, char** argv) {
   double* wind = NULL;
   int nwind = 0;
   vd_sdf* sdf[8] = {NULL};
-  outputs out;
+  cli_frames out;
   memset(&out, 0, sizeof out);
   out.watch = out.cwatch = -1;
   cli_grow_info info;
@@ -875,13 +739,13 @@ int cli_sim(int argc, char** argv) {
     goto done;
   }
   if (o.out) {
-    st = write_rod_json(m, plant, &o.def, o.out, &err);
+    st = cli_rod_json_write(m, plant, &o.def, o.out, &err);
     if (!st) {
       char path[4096];
       snprintf(path, sizeof path, "%s/plant_initial.json", o.out);
       st = vd_plant_write_json(spec, path, &err);
     }
-    if (!st && strcmp(o.frames, "none") != 0) st = frames_begin(&out, m, o.out, !strcmp(o.frames, "jsonl"), &err);
+    if (!st && strcmp(o.frames, "none") != 0) st = cli_frames_begin(&out, m, o.out, !strcmp(o.frames, "jsonl"), &err);
     if (st) {
       cli_report("sim", &err, st);
       code = EXIT_FAIL;
@@ -904,7 +768,7 @@ int cli_sim(int argc, char** argv) {
     double start = d->time, total = o.duration, next_frame = start;
     double ramp = o.ramp_set ? o.ramp : total;
     int show = o.po.progress && total / m->opt.dt > 2000;
-    if (out.frames_open) frames_write(&out, m, d), next_frame += 1.0 / o.fps;
+    if (out.frames_open) cli_frames_write(&out, m, d), next_frame += 1.0 / o.fps;
     for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
       double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
       for (int k = 0; k < o.npull; k++) {
@@ -922,7 +786,7 @@ int cli_sim(int argc, char** argv) {
       }
       st = vd_sim_step(m, d);
       if (out.frames_open && d->time >= next_frame - 1e-12) {
-        if (frames_write(&out, m, d)) break;  // reported by the commit below
+        if (cli_frames_write(&out, m, d)) break;  // reported by the commit below
         next_frame += 1.0 / o.fps;
       }
       if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);

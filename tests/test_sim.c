@@ -506,7 +506,7 @@ TEST(sim, self_contact_projection) {
   for (int k = 0; k < 4; k++) mom0 = vd_madd(mom0, d->node_pos[nodes[k]], d->node_mass[nodes[k]]);
   sim_contact c = {-1, s1, 0.5, m->seg_radius[s1], -1, 0, -1, s2, 0.5, m->seg_radius[s2]};
   CHECK(sim_contact_gap(m, d, &c) < -0.003);
-  for (int it = 0; it < 5; it++) sim_contacts_project(m, d, &c, 1);
+  for (int it = 0; it < 5; it++) sim_contacts_project(m, d, &c, 1, m->opt.dt);
   CHECK(sim_contact_gap(m, d, &c) > -1e-9);
   vd_vec3 mom1 = vd_v3(0, 0, 0);
   for (int k = 0; k < 4; k++) mom1 = vd_madd(mom1, d->node_pos[nodes[k]], d->node_mass[nodes[k]]);

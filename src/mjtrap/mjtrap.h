@@ -48,6 +48,12 @@ vd_status vd_mj_trap_status(const vd_mj_trap* t, vd_error* err);
 // Innermost open trap of this thread, NULL when none.
 vd_mj_trap* vd_mj_trap_current(void);
 
+struct mjModel_;
+// Load an MJCF file (MuJoCo's mj_loadXML under a trap): VD_ERR_IO when it cannot be opened,
+// VD_ERR_FORMAT with MuJoCo's message on one line, the file and the line where MuJoCo names one,
+// prefixed by what ("robot MJCF").
+vd_status vd_mj_load_xml(const char* path, const char* what, struct mjModel_** out, vd_error* err);
+
 // Open a trap and set its jump point: true on entry, false when a MuJoCo error jumped back
 // (the trap is closed by then).
 #define VD_MJ_TRY(t) (vd_mj_trap_begin(t), setjmp((t)->env) == 0)

@@ -2,6 +2,7 @@
 // MuJoCo error trap (mjtrap.h): hooks that longjmp to the innermost open trap of the thread.
 #include "mjtrap.h"
 
+#include <errno.h>
 #include <mujoco/mujoco.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -59,4 +60,33 @@ vd_status vd_mj_trap_status(const vd_mj_trap* t, vd_error* err) {
 
 vd_mj_trap* vd_mj_trap_current(void) {
   return open_trap;
+}
+
+vd_status vd_mj_load_xml(const char* path, const char* what, mjModel** out, vd_error* err) {
+  *out = NULL;
+  FILE* f = fopen(path, "rb");
+  if (!f) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot open: %s", strerror(errno));
+  fclose(f);
+  vd_mj_trap_install();
+  char msg[1000] = "";
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap)) return vd_error_set(err, VD_ERR_FORMAT, path, 0, 0, "%s: MuJoCo: %s", what, trap.error);
+  mjModel* m = mj_loadXML(path, NULL, msg, sizeof msg);
+  vd_mj_trap_end(&trap);
+  if (m) {
+    *out = m;
+    return VD_OK;
+  }
+  // MuJoCo's message spans lines ("XML parse error 7:\nError=... Line number=5: ..."): one line,
+  // with the line number where the parser gives one
+  long line = 0;
+  const char* ln = strstr(msg, "Line number=");
+  if (!ln) ln = strstr(msg, "line ");
+  if (ln) line = strtol(ln + (ln[0] == 'L' ? 12 : 5), NULL, 10);
+  for (char* c = msg; *c; c++)
+    if (*c == '\n' || *c == '\r') *c = ' ';
+  size_t n = strlen(msg);
+  while (n && msg[n - 1] == ' ') msg[--n] = 0;
+  return vd_error_set(err, VD_ERR_FORMAT, path, line > 0 && line < 1000000000 ? (int)line : 0, 0,
+                      "%s: %s", what, msg[0] ? msg : "MuJoCo could not load it");
 }

@@ -113,26 +113,7 @@ static mjModel* load_model(vd_renderer* r, vd_status* st, vd_error* err) {
   char msg[1000] = "";
   mjModel* m = NULL;
   if (r->def.robot_mjcf) {
-    FILE* f = fopen(r->robot_path, "rb");
-    if (!f) {
-      *st = vd_error_set(err, VD_ERR_IO, r->robot_path, 0, 0, "cannot open: %s", strerror(errno));
-      return NULL;
-    }
-    fclose(f);
-    m = mj_loadXML(r->robot_path, NULL, msg, sizeof msg);
-    if (!m) {
-      // MuJoCo's message spans lines ("XML parse error 7:\nError=... Line number=5: ..."): one
-      // line, with the line number where the parser gives one
-      long line = 0;
-      const char* ln = strstr(msg, "Line number=");
-      if (ln) line = strtol(ln + 12, NULL, 10);
-      for (char* c = msg; *c; c++)
-        if (*c == '\n' || *c == '\r') *c = ' ';
-      size_t n = strlen(msg);
-      while (n && msg[n - 1] == ' ') msg[--n] = 0;
-      *st = vd_error_set(err, VD_ERR_FORMAT, r->robot_path, line > 0 && line < 1000000000 ? (int)line : 0, 0,
-                          "robot MJCF: %s", msg);
-    }
+    *st = vd_mj_load_xml(r->robot_path, "robot MJCF", &m, err);
     return m;
   }
   char xml[4096];

@@ -128,6 +128,36 @@ static double seg_param(const vd_sim_collider* k, vd_vec3 a, vd_vec3 b) {
   }
 }
 
+// radius of a ball around the collider's pos holding the whole shape (m); planes: infinite
+static double collider_reach(const vd_sim_collider* k) {
+  switch (k->shape) {
+    case VD_SIM_SPHERE: return k->size[0];
+    case VD_SIM_CAPSULE: return k->size[0] + k->size[1];
+    case VD_SIM_BOX: return sqrt(k->size[0] * k->size[0] + k->size[1] * k->size[1] + k->size[2] * k->size[2]);
+    case VD_SIM_MESH: {
+      // the grid's box around the mesh frame's origin: its farthest corner
+      if (!k->sdf) return 0;
+      const vd_sdf* g = k->sdf;
+      double r2 = 0;
+      for (int c = 0; c < 8; c++) {
+        vd_vec3 p = vd_v3(g->origin.x + ((c & 1) ? (g->nx - 1) * g->cell : 0),
+                          g->origin.y + ((c & 2) ? (g->ny - 1) * g->cell : 0),
+                          g->origin.z + ((c & 4) ? (g->nz - 1) * g->cell : 0));
+        double q = vd_dot(p, p);
+        if (q > r2) r2 = q;
+      }
+      return sqrt(r2);
+    }
+    default: return INFINITY;
+  }
+}
+
+// squared distance from point p to segment a-b
+static double seg_dist2(vd_vec3 a, vd_vec3 b, vd_vec3 p) {
+  vd_vec3 q = vd_sub(vd_add(a, vd_scale(vd_sub(b, a), closest_t(a, b, p))), p);
+  return vd_dot(q, q);
+}
+
 // how far the plant reaches beyond each node towards a plane of normal n (m), -1 where nothing
 // is attached. A rod segment is a cylinder with flat ends: its deepest point towards the
 // plane lies on the rim of an end disk, r sqrt(1 - (n.u)^2) beyond the axis (u its direction),
@@ -167,10 +197,14 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
     // nodes: every moving node against planes (with the rod's reach towards the plane), fruit
     // spheres against the rest
     if (col->shape == VD_SIM_PLANE) plane_reach(m, d, q_rotate(col->quat, vd_v3(0, 0, 1)), reach);
+    // a ball around the shape: elements beyond it (plus their radius) are skipped at once
+    double far = collider_reach(col) + margin;
     for (int i = 0; i < m->nnode_all; i++) {
-      if (sim_node_w(m, d, i) <= 0) continue;
+      if (sim_node_w(m, d, i) <= 0 || i == d->collider_pass[k]) continue;
       double r = col->shape == VD_SIM_PLANE ? reach[i] : m->node_sphere[i];
       if (r < 0 || (r == 0 && col->shape != VD_SIM_PLANE)) continue;
+      vd_vec3 dp = vd_sub(d->node_pos[i], col->pos);
+      if (vd_dot(dp, dp) > (far + r) * (far + r)) continue;
       if (sim_collider_distance(col, d->node_pos[i], &nrm) - r < margin)
         c[n++] = (sim_contact){i, -1, 0, r, k, 0, -1, -1, 0, 0};
     }
@@ -180,8 +214,9 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
       if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
       int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
       vd_vec3 a = d->node_pos[na], b = d->node_pos[nb];
-      double u = seg_param(col, a, b);
       double r = m->seg_radius[t];
+      if (seg_dist2(a, b, col->pos) > (far + r) * (far + r)) continue;
+      double u = seg_param(col, a, b);
       if (sim_collider_distance(col, vd_add(a, vd_scale(vd_sub(b, a), u)), &nrm) - r < margin)
         c[n++] = (sim_contact){-1, t, u, r, k, 0, -1, -1, 0, 0};
     }
@@ -241,19 +276,30 @@ double sim_contact_gap(const vd_sim_model* m, const vd_sim_data* d, sim_contact*
   return v_norm(vd_sub(q.p, q2.p)) - c->radius - c->radius2;
 }
 
-// move the contact point by dp, sharing the motion by inverse mass
-static void move_point(vd_sim_data* d, const cpoint* q, vd_vec3 dp) {
-  if (q->w <= 0) return;
+// move the contact point by dp, sharing the motion by inverse mass; returns the mass-weighted
+// displacement sum m_i dx_i (the momentum given to the plant, times h) (kg m)
+static vd_vec3 move_point(vd_sim_data* d, const cpoint* q, vd_vec3 dp) {
+  if (q->w <= 0) return vd_v3(0, 0, 0);
   vd_vec3 k = vd_scale(dp, 1.0 / q->w);
   if (q->na == q->nb) {
     d->node_pos[q->na] = vd_add(d->node_pos[q->na], dp);
-    return;
+    return vd_scale(dp, d->node_mass[q->na]);
   }
   d->node_pos[q->na] = vd_madd(d->node_pos[q->na], k, q->ca * q->wa);
   d->node_pos[q->nb] = vd_madd(d->node_pos[q->nb], k, q->cb * q->wb);
+  return vd_scale(k, (q->wa > 0 ? q->ca : 0) + (q->wb > 0 ? q->cb : 0));
 }
 
-void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n) {
+// the reaction of a collider contact at point p: the collider receives minus the momentum mdx / h
+// it gave the plant (accumulated per step in the work block)
+static void collider_reaction(const vd_sim_data* d, int k, vd_vec3 p, vd_vec3 mdx, double h) {
+  sim_work* w = (sim_work*)d->work;
+  vd_vec3 j = vd_scale(mdx, -1.0 / h);
+  w->col_imp[k] = vd_add(w->col_imp[k], j);
+  w->col_ang[k] = vd_add(w->col_ang[k], vd_cross(vd_sub(p, d->collider[k].pos), j));
+}
+
+void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n, double h) {
   for (int i = 0; i < n; i++) {
     cpoint q = contact_point(m, d, &c[i]);
     vd_vec3 nrm;
@@ -261,7 +307,7 @@ void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c,
       if (q.w <= 0) continue;
       double s = sim_collider_distance(&d->collider[c[i].collider], q.p, &nrm) - c[i].radius;
       if (s >= 0) continue;
-      move_point(d, &q, vd_scale(nrm, -s));
+      collider_reaction(d, c[i].collider, q.p, move_point(d, &q, vd_scale(nrm, -s)), h);
       c[i].lambda += -s;
       continue;
     }
@@ -295,6 +341,6 @@ void sim_contacts_friction(const vd_sim_model* m, vd_sim_data* d, sim_contact* c
     if (lt <= 0) continue;
     // static friction cancels the slip; kinetic friction removes mu times the normal push
     double k = lt <= lim ? 1.0 : lim / lt;
-    move_point(d, &q, vd_scale(dt, -k));
+    collider_reaction(d, c[i].collider, q.p, move_point(d, &q, vd_scale(dt, -k)), h);
   }
 }

@@ -129,6 +129,8 @@ int vd_sim_add_collider(vd_sim_data* d, const vd_sim_collider* c) {
   if (d->ncollider >= VD_SIM_MAX_COLLIDERS) return -1;
   d->collider[d->ncollider] = *c;
   d->collider[d->ncollider].quat = q_normalize(c->quat);
+  d->collider_force[d->ncollider] = d->collider_torque[d->ncollider] = vd_v3(0, 0, 0);
+  d->collider_pass[d->ncollider] = -1;
   return d->ncollider++;
 }
 

@@ -364,7 +364,7 @@ int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   int iters = c->statics && m->opt.iterations < 4 ? 4 : m->opt.iterations;
   for (int it = 0; it < iters; it++) {
     if (!iterate(m, d, w, c)) return 0;
-    if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact);
+    if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact, c->h);
   }
   return 1;
 }

@@ -122,6 +122,6 @@ void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c) 
       project_bend(m, d, t, c, cp);
     }
     project_ties(m, d, c);
-    if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact);
+    if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact, c->h);
   }
 }

@@ -195,6 +195,8 @@ typedef struct sim_work {
   int model_ties;       // stake ties of the model (the first rows)
   int gravity_only;     // scratch flag
   sim_self self;        // self-collision primitives and exclusion
+  vd_vec3 col_imp[VD_SIM_MAX_COLLIDERS];  // impulse of this step's contacts on each collider (N s)
+  vd_vec3 col_ang[VD_SIM_MAX_COLLIDERS];  // its moment about the collider's pos (N m s)
   double strain;        // largest stretch strain at the end of the last step (-)
 } sim_work;
 
@@ -264,8 +266,9 @@ void sim_self_free(sim_self* s);
 // the joined list (in the arena). Returns the new count.
 int sim_self_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_contact* prev, int nprev,
                   sim_contact** out);
-// Project contacts: push penetrating rod elements out of the colliders (compliance 0).
-void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n);
+// Project contacts: push penetrating rod elements out of the colliders (compliance 0); the
+// reactions on the colliders of a step of h (s) go to the work block's col_imp / col_ang.
+void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n, double h);
 // Coulomb friction on the step's tangential motion at each active contact.
 void sim_contacts_friction(const vd_sim_model* m, vd_sim_data* d, sim_contact* c, int n, double h);
 // Signed gap of contact c at the current state (m, negative when penetrating).

@@ -135,6 +135,8 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   double h = c.h;
   int na = m->nnode_all, ns = m->nseg;
   vd_arena_reset(&d->arena);
+  memset(w->col_imp, 0, sizeof w->col_imp);
+  memset(w->col_ang, 0, sizeof w->col_ang);
   // the stretch at the start: a step may not double it beyond VD_SIM_MAX_STRAIN (a stretch the
   // state already had, e.g. from a contact holding a node, is not a new failure)
   double strain0 = c.statics ? 0 : max_stretch(m, d);
@@ -204,7 +206,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   d->ncontact = c.ncontact;
   d->max_penetration = 0;
   if (c.ncontact) {
-    sim_contacts_project(m, d, c.contacts, c.ncontact);
+    sim_contacts_project(m, d, c.contacts, c.ncontact, h);
     sim_contacts_friction(m, d, c.contacts, c.ncontact, h);
     for (int k = 0; k < c.ncontact; k++) {
       double s = sim_contact_gap(m, d, &c.contacts[k]);
@@ -243,6 +245,11 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     d->seg_omega[t] = vd_scale(dq, damp / h);
   }
   if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
+  // the step's reactions on the colliders (impulses; vd_sim_step makes them forces)
+  for (int k = 0; k < d->ncollider; k++) {
+    d->collider_force[k] = vd_add(d->collider_force[k], w->col_imp[k]);
+    d->collider_torque[k] = vd_add(d->collider_torque[k], w->col_ang[k]);
+  }
   for (int k = 0; k < d->ncollider; k++) d->collider[k].vel = vd_v3(0, 0, 0);
   d->time += c.statics ? 0.0 : h;
   return -1;
@@ -268,10 +275,26 @@ static vd_status step_retake(const vd_sim_model* m, vd_sim_data* d, const sim_st
   return st ? st : step_retake(m, d, base, 0.5 * h, depth + 1);
 }
 
+// collider reactions of the step(s) to come: impulses summed from zero (step_core)
+static void reactions_begin(vd_sim_data* d) {
+  memset(d->collider_force, 0, sizeof d->collider_force);
+  memset(d->collider_torque, 0, sizeof d->collider_torque);
+}
+
+// ... divided by the time they span: mean forces and moments (N, N m)
+static void reactions_end(vd_sim_data* d, double h) {
+  for (int k = 0; k < d->ncollider; k++) {
+    d->collider_force[k] = vd_scale(d->collider_force[k], 1.0 / h);
+    d->collider_torque[k] = vd_scale(d->collider_torque[k], 1.0 / h);
+  }
+}
+
 vd_status vd_sim_step(const vd_sim_model* m, vd_sim_data* d) {
   sim_step_ctx c;
   memset(&c, 0, sizeof c);
+  reactions_begin(d);
   vd_status st = step_retake(m, d, &c, m->opt.dt, 0);
+  reactions_end(d, m->opt.dt);
   if (!st) d->nstep++;
   if (!st && ((sim_work*)d->work)->strain > VD_SIM_MAX_STRAIN) sim_warn(d, VD_SIM_WARN_STRETCHED);
   return st;
@@ -301,7 +324,10 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
     // still means below the tolerance for a quarter second in a row (not one turning point)
     double t0 = d->time, calm = 0;
     while (d->time - t0 < s->max_time) {
-      if ((st = step_retake(m, d, &c, m->opt.dt, 0))) break;
+      reactions_begin(d);
+      st = step_retake(m, d, &c, m->opt.dt, 0);
+      reactions_end(d, m->opt.dt);
+      if (st) break;
       d->nstep++;
       if (w->strain > VD_SIM_MAX_STRAIN) sim_warn(d, VD_SIM_WARN_STRETCHED);
       n++;

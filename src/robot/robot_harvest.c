@@ -1,0 +1,761 @@
+// SPDX-License-Identifier: MIT
+// Harvest episodes: the coupling loop of robot and plant, the grasp (touch, tie, slip, release),
+// detachment and the other outcomes, observations and the summary.
+//
+// One robot step (the MJCF's timestep):
+//   mj_step1 (positions, velocities, the servos' bias forces) -> gravity compensation of the arm
+//   -> every robot collider's pose -> nsub plant steps, the collider poses (and the grasp tie's
+//   target) interpolated from the previous robot step's poses to these -> the colliders' contact
+//   forces, averaged over the substeps -> two-way: their reactions (and the held fruit's pull)
+//   as xfrc_applied on the robot bodies -> mj_step2.
+// The plant thus sees the robot one robot step late (2 ms with the bundled robots), and the
+// robot feels the plant's reaction of the step before: the usual explicit co-simulation.
+#include <stdio.h>
+#include <string.h>
+
+#include "robot_internal.h"
+
+#define GRIP_SPEED 0.02  // finger target speed (m/s): closes 20 mm in a second
+
+const char* vd_harvest_phase_name(vd_harvest_phase p) {
+  static const char* n[VD_PHASE_COUNT] = {"external", "approach", "reach", "close",
+                                          "detach",   "hold",     "done"};
+  return p >= 0 && p < VD_PHASE_COUNT ? n[p] : "?";
+}
+
+const char* vd_harvest_site_name(vd_harvest_site s) {
+  static const char* n[VD_SITE_COUNT] = {"none", "calyx", "abscission", "elsewhere"};
+  return s >= 0 && s < VD_SITE_COUNT ? n[s] : "?";
+}
+
+const char* vd_harvest_event_name(vd_harvest_event_kind k) {
+  static const char* n[VD_EV_KIND_COUNT] = {"phase",  "touch",  "grasp", "slip", "release",
+                                            "fracture", "detach", "hit",  "drop", "ik"};
+  return k >= 0 && k < VD_EV_KIND_COUNT ? n[k] : "?";
+}
+
+// ---------------------------------------------------------------------------------------------
+// events and the end
+
+void harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg, int instance) {
+  if (!vd_grow((void**)&h->ev, &h->cap_ev, h->nev + 1, sizeof *h->ev)) return;  // log full: dropped
+  vd_harvest_event* e = &h->ev[h->nev++];
+  memset(e, 0, sizeof *e);
+  e->time = h->sd->time;
+  e->kind = k;
+  e->value = value;
+  e->seg = seg;
+  e->instance = instance;
+  e->cls = seg >= 0 ? h->sm->seg_class[seg] : -1;
+}
+
+void harvest_finish(vd_harvest* h, const char* reason) {
+  if (h->done) return;
+  h->done = 1;
+  snprintf(h->reason, sizeof h->reason, "%s", reason);
+  if (h->phase != VD_PHASE_EXTERNAL) control_set_phase(h, VD_PHASE_DONE);
+}
+
+// remove the grasp tie (the last user tie of the state) and let the fingers touch the fruit again
+static void tie_remove(vd_harvest* h) {
+  if (h->tie >= 0 && h->tie < h->sd->ntie) {
+    h->sd->tie[h->tie] = h->sd->tie[h->sd->ntie - 1];
+    h->sd->ntie--;
+  }
+  h->tie = -1;
+  for (int k = 0; k < h->ncol; k++) h->sd->collider_pass[h->col[k].sim] = -1;
+  if (h->target >= 0) h->sd->seg_torque[h->fruit[h->target].seg] = vd_v3(0, 0, 0);
+  h->held = 0;
+}
+
+void harvest_release(vd_harvest* h) {
+  if (!h->held) return;
+  tie_remove(h);
+  harvest_event(h, VD_EV_RELEASE, 0, -1, h->target >= 0 ? h->fruit[h->target].instance : 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// creation and reset
+
+static void harvest_free_parts(vd_harvest* h) {
+  robot_free(h);
+  if (h->sm) vd_free(h->on, (size_t)h->sm->nseg + 1);
+  vd_sim_data_destroy(h->sd);
+  vd_sim_model_destroy(h->sm);
+  vd_free(h->ev, (size_t)h->cap_ev * sizeof *h->ev);
+  vd_scene_free(&h->scene);
+}
+
+void vd_harvest_destroy(vd_harvest* h) {
+  if (!h) return;
+  harvest_free_parts(h);
+  vd_free(h, sizeof *h);
+}
+
+vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_harvest** out,
+                            vd_error* err) {
+  *out = NULL;
+  vd_mj_trap_install();
+  vd_harvest* h = vd_calloc(1, sizeof *h);
+  if (!h) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  h->tie = -1;
+  h->target = -1;
+  vd_status st = vd_scene_copy(scene, &h->scene, err);
+  if (st) {
+    vd_free(h, sizeof *h);
+    return st;
+  }
+  h->plant = plant;
+  // the plant's rods, then the robot (its geoms become the plant's colliders)
+  st = vd_sim_build(plant, &h->scene.sim_def, &h->sm, err);
+  if (!st) {
+    h->sm->opt = h->scene.sim_opt;
+    h->sd = vd_sim_data_create(h->sm);
+    h->on = vd_malloc((size_t)h->sm->nseg + 1);
+    if (!h->sd || !h->on) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory (plant state)");
+  }
+  if (!st) st = robot_load(h, err);
+  if (!st && isfinite(h->scene.ground)) {
+    vd_sim_collider g;
+    memset(&g, 0, sizeof g);
+    g.shape = VD_SIM_PLANE;
+    g.pos = vd_v3(0, 0, h->scene.ground);
+    g.quat = vd_quat_identity();
+    if (vd_sim_add_collider(h->sd, &g) < 0)
+      st = vd_error_set(err, VD_ERR_LIMIT, "", 0, 0, "no room for the ground collider");
+  }
+  if (!st) {
+    vd_mj_trap trap;
+    if (VD_MJ_TRY(&trap)) {
+      mj_forward(h->m, h->d);
+      vd_mj_trap_end(&trap);
+    } else {
+      st = vd_mj_trap_status(&trap, err);
+    }
+  }
+  if (!st) st = robot_colliders(h, err);
+  if (st) {
+    vd_harvest_destroy(h);
+    return st;
+  }
+  st = vd_harvest_reset(h, 0, err);
+  if (st && st != VD_ERR_VALUE) {
+    vd_harvest_destroy(h);
+    return st;
+  }
+  // a target that cannot be reached is an outcome (the episode is done), not a failure
+  *out = h;
+  return st;
+}
+
+// is fruit f still on the plant? else *seg gets the broken joint nearest the fruit
+static int fruit_attached(const vd_harvest* h, int f, int* seg) {
+  const vd_sim_model* m = h->sm;
+  for (int t = h->fruit[f].seg; t >= 0; t = m->seg_parent[t])
+    if (h->sd->seg_broken[t]) {
+      if (seg) *seg = t;
+      return 0;
+    }
+  return 1;
+}
+
+// the grasp pose of fruit f is reachable from q0 through its pre-grasp pose
+static int reachable(vd_harvest* h, int f, double* ik_err) {
+  vd_vec3 pos, a, p;
+  vd_quat rot;
+  control_grasp_pose(h, f, &pos, &rot, &a, &p);
+  double q[VD_ROBOT_MAX_JOINTS], e1, r1, e2, r2;
+  memcpy(q, h->q0, sizeof q);
+  vd_ik_def def = vd_ik_def_default();
+  def.max_iter = 400;
+  vd_vec3 pre = vd_madd(pos, a, -h->scene.method.pregrasp);
+  robot_ik(h, &def, pre, &rot, q, &e1, &r1);
+  memcpy(h->qpre, q, sizeof q);
+  robot_ik(h, &def, pos, &rot, q, &e2, &r2);
+  if (ik_err) *ik_err = e2;
+  return e1 < 1e-3 && e2 < 1e-3 && r1 < 1e-2 && r2 < 1e-2;
+}
+
+// base of the robot (for "nearest")
+static vd_vec3 base_pos(const vd_harvest* h) {
+  int r = h->root_body;
+  return vd_v3(h->d->xpos[3 * r], h->d->xpos[3 * r + 1], h->d->xpos[3 * r + 2]);
+}
+
+// choose the target fruit; -1 with the episode finished when there is none
+static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
+  const vd_scene* s = &h->scene;
+  h->target = -1;
+  if (!h->nfruit) {
+    harvest_finish(h, "no fruit");
+    return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0, "the plant has no fruit");
+  }
+  int random = s->target_instance < 0;
+  if (s->target_instance > 0) {
+    for (int f = 0; f < h->nfruit; f++)
+      if (h->fruit[f].instance == s->target_instance) h->target = f;
+    if (h->target < 0)
+      return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0,
+                          "target.fruit: the plant has no fruit with instance %d",
+                          s->target_instance);
+    if (!reachable(h, h->target, &h->grasp_ik_err)) harvest_finish(h, "unreachable");
+    return VD_OK;
+  }
+  // fruits by distance from the robot's base (instance breaks ties), the reachable ones
+  vd_vec3 b = base_pos(h);
+  int* order = vd_malloc((size_t)h->nfruit * sizeof(int));
+  if (!order) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  for (int f = 0; f < h->nfruit; f++) order[f] = f;
+  for (int i = 1; i < h->nfruit; i++)
+    for (int k = i; k > 0; k--) {
+      int x = order[k - 1], y = order[k];
+      double dx = vd_norm(vd_sub(h->sd->node_pos[h->fruit[x].node], b));
+      double dy = vd_norm(vd_sub(h->sd->node_pos[h->fruit[y].node], b));
+      if (dx < dy || (dx == dy && h->fruit[x].instance < h->fruit[y].instance)) break;
+      order[k - 1] = y, order[k] = x;
+    }
+  int nok = 0;
+  for (int i = 0; i < h->nfruit; i++) {
+    double e;
+    if (!reachable(h, order[i], &e)) continue;
+    order[nok++] = order[i];
+    if (!random) break;
+  }
+  if (nok) {
+    int pick = 0;
+    if (random) {
+      vd_rng* g = vd_malloc(sizeof *g);
+      if (g) {
+        vd_rng_seed(g, seed);
+        pick = (int)vd_rng_randint(g, 0, nok - 1);
+        vd_free(g, sizeof *g);
+      }
+    }
+    h->target = order[pick];
+    reachable(h, h->target, &h->grasp_ik_err);
+  }
+  vd_free(order, (size_t)h->nfruit * sizeof(int));
+  if (h->target < 0) harvest_finish(h, "no reachable fruit");
+  return VD_OK;
+}
+
+vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
+  mjModel* m = h->m;
+  mjData* d = h->d;
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap)) {
+    h->done = 1;
+    return vd_mj_trap_status(&trap, err);
+  }
+  // robot at q0, gripper open
+  mj_resetData(m, d);
+  for (int k = 0; k < h->narm; k++) {
+    d->qpos[h->arm_qpos[k]] = h->q0[k];
+    d->ctrl[h->arm_act[k]] = h->q0[k];
+    h->qcmd[k] = h->q0[k];
+  }
+  for (int k = 0; k < 2; k++) {
+    d->qpos[h->grip_qpos[k]] = h->scene.gripper_open;
+    d->ctrl[h->grip_act[k]] = h->scene.gripper_open;
+  }
+  mj_forward(m, d);
+  vd_mj_trap_end(&trap);
+  // plant at its modelled shape, colliders at the robot's pose
+  vd_sim_data_reset(h->sm, h->sd);
+  h->sd->ntie = 0;
+  for (int k = 0; k < h->ncol; k++) {
+    robot_collider* c = &h->col[k];
+    c->cur = c->prev = c->shape.pose = robot_geom_pose(m, d, c->geom);
+    vd_sim_collider* sc = &h->sd->collider[c->sim];
+    sc->pos = c->cur.pos, sc->quat = c->cur.rot, sc->vel = vd_v3(0, 0, 0);
+    h->sd->collider_pass[c->sim] = -1;
+  }
+  // episode state
+  robot_site_pose(h, d, &h->ee_pos, &h->ee_quat);
+  h->xcmd = h->ee_pos, h->rcmd = h->ee_quat;
+  h->grip_cmd = 0;
+  h->ik_err = 0;
+  h->joint_move = 0;
+  h->held = h->ever_held = 0, h->tie = -1;
+  h->slip = 0;
+  h->pull_force = h->pull_torque = h->robot_force = vd_v3(0, 0, 0);
+  h->touching[0] = h->touching[1] = h->touched[0] = h->touched[1] = 0;
+  h->finger_force[0] = h->finger_force[1] = 0;
+  h->detached = 0, h->site = VD_SITE_NONE;
+  h->detach_time = h->detach_force = h->detach_moment = h->detach_pull = 0;
+  h->max_pull = h->max_disp = h->grasp_ik_err = h->grasp_track_err = h->pull_at_break = 0;
+  h->done = 0, h->reason[0] = 0;
+  h->nevent_seen = 0, h->nev = 0, h->step = 0;
+  for (int f = 0; f < h->nfruit; f++) h->fruit[f].hit = h->fruit[f].dropped = 0;
+  h->scripted = 1;
+  h->phase = VD_PHASE_APPROACH;
+  vd_status st = choose_target(h, seed, err);
+  if (!st && !h->done) control_begin(h);
+  return st ? st : (h->target < 0 || h->done) ? vd_error_set(err, VD_ERR_VALUE, h->scene.path, 0, 0, "%s", h->reason) : VD_OK;
+}
+
+// ---------------------------------------------------------------------------------------------
+// one robot step with its plant substeps
+
+static vd_pose pose_lerp(vd_pose a, vd_pose b, double t) {
+  vd_pose p;
+  p.pos = vd_add(vd_scale(a.pos, 1 - t), vd_scale(b.pos, t));
+  p.rot = vd_quat_mul(quat_exp_v(vd_scale(quat_log_v(vd_quat_mul(b.rot, vd_quat_conj(a.rot))), t)), a.rot);
+  return p;
+}
+
+// the grasp tie's target and the torsion spring on the held fruit at end-effector pose e
+static void grasp_drive(vd_harvest* h, vd_pose e, vd_vec3* torque) {
+  const robot_fruit* f = &h->fruit[h->target];
+  vd_sim_data* sd = h->sd;
+  sd->tie[h->tie].target = vd_add(e.pos, vd_quat_rotate(e.rot, h->hold_local));
+  // orientation: a spring on the fruit's stalk frame, stable explicitly (k h^2 / I = 0.5)
+  int t = f->seg;
+  double ib = h->sm->seg_inertia[2 * t], it = h->sm->seg_inertia[2 * t + 1], dt = h->sm->opt.dt;
+  double inr = ib < it ? ib : it, k = 0.5 * inr / (dt * dt), c = sqrt(k * inr);
+  vd_quat want = vd_quat_mul(e.rot, h->hold_rot);
+  vd_vec3 tau = vd_sub(vd_scale(quat_log_v(vd_quat_mul(want, vd_quat_conj(sd->seg_quat[t]))), k),
+                       vd_scale(sd->seg_omega[t], c));
+  // the grip's friction torque bounds it: mu * 2 F_grip * r
+  const vd_method_def* md = &h->scene.method;
+  double lim = md->grip_friction * 2 * md->grip_force * f->radius, n = vd_norm(tau);
+  if (n > lim && n > 0) tau = vd_scale(tau, lim / n);
+  sd->seg_torque[t] = tau;
+  *torque = tau;
+}
+
+// after a plant substep: the tie's force on the gripper; slipping when beyond friction x grip
+static void grasp_slip(vd_harvest* h, vd_pose e, vd_vec3* force) {
+  const robot_fruit* f = &h->fruit[h->target];
+  vd_sim_data* sd = h->sd;
+  vd_vec3 p = sd->node_pos[f->node], tg = sd->tie[h->tie].target;
+  vd_vec3 fg = vd_scale(vd_sub(p, tg), 1.0 / ROBOT_TIE_COMPLIANCE);
+  const vd_method_def* md = &h->scene.method;
+  double lim = md->grip_friction * 2 * md->grip_force, n = vd_norm(fg);
+  if (n > lim) {
+    // the fruit slides in the fingers until the tie pulls with the friction limit
+    vd_vec3 nt = vd_add(p, vd_scale(vd_sub(tg, p), lim / n));
+    h->slip += vd_norm(vd_sub(nt, tg));
+    h->hold_local = vd_quat_rotate(vd_quat_conj(e.rot), vd_sub(nt, e.pos));
+    sd->tie[h->tie].target = nt;
+    fg = vd_scale(fg, lim / n);
+  }
+  *force = fg;
+}
+
+// the finger touches and forces on the target fruit, from the last robot step
+static void finger_contacts(vd_harvest* h, const vd_vec3* force) {
+  h->touching[0] = h->touching[1] = 0;
+  h->finger_force[0] = h->finger_force[1] = 0;
+  if (h->target < 0) return;
+  const robot_fruit* f = &h->fruit[h->target];
+  vd_vec3 p = h->sd->node_pos[f->node];
+  vd_vec3 fs[2] = {{0, 0, 0}, {0, 0, 0}};
+  for (int k = 0; k < h->ncol; k++) {
+    const robot_collider* c = &h->col[k];
+    if (c->finger < 0) continue;
+    if (vd_collide_sphere(&c->shape, p, f->radius).dist < ROBOT_TOUCH_GAP) h->touching[c->finger] = 1;
+    fs[c->finger] = vd_add(fs[c->finger], force[k]);
+  }
+  for (int k = 0; k < 2; k++) h->finger_force[k] = vd_norm(fs[k]);
+}
+
+// grasp the target when both fingers touch it hard enough while closing
+static void grasp_check(vd_harvest* h) {
+  if (h->held || h->target < 0 || h->grip_cmd < 0.5 || h->detached) return;
+  const robot_fruit* f = &h->fruit[h->target];
+  for (int k = 0; k < 2; k++)
+    if (h->touching[k] && !h->touched[k]) {
+      h->touched[k] = 1;
+      harvest_event(h, VD_EV_TOUCH, k, -1, f->instance);
+    }
+  double tf = h->scene.method.touch_force;
+  if (!(h->touching[0] && h->touching[1] && h->finger_force[0] >= tf && h->finger_force[1] >= tf))
+    return;
+  vd_sim_data* sd = h->sd;
+  vd_vec3 p = sd->node_pos[f->node];
+  h->tie = vd_sim_add_tie(sd, f->node, p, ROBOT_TIE_COMPLIANCE);
+  if (h->tie < 0) return;  // out of memory: try again next step
+  h->held = h->ever_held = 1;
+  h->slip = 0;
+  h->hold_local = vd_quat_rotate(vd_quat_conj(h->ee_quat), vd_sub(p, h->ee_pos));
+  h->hold_rot = vd_quat_mul(vd_quat_conj(h->ee_quat), sd->seg_quat[f->seg]);
+  for (int k = 0; k < 2; k++) h->finger_q[k] = h->d->qpos[h->grip_qpos[k]];
+  // the fingers hold the fruit through the tie now: they no longer push it
+  for (int k = 0; k < h->ncol; k++)
+    if (h->col[k].finger >= 0) sd->collider_pass[h->col[k].sim] = f->node;
+  h->grasp_track_err = vd_norm(vd_sub(h->ee_pos, h->xcmd));
+  harvest_event(h, VD_EV_GRASP, 0.5 * (h->finger_force[0] + h->finger_force[1]), -1, f->instance);
+}
+
+static vd_status robot_step(vd_harvest* h, vd_error* err) {
+  mjModel* m = h->m;
+  mjData* d = h->d;
+  vd_sim_data* sd = h->sd;
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
+  mj_step1(m, d);
+  // the arm's controller compensates gravity and the velocity-dependent forces
+  for (int k = 0; k < h->narm; k++) d->qfrc_applied[h->arm_dof[k]] = d->qfrc_bias[h->arm_dof[k]];
+  vd_mj_trap_end(&trap);
+  // poses at this robot step
+  for (int k = 0; k < h->ncol; k++) {
+    robot_collider* c = &h->col[k];
+    c->prev = c->cur;
+    c->cur = c->shape.pose = robot_geom_pose(m, d, c->geom);
+  }
+  vd_pose e0 = {h->ee_pos, h->ee_quat}, e1;
+  robot_site_pose(h, d, &e1.pos, &e1.rot);
+  // the plant's substeps
+  vd_vec3 force[ROBOT_MAX_COLLIDERS], torque[ROBOT_MAX_COLLIDERS];
+  vd_vec3 pull = {0, 0, 0}, twist = {0, 0, 0};
+  memset(force, 0, sizeof force);
+  memset(torque, 0, sizeof torque);
+  int held0 = h->held;
+  for (int s = 0; s < h->nsub; s++) {
+    double a = (double)(s + 1) / h->nsub;
+    for (int k = 0; k < h->ncol; k++) {
+      robot_collider* c = &h->col[k];
+      vd_pose p = pose_lerp(c->prev, c->cur, a);
+      vd_sim_set_collider_pose(h->sm, sd, c->sim, p.pos, p.rot);
+    }
+    vd_pose e = pose_lerp(e0, e1, a);
+    vd_vec3 tau = {0, 0, 0};
+    if (h->held) grasp_drive(h, e, &tau);
+    int nev = sd->nevent;
+    if (vd_sim_step(h->sm, sd))
+      return vd_error_set(err, VD_ERR_VALUE, "", 0, 0,
+                          "the plant simulation failed at t = %.4f s (non-finite or torn apart)", sd->time);
+    for (int k = 0; k < h->ncol; k++) {
+      force[k] = vd_add(force[k], sd->collider_force[h->col[k].sim]);
+      torque[k] = vd_add(torque[k], sd->collider_torque[h->col[k].sim]);
+    }
+    if (h->held) {
+      vd_vec3 fg;
+      grasp_slip(h, e, &fg);
+      pull = vd_add(pull, fg);
+      if (sd->nevent > nev) h->pull_at_break = vd_norm(fg);  // the force sensor at the break
+      twist = vd_sub(twist, tau);
+      if (h->slip > h->fruit[h->target].radius) {
+        harvest_event(h, VD_EV_SLIP, vd_norm(fg), -1, h->fruit[h->target].instance);
+        tie_remove(h);
+      }
+    }
+  }
+  double inv = 1.0 / h->nsub;
+  h->robot_force = vd_v3(0, 0, 0);
+  for (int k = 0; k < h->ncol; k++) {
+    force[k] = vd_scale(force[k], inv), torque[k] = vd_scale(torque[k], inv);
+    h->robot_force = vd_add(h->robot_force, force[k]);
+  }
+  h->pull_force = held0 ? vd_scale(pull, inv) : vd_v3(0, 0, 0);
+  h->pull_torque = held0 ? vd_scale(twist, inv) : vd_v3(0, 0, 0);
+  h->ee_pos = e1.pos, h->ee_quat = e1.rot;
+  // two-way: the plant's reactions on the robot bodies, as forces at their centres of mass
+  if (h->scene.two_way) {
+    for (int k = 0; k < h->ncol; k++) {
+      int b = h->col[k].body;
+      mjtNum* x = d->xfrc_applied + 6 * b;
+      memset(x, 0, 6 * sizeof(mjtNum));
+    }
+    int gb = m->site_bodyid[h->ee_site];
+    memset(d->xfrc_applied + 6 * gb, 0, 6 * sizeof(mjtNum));
+    for (int k = 0; k <= h->ncol; k++) {
+      int b;
+      vd_vec3 f, t, at;
+      if (k < h->ncol) {
+        b = h->col[k].body, f = force[k], t = torque[k], at = h->col[k].cur.pos;
+      } else {
+        b = gb, f = h->pull_force, t = h->pull_torque, at = e1.pos;
+        if (!held0) continue;
+      }
+      vd_vec3 com = vd_v3(d->xipos[3 * b], d->xipos[3 * b + 1], d->xipos[3 * b + 2]);
+      t = vd_add(t, vd_cross(vd_sub(at, com), f));
+      mjtNum* x = d->xfrc_applied + 6 * b;
+      x[0] += f.x, x[1] += f.y, x[2] += f.z, x[3] += t.x, x[4] += t.y, x[5] += t.z;
+    }
+  }
+  if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
+  mj_step2(m, d);
+  vd_mj_trap_end(&trap);
+  finger_contacts(h, force);
+  grasp_check(h);
+  return VD_OK;
+}
+
+// ---------------------------------------------------------------------------------------------
+// outcomes after each control step
+
+// largest displacement of the nodes still on the plant
+static double attached_displacement(const vd_harvest* h) {
+  const vd_sim_model* m = h->sm;
+  const vd_sim_data* d = h->sd;
+  double best = 0;
+  // a segment is on the plant when no joint between it and its root has broken (memo in h->on:
+  // -1 unknown, 0 off, 1 on)
+  signed char* on = h->on;
+  memset(on, -1, (size_t)m->nseg);
+  for (int t = 0; t < m->nseg; t++) {
+    int u = t;
+    while (u >= 0 && on[u] < 0 && !d->seg_broken[u]) u = m->seg_parent[u];
+    signed char v = (signed char)(u < 0 ? 1 : on[u] >= 0 ? on[u] : 0);
+    for (int x = t; x != u; x = m->seg_parent[x]) on[x] = v;
+    if (u >= 0 && on[u] < 0) on[u] = 0;
+    if (!on[t]) continue;
+    int n = m->seg_node[2 * t + 1];
+    double s = vd_norm(vd_sub(d->node_pos[n], m->node_pos0[n]));
+    if (s > best) best = s;
+  }
+  return best;
+}
+
+static void outcomes(vd_harvest* h) {
+  vd_sim_data* sd = h->sd;
+  // fractures
+  for (; h->nevent_seen < sd->nevent; h->nevent_seen++) {
+    const vd_sim_event* e = &sd->event[h->nevent_seen];
+    harvest_event(h, VD_EV_FRACTURE, e->force, e->seg, e->instance);
+    h->ev[h->nev - 1].force = e->force;
+    h->ev[h->nev - 1].moment = e->moment;
+  }
+  // the target
+  if (h->held) {
+    double pf = vd_norm(h->pull_force);
+    if (!h->detached && pf > h->max_pull) h->max_pull = pf;
+  }
+  int seg;
+  if (h->target >= 0 && !h->detached && !fruit_attached(h, h->target, &seg)) {
+    h->detached = 1;
+    h->detach_time = sd->time;
+    int cls = h->sm->seg_class[seg];
+    h->site = cls == VD_SIM_FRUIT ? VD_SITE_CALYX
+              : (cls == VD_SIM_PEDICEL && (h->sm->seg_flags[seg] & VD_SIM_ABSCISSION)) ? VD_SITE_ABSCISSION
+                                                                                        : VD_SITE_ELSEWHERE;
+    for (int k = sd->nevent - 1; k >= 0; k--)
+      if (sd->event[k].seg == seg) {
+        h->detach_force = sd->event[k].force;
+        h->detach_moment = sd->event[k].moment;
+        break;
+      }
+    h->detach_pull = h->held ? h->pull_at_break : 0;
+    harvest_event(h, VD_EV_DETACH, h->detach_pull, seg, h->fruit[h->target].instance);
+    vd_harvest_event* e = &h->ev[h->nev - 1];
+    e->site = h->site, e->force = h->detach_force, e->moment = h->detach_moment;
+  }
+  // other fruits: touched by the robot, come off
+  for (int f = 0; f < h->nfruit; f++) {
+    robot_fruit* fr = &h->fruit[f];
+    if (f == h->target) continue;
+    if (!fr->dropped && !fruit_attached(h, f, NULL)) {
+      fr->dropped = 1;
+      harvest_event(h, VD_EV_DROP, 0, -1, fr->instance);
+    }
+    if (fr->hit) continue;
+    vd_vec3 p = sd->node_pos[fr->node];
+    for (int k = 0; k < h->ncol && !fr->hit; k++)
+      if (vd_collide_sphere(&h->col[k].shape, p, fr->radius).dist < ROBOT_TOUCH_GAP) {
+        fr->hit = 1;
+        harvest_event(h, VD_EV_HIT, 0, -1, fr->instance);
+      }
+  }
+  double md = attached_displacement(h);
+  if (md > h->max_disp) h->max_disp = md;
+}
+
+// ---------------------------------------------------------------------------------------------
+// control steps
+
+static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_error* err) {
+  if (h->done) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the episode is over (reset it)");
+  const vd_scene* s = &h->scene;
+  double dt = s->control_dt;
+  // the commanded pose moves with the action; IK turns it into joint targets
+  h->grip_cmd = a->gripper < 0 ? 0 : a->gripper > 1 ? 1 : a->gripper;
+  vd_vec3 v = a->lin_vel, w = a->ang_vel;
+  if (!isfinite(v.x + v.y + v.z + w.x + w.y + w.z + h->grip_cmd))
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "action: velocities must be finite");
+  double q[VD_ROBOT_MAX_JOINTS], re = 0;
+  memcpy(q, h->qcmd, sizeof q);
+  if (h->joint_move) {
+    // joint space (the scripted approach): straight to the goal, every joint arriving together
+    memcpy(q, h->qgoal, sizeof q);
+  } else {
+    h->xcmd = vd_madd(h->xcmd, v, dt);
+    if (h->orient) h->rcmd = vd_quat_normalize(vd_quat_mul(quat_exp_v(vd_scale(w, dt)), h->rcmd));
+    vd_ik_def def = vd_ik_def_default();
+    def.max_iter = 30;
+    def.tol_pos = 1e-5;
+    def.tol_rot = 1e-4;
+    vd_mj_trap trap;
+    if (!VD_MJ_TRY(&trap)) {
+      harvest_finish(h, "MuJoCo error");
+      return vd_mj_trap_status(&trap, err);
+    }
+    robot_ik(h, &def, h->xcmd, &h->rcmd, q, &h->ik_err, &re);
+    vd_mj_trap_end(&trap);
+  }
+  // the joints' speed limits: the whole step scaled down so that the path stays the same
+  double sc = 1;
+  for (int k = 0; k < h->narm; k++) {
+    double dq = fabs(q[k] - h->qcmd[k]), lim = h->qd_max[k] * dt;
+    if (dq > lim && lim / dq < sc) sc = lim / dq;
+  }
+  for (int k = 0; k < h->narm; k++) h->qcmd[k] += sc * (q[k] - h->qcmd[k]);
+  if (h->joint_move || sc < 1) {
+    vd_quat r;
+    vd_vec3 x;
+    vd_harvest_fk(h, h->qcmd, &x, &r);
+    if (!h->joint_move) h->ik_err = vd_norm(vd_sub(x, h->xcmd));
+    h->xcmd = x;
+    if (h->orient) h->rcmd = r;
+  }
+  if (!h->joint_move && (h->ik_err > 5e-3 || re > 5e-2)) {
+    // out of reach: the command stops where the arm can be (no wind-up)
+    harvest_event(h, VD_EV_IK, h->ik_err, -1, 0);
+    vd_quat r;
+    vd_harvest_fk(h, h->qcmd, &h->xcmd, &r);
+    if (h->orient) h->rcmd = r;
+  }
+  mjData* d = h->d;
+  for (int k = 0; k < h->narm; k++) d->ctrl[h->arm_act[k]] = h->qcmd[k];
+  if (h->held && h->grip_cmd < 0.5) harvest_release(h);
+  for (int r = 0; r < h->nrobot; r++) {
+    // fingers: frozen on a held fruit, else their targets move toward the command
+    for (int k = 0; k < 2; k++) {
+      int act = h->grip_act[k];
+      if (h->held) {
+        d->ctrl[act] = h->finger_q[k];
+        continue;
+      }
+      double want = s->gripper_open + h->grip_cmd * (s->gripper_closed - s->gripper_open);
+      double step = GRIP_SPEED * h->m->opt.timestep, cur = d->ctrl[act];
+      d->ctrl[act] = cur + (want > cur + step ? step : want < cur - step ? -step : want - cur);
+    }
+    vd_status st = robot_step(h, err);
+    if (st) {
+      harvest_finish(h, "simulation failed");
+      return st;
+    }
+  }
+  h->step++;
+  outcomes(h);
+  if (h->sd->time >= s->duration - 1e-9) harvest_finish(h, h->detached ? "detached" : "time");
+  return VD_OK;
+}
+
+vd_status vd_harvest_step(vd_harvest* h, const vd_harvest_action* a, vd_error* err) {
+  if (h->scripted) {
+    h->scripted = 0;
+    h->joint_move = 0;
+    h->phase = VD_PHASE_EXTERNAL;
+  }
+  return control_step(h, a, err);
+}
+
+void vd_harvest_scripted_action(vd_harvest* h, vd_harvest_action* a) {
+  control_action(h, a);
+}
+
+vd_status vd_harvest_run(vd_harvest* h, vd_status (*on_step)(void* user, const vd_harvest* h),
+                         void* user, vd_error* err) {
+  vd_status st = VD_OK;
+  if (on_step && (st = on_step(user, h))) return st;
+  while (!h->done) {
+    vd_harvest_action a;
+    control_action(h, &a);
+    if ((st = control_step(h, &a, err))) return st;
+    control_after_step(h);
+    if (on_step && (st = on_step(user, h))) return st;
+  }
+  return VD_OK;
+}
+
+// ---------------------------------------------------------------------------------------------
+// reading an episode
+
+int vd_harvest_done(const vd_harvest* h) {
+  return h->done;
+}
+
+void vd_harvest_observe(const vd_harvest* h, vd_harvest_obs* o) {
+  vd_harvest* w = (vd_harvest*)h;  // observation copies live in the episode
+  memset(o, 0, sizeof *o);
+  o->time = h->sd->time;
+  o->step = h->step;
+  o->phase = h->phase;
+  o->nq = h->narm;
+  for (int k = 0; k < h->narm; k++) {
+    w->qbuf[k] = h->d->qpos[h->arm_qpos[k]];
+    w->qdbuf[k] = h->d->qvel[h->arm_dof[k]];
+  }
+  o->q = w->qbuf;
+  o->qd = w->qdbuf;
+  o->gripper_opening = h->d->qpos[h->grip_qpos[0]] + h->d->qpos[h->grip_qpos[1]];
+  o->ee_pos = h->ee_pos;
+  o->ee_quat = h->ee_quat;
+  o->cmd_pos = h->xcmd;
+  if (h->target >= 0) {
+    const robot_fruit* f = &h->fruit[h->target];
+    o->target_instance = f->instance;
+    o->fruit_pos = h->sd->node_pos[f->node];
+    o->fruit_vel = h->sd->node_vel[f->node];
+  }
+  o->held = h->held;
+  o->touching[0] = h->touching[0], o->touching[1] = h->touching[1];
+  o->finger_force[0] = h->finger_force[0], o->finger_force[1] = h->finger_force[1];
+  o->grip_force = h->held ? h->scene.method.grip_force : 0;
+  o->pull_force = h->pull_force;
+  o->pull_torque = vd_norm(h->pull_torque);
+  o->slip = h->slip;
+  o->robot_force = h->robot_force;
+  o->detached = h->detached;
+  o->site = h->site;
+  o->ik_error = h->ik_err;
+}
+
+int vd_harvest_events(const vd_harvest* h, const vd_harvest_event** out) {
+  *out = h->ev;
+  return h->nev;
+}
+
+void vd_harvest_summarize(const vd_harvest* h, vd_harvest_summary* o) {
+  memset(o, 0, sizeof *o);
+  o->detached = h->detached;
+  o->grasped = h->ever_held;
+  o->site = h->site;
+  o->time = h->detached ? h->detach_time : h->sd->time;
+  o->detach_force = h->detach_force;
+  o->detach_moment = h->detach_moment;
+  o->pull_force = h->detach_pull;
+  o->max_pull_force = h->max_pull;
+  o->max_displacement = h->max_disp;
+  for (int f = 0; f < h->nfruit; f++) {
+    o->fruits_hit += h->fruit[f].hit;
+    o->fruits_dropped += h->fruit[f].dropped;
+  }
+  o->ik_error = h->grasp_ik_err;
+  o->track_error = h->grasp_track_err;
+  o->slip = h->slip;
+  o->duration = h->sd->time;
+  o->steps = h->step;
+  o->plant_warnings = h->sd->nwarning;
+  o->target_instance = h->target >= 0 ? h->fruit[h->target].instance : 0;
+  snprintf(o->reason, sizeof o->reason, "%s", h->done ? h->reason : "running");
+}
+
+const vd_sim_model* vd_harvest_sim_model(const vd_harvest* h) {
+  return h->sm;
+}
+
+const vd_sim_data* vd_harvest_sim_data(const vd_harvest* h) {
+  return h->sd;
+}
+
+const double* vd_harvest_qpos(const vd_harvest* h, int* nq) {
+  *nq = h->m->nq;
+  return h->d->qpos;
+}
+
+const vd_scene* vd_harvest_scene(const vd_harvest* h) {
+  return &h->scene;
+}

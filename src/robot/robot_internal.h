@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: MIT
+// Private parts of the robot module: the episode's state, shared by robot_model.c (MJCF, robot
+// description, colliders), robot_ik.c (inverse kinematics), robot_harvest.c (coupling, grasp,
+// episode) and robot_control.c (the scripted methods). Never installed.
+#ifndef VERDANT_ROBOT_INTERNAL_H
+#define VERDANT_ROBOT_INTERNAL_H
+
+#include <math.h>
+#include <mujoco/mujoco.h>
+
+#include "mjtrap/mjtrap.h"
+#include "verdant/collide.h"
+#include "verdant/robot.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define ROBOT_MAX_COLLIDERS (VD_SIM_MAX_COLLIDERS - 1) // robot geoms (one collider is the ground)
+#define ROBOT_TIE_COMPLIANCE 1e-5  // the grasp tie: 1e5 N/m (m/N)
+#define ROBOT_TOUCH_GAP 5e-4       // a finger touches the fruit within this gap (m)
+
+// One robot geom as a collider of the plant.
+typedef struct robot_collider {
+  int geom;           // MuJoCo geom
+  int body;           // its body
+  int sim;            // its index in the plant state's colliders
+  int finger;         // 0 / 1 for a geom of finger l / r, else -1
+  vd_sdf* sdf;        // owned distance grid (cylinder, ellipsoid, mesh), else NULL
+  vd_pose prev;       // pose at the previous robot step
+  vd_pose cur;        // pose at this robot step
+  vd_collider shape;  // the same shape for queries of the collide module (pose cur)
+} robot_collider;
+
+// One fruit of the plant.
+typedef struct robot_fruit {
+  int node;       // rod node at its centre
+  int seg;        // its stalk segment (VD_SIM_FRUITSEG, class fruit)
+  int instance;   // organ instance
+  double radius;  // sphere radius (m)
+  int hit;        // the robot has touched it
+  int dropped;    // it came off the plant
+} robot_fruit;
+
+struct vd_harvest {
+  vd_scene scene;             // own copy
+  const vd_model* plant;      // borrowed
+  vd_sim_model* sm;           // rod model
+  vd_sim_data* sd;            // rod state
+  // MuJoCo
+  mjModel* m;
+  mjData* d;                  // the episode
+  mjData* dk;                 // scratch for inverse kinematics
+  int root_body;              // the robot's root (a child of the world)
+  int ee_site;                // end-effector site
+  int narm;                   // arm joints (those between the root and the site, with servos)
+  int arm_jnt[VD_ROBOT_MAX_JOINTS], arm_qpos[VD_ROBOT_MAX_JOINTS], arm_dof[VD_ROBOT_MAX_JOINTS],
+      arm_act[VD_ROBOT_MAX_JOINTS];
+  double arm_lo[VD_ROBOT_MAX_JOINTS], arm_hi[VD_ROBOT_MAX_JOINTS];  // joint limits
+  int grip_act[2], grip_qpos[2], finger_body[2];
+  int orient;                 // 1 when the arm can turn the end-effector (IK on orientation)
+  int nrobot;                 // robot steps per control step
+  int nsub;                   // plant steps per robot step
+  robot_collider col[ROBOT_MAX_COLLIDERS];
+  int ncol;
+  // fruits
+  robot_fruit* fruit;
+  int nfruit;
+  // command
+  double qcmd[VD_ROBOT_MAX_JOINTS];  // joint targets
+  vd_vec3 xcmd;               // commanded end-effector position (m)
+  vd_quat rcmd;               // ... orientation
+  double grip_cmd;            // gripper command in [0, 1]
+  double ik_err;              // residual of the last IK (m)
+  double q0[VD_ROBOT_MAX_JOINTS];  // initial arm joints
+  double qd_max[VD_ROBOT_MAX_JOINTS]; // joint speed limit of the command (rad/s or m/s)
+  int joint_move;             // 1: the command moves in joint space to qgoal (scripted approach)
+  double qgoal[VD_ROBOT_MAX_JOINTS];  // its goal
+  double qpre[VD_ROBOT_MAX_JOINTS];   // IK solution of the target's pre-grasp pose
+  // target and grasp
+  int target;                 // index into fruit, -1 none
+  int held, ever_held, tie;   // holding; tie index in sd->tie
+  vd_vec3 hold_local;         // fruit centre in the end-effector frame (m)
+  vd_quat hold_rot;           // conj(ee) * fruit stalk frame
+  double finger_q[2];         // finger positions frozen at the grasp (m)
+  double slip;                // slip so far (m)
+  vd_vec3 pull_force;         // held fruit on the gripper (N), last robot step
+  vd_vec3 pull_torque;        // ... its torque (N m)
+  double pull_at_break;       // its size at the end of the plant step of the last fracture (N)
+  int touching[2];
+  double finger_force[2];
+  int touched[2];             // a touch event was logged
+  vd_vec3 robot_force;        // plant on robot, last robot step (N)
+  vd_vec3 ee_pos;             // site pose at the last robot step
+  vd_quat ee_quat;
+  // scripted controller
+  int scripted;               // 1 until an external action is given
+  vd_harvest_phase phase;
+  double phase_t0;            // time the phase began (s)
+  vd_vec3 pre_pos, grasp_pos; // pre-grasp and grasp points (m)
+  vd_quat grasp_rot;          // grasp orientation
+  vd_vec3 approach;           // approach direction (unit)
+  vd_vec3 pedicel;            // pedicel axis at the fruit, calyx to fruit (unit)
+  vd_vec3 pivot;              // bend pivot: the calyx (m)
+  vd_vec3 axis;               // bend / twist axis (unit)
+  double progress;            // method motion done (m or rad)
+  double settle_t;            // time the command has been at its target (s)
+  // outcome
+  int detached;
+  vd_harvest_site site;
+  double detach_time, detach_force, detach_moment, detach_pull, max_pull, max_disp;
+  double grasp_ik_err, grasp_track_err;
+  int done;
+  char reason[128];
+  int nevent_seen;            // plant fracture events already logged
+  vd_harvest_event* ev;       // log (nev, capacity cap_ev)
+  int nev, cap_ev;
+  int64_t step;
+  signed char* on;            // scratch: segment still on the plant (nseg + 1)
+  double qbuf[VD_ROBOT_MAX_JOINTS], qdbuf[VD_ROBOT_MAX_JOINTS];  // observation copies
+};
+
+// robot_model.c: load and describe the robot, its colliders and the fruits.
+vd_status robot_load(vd_harvest* h, vd_error* err);
+vd_status robot_colliders(vd_harvest* h, vd_error* err);
+void robot_free(vd_harvest* h);
+// Pose of geom g (after kinematics) as a vd_pose.
+vd_pose robot_geom_pose(const mjModel* m, const mjData* d, int g);
+// Site pose of the end-effector in data d.
+void robot_site_pose(const vd_harvest* h, const mjData* d, vd_vec3* pos, vd_quat* rot);
+// Arm joint positions of data d into q.
+void robot_get_q(const vd_harvest* h, const mjData* d, double* q);
+
+// robot_ik.c: damped least squares on mj_jacSite in the scratch data.
+int robot_ik(vd_harvest* h, const vd_ik_def* def, vd_vec3 pos, const vd_quat* rot, double* q,
+             double* pos_err, double* rot_err);
+
+// robot_control.c: the scripted methods.
+void control_begin(vd_harvest* h);
+void control_action(vd_harvest* h, vd_harvest_action* a);
+void control_after_step(vd_harvest* h);
+void control_set_phase(vd_harvest* h, vd_harvest_phase p);
+// grasp geometry of fruit f: approach, pedicel axis, grasp pose; 0 when degenerate
+void control_grasp_pose(vd_harvest* h, int f, vd_vec3* pos, vd_quat* rot, vd_vec3* approach,
+                        vd_vec3* pedicel);
+
+// robot_harvest.c
+void harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg, int instance);
+void harvest_finish(vd_harvest* h, const char* reason);
+void harvest_release(vd_harvest* h);
+
+// small rotation helpers
+vd_vec3 quat_log_v(vd_quat q);          // rotation vector of q (shortest)
+vd_quat quat_exp_v(vd_vec3 v);          // rotation of rotation vector v
+vd_quat quat_from_mat(const double* r); // from a row-major 3x3 rotation
+
+#endif
