@@ -439,23 +439,44 @@ def Stop():
     _vd.stop()
 
 
-_direction = {"forward": True}
-
-
 def forward():
-    _direction["forward"] = True
+    """Derive left to right from the next step on (the default)."""
+    _vd.set_backward(False)
 
 
 def backward():
-    _direction["forward"] = False
+    """Derive right to left from the next step on (new right contexts >> apply)."""
+    _vd.set_backward(True)
 
 
 def isForward():
-    return _direction["forward"]
+    return not _vd.is_backward()
 
 
 def frameDisplay(enabled=True):
     """Display only: nothing to do without a viewer."""
+
+
+def isFrameDisplayed():
+    """True during the last step (L-Py computes a scene for the hooks then)."""
+    return _vd.frame_displayed()
+
+
+def isAnimationEnabled():
+    """No animation runs in verdant."""
+    return False
+
+
+class _PatternModuleType(type):
+    @property
+    def matchingMethod(cls):
+        return _vd.module_matching()
+
+
+class PatternModule(metaclass=_PatternModuleType):
+    """The 'Module matching' option's values, and the one in force (matchingMethod)."""
+    eSimple, eWithStar, eWithStarNValueConstraint = 0, 1, 2
+    eDefaultModuleMatching = 2
 
 
 def nsproduce(lstring):
@@ -469,11 +490,6 @@ def extern(**kw):
     over = g.get("__vd_set", {})
     for k, v in kw.items():
         g[k] = over.get(k, v)
-
-
-def isAnimationEnabled():
-    """verdant derives and draws once: no animation."""
-    return False
 
 
 class ParameterSet:
@@ -2024,7 +2040,8 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
-        "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet"]
+        "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
+        "PatternModule"]
 
 _pgl_math = _module("openalea.plantgl.math", _MATH)
 _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
