@@ -245,9 +245,9 @@ typedef struct probe {
 } probe;
 
 typedef struct pull {
+  vd_vec3 v;
   char organ[64];
   int instance;
-  vd_vec3 v;
   int move;  // 0 force, 1 displacement
   int node, tie;
 } pull;
@@ -807,9 +807,9 @@ static void batch_run(const sim_opts* o, int i, double nsteps, const double* win
     st = vd_sim_settle(m, d, &sd, NULL, NULL);
   }
   // the run with probes and pulls, as a single run drives them
-  double start = st ? 0 : d->time, total = o->duration, ramp = o->ramp_set ? o->ramp : total;
-  int64_t steps0 = st ? 0 : d->nstep;
-  for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
+  double start = d ? d->time : 0, total = o->duration, ramp = o->ramp_set ? o->ramp : total;
+  int64_t steps0 = d ? d->nstep : 0;
+  for (int64_t step = 0; !st && d && step < (int64_t)nsteps; step++) {
     double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
     for (int k = 0; k < o->npull; k++) {
       if (pl[k].move)
@@ -861,7 +861,7 @@ static int sim_batch(const sim_opts* o, double nsteps) {
     st = vd_error_set(&err, VD_ERR_IO, o->out, 0, 0, "cannot create the output folder: %s", strerror(errno));
   batch_item* r = st ? NULL : vd_calloc((size_t)n, sizeof *r);
   if (!st && !r) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  if (st) {
+  if (st || !r) {
     code = cli_report("sim", &err, st);
     goto done;
   }
