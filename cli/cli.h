@@ -307,6 +307,8 @@ void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
 
 // Subcommands.
 int cli_harvest(int argc, char** argv);
+// verdant sim PLANT --grow (cli_sim_grow.c): growth with physics between the age steps.
+int cli_sim_grow(int argc, char** argv);
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);
 int cli_dataset(int argc, char** argv);
