@@ -260,6 +260,9 @@ int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]);
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err);
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);
+// Render a growth run folder (growth.json, age_NNN.json; cli_render_growth.c): the last age, the
+// one nearest --time, or every age into a folder; returns the exit code.
+int cli_render_growth(const cli_render_opts* o);
 
 // The pictures of `verdant dataset --images N` (cli_views.c): render options and what varies
 // from view to view.

@@ -391,8 +391,10 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
       int base = owner[i] < 0;
       // in the soil: root nodes below the ground (a base at the ground holds through its roots)
       int in_soil = has_roots && (m->node_flags[i] & VD_MSS_ROOT) && depth > 0;
-      // clamped: in a clamping soil, or a stem base at the ground of a plant without roots
-      int clamp = (in_soil && soil->method == VD_SOIL_CLAMP) || (!has_roots && base && z <= soil->ground + def->fix_height);
+      // clamped: in a clamping soil (with the stem's base there, a pot), or a stem base at the
+      // ground of a plant without roots
+      int at_ground = base && z <= soil->ground + def->fix_height;
+      int clamp = (in_soil && soil->method == VD_SOIL_CLAMP) || (at_ground && (!has_roots || soil->method == VD_SOIL_CLAMP));
       if (clamp) {
         m->node_flags[i] |= VD_MSS_FIXED;
         nfixed++;
