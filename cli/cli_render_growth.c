@@ -42,7 +42,7 @@ static vd_status read_index(const char* dir, snap** out, int* n, vd_error* err) 
   snap* s = cnt ? vd_calloc((size_t)cnt, sizeof(snap)) : NULL;
   if (!st && !s) st = vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
   int k = 0;
-  for (const cJSON* e = st ? NULL : list->child; e && !st; e = e->next, k++) {
+  for (const cJSON* e = st || !list || !s ? NULL : list->child; e && s && !st && k < cnt; e = e->next, k++) {
     const cJSON* f = cJSON_GetObjectItemCaseSensitive(e, "file");
     const cJSON* t = cJSON_GetObjectItemCaseSensitive(e, "time");
     const cJSON* a = cJSON_GetObjectItemCaseSensitive(e, "age");

@@ -125,7 +125,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     double x_;                                                                                    \
     if (!cli_parse_num(val, &x_) || !isfinite(x_) || !(cond))                                     \
       return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                      \
-    dst = x_;                                                                                     \
+    (dst) = x_;                                                                                   \
   } while (0)
 #define PAIR(d0, d1, cond, what, inf)                                                             \
   do {                                                                                            \
@@ -133,7 +133,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     double v_[2];                                                                                 \
     if (!nums(val, v_, 2, inf) || !(cond))                                                        \
       return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                      \
-    d0 = v_[0], d1 = v_[1];                                                                       \
+    (d0) = v_[0], (d1) = v_[1];                                                                   \
   } while (0)
     if (!strcmp(a, "--grow")) {
     } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {

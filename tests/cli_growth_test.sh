@@ -76,6 +76,13 @@ expect "grow bastien" 0 "$V" sim "$TREE" --grow --model mss --gravitropism basti
 expect "sim soil rods" 0 "$V" sim "$TREE" --soil loam --duration 0.05 --stats
 json_check "rods in soil stand" "d['max_displacement'] < 0.5"
 
+# the closed forms in verdant validate
+expect "validate mass-spring" 0 "$V" validate --case mss_ --no-progress
+expect "validate rigid" 0 "$V" validate --case rigid --no-progress
+expect "validate bastien" 0 "$V" validate --case bastien --no-progress
+expect "validate growth momentum" 0 "$V" validate --case growth_momentum --json --no-progress
+json_check "validate json" "len(d) == 2 and all(r['pass'] for r in d)"
+
 # pictures of the ages
 if "$V" render --help >/dev/null 2>&1; then
   expect "render growth run" 0 "$V" render "$T/run" -o "$T/last.png" --size 160x120 --color-by stress

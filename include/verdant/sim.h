@@ -465,6 +465,21 @@ typedef struct vd_validate_def {
   const vd_model* plant;  // Nullable: also run the sag-free gate on this plant (e.g. the tomato)
 } vd_validate_def;
 
+// A growing list of validation results (for the modules' own cases).
+typedef struct vd_validate_list {
+  vd_validate_result* r;  // results (n, capacity cap)
+  int n, cap;
+} vd_validate_list;
+
+// Append a checked quantity: error relative to the reference (absolute when abs_err is set or
+// the reference is 0); pass when finite and within tol. note is printf-style. 0 when out of
+// memory.
+int vd_validate_add(vd_validate_list* l, const char* name, const char* form, const char* quantity,
+                    double measured, double reference, double tol, int abs_err, const char* note,
+                    ...) __attribute__((format(printf, 9, 10)));
+// Hand the list's results to a caller as vd_sim_validate does (*out exactly n entries, or NULL).
+vd_status vd_validate_finish(vd_validate_list* l, vd_validate_result** out, int* n, vd_error* err);
+
 // Run the validation cases; *out (free with vd_free(*out, *n * sizeof **out)) gets the results.
 vd_status vd_sim_validate(const vd_validate_def* def, vd_validate_result** out, int* n,
                           vd_error* err);
@@ -685,13 +700,15 @@ typedef struct vd_mss_opt {
   int breaking;                 // 1: an internode breaks when its stress exceeds its MOR
   double strain_limit;          // internodes stretched or shortened by more than this after a
                                 // substep are put back to it, parents first (Provot 1995); 0 off
+  int rigid_release;            // 1: a rigid part nothing holds (its soil gave way) is released into
+                                // the springs; 0: stepped by RK4 against them (the paper's; unstable)
 } vd_mss_opt;
 
 // Defaults: dt 0.01 s, integrator implicit, cg_iterations 500, cg_tolerance 1e-8, gravity
 // (0, 0, -9.81) m/s^2, no wind, gust_period 2 s, wind_model area, air_density 1.226 kg/m^3,
 // drag_cd 1.2, leaf_cd 0.1, drag quadratic, viscosity 1.81e-5 Pa s, no light, light_k 1 N m^2,
 // no gravitropism, gravi_k 0.1 N, bastien_beta 0.5 1/(m year), bastien_gamma 1 1/year,
-// growth_zone_age 2 years, soil 1, breaking 1, strain_limit 1e-4.
+// growth_zone_age 2 years, soil 1, breaking 1, strain_limit 1e-4, rigid_release 1.
 vd_mss_opt vd_mss_opt_default(void);
 
 // node flags

@@ -204,6 +204,7 @@ void vd_growth_def_paper(vd_growth_def* d) {
   d->opt.wind_model = VD_MSS_WIND_PAPER;
   d->opt.drag = VD_MSS_DRAG_STOKES;
   d->opt.strain_limit = 0;
+  d->opt.rigid_release = 0;
   d->paper_eq8 = 1;
   d->stress_free = 0;
 }
@@ -802,7 +803,7 @@ static vd_status carry_out(vd_growth* g, vd_error* err) {
     g->c.stiff[i] = g->owner_seg[i] >= 0 ? seg_stiffness(g, s, g->owner_seg[i]) : 0;
     int k = g->pmap[i];
     // the node's own plant node carries it (not the aliases of a shared base)
-    if (k >= 0 && g->md && !g->md->removed[k] && g->mm->node_plant[k] == i) {
+    if (k >= 0 && g->md && g->mm && !g->md->removed[k] && g->mm->node_plant[k] == i) {
       g->c.mass[i] = g->md->mass[k];
       g->c.rigid[i] = g->md->rigid[k];
       g->c.body[i] = g->md->body[k];

@@ -63,6 +63,7 @@ vd_mss_opt vd_mss_opt_default(void) {
   o.soil = 1;
   o.breaking = 1;
   o.strain_limit = 1e-4;
+  o.rigid_release = 1;
   return o;
 }
 
@@ -1186,6 +1187,14 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
       for (int i = 0; i < m->nnode; i++)
         if (d->rigid[i] && (m->node_flags[i] & VD_MSS_SOIL)) d->yielded[i] = 1;
     }
+  }
+  // a body nothing holds, stepped explicitly against stiff springs, is unstable (h^2 k / M of
+  // hundreds): released, its nodes go on with the springs at the velocities they have
+  if (!held && m->opt.rigid_release) {
+    for (int i = 0; i < m->nnode; i++) d->rigid[i] = 0;
+    memset(b, 0, sizeof *b);
+    b->q = vd_quat_identity();
+    return 0;
   }
   if (!held) vd_rigid_step(b, f, tau, m->opt.dt);
   mss_rigid_sync(m, d);
