@@ -73,6 +73,8 @@ json_check "rods grown" "d['model'] == 'rods' and d['height'] > 1.5 and not d['c
 expect "grow soil loam" 0 "$V" sim "$TREE" --grow --model mrl --soil loam --ages 3 --substeps 10 --stats
 json_check "loam holds" "not d['uprooted'] and d['height'] > 1.5"
 expect "grow bastien" 0 "$V" sim "$TREE" --grow --model mss --gravitropism bastien --ages 3 --substeps 10 --stats
+expect "grow hopea" 0 "$V" sim "$SRC/data/hopea.lpy" --grow --model mrl --species hopea-odorata --ages 12 --substeps 5 --stats
+json_check "hopea grown" "d['ages'] == 12 and d['height'] > 6 and not d['collapsed'] and not d['uprooted']"
 expect "sim soil rods" 0 "$V" sim "$TREE" --soil loam --duration 0.05 --stats
 json_check "rods in soil stand" "d['max_displacement'] < 0.5"
 
