@@ -36,6 +36,7 @@ typedef struct cli_plant_opts {
   double curve_connect;    // --curve-connect (m), < 0: the file's or the default
   double curve_distance;   // --curve-distance (m), < 0: the file's or the default
   int engine;              // --engine auto|native|python (vd_lsys_engine), VD_LSYS_AUTO by default
+  const char* lstring_out; // --lstring FILE: the derived L-string as JSON (.lpy files), NULL: none
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
@@ -57,6 +58,10 @@ typedef struct cli_grow_info {
   const char* engine;       // the engine that ran the .lpy file ("native", "python"), NULL otherwise
 } cli_grow_info;
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err);
+// What the file at path is when it is not a plant ("a mesh (PLY)", "a point cloud (LAS)", "a
+// simulation run", JSON of another format), told from its first bytes and its name; NULL when it
+// may be one (L-Py text, plant or curves JSON). buf holds the text for some kinds (cli_kind.c).
+const char* cli_not_a_plant(const char* path, char* buf, size_t cap);
 // Free what cli_load_plant put in info.
 void cli_grow_info_free(cli_grow_info* info);
 
@@ -64,6 +69,10 @@ void cli_grow_info_free(cli_grow_info* info);
 int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out);
 // Parse two whole decimal integers A<sep>B, each within [lo, hi] ("640x480", "2/8"); 1 on success.
 int cli_parse_i64_pair(const char* s, char sep, int64_t lo, int64_t hi, int64_t* a, int64_t* b);
+// Parse n comma-separated finite numbers, the whole text ("1,2.5,3"); 1 on success.
+int cli_parse_nums(const char* s, double* x, int n);
+// Parse X,Y,Z (three finite numbers, the whole text); 1 on success.
+int cli_parse_vec3(const char* s, vd_vec3* v);
 // Parse a whole finite number; 1 on success.
 int cli_parse_num(const char* s, double* out);
 // Inside an option parser with locals a (the option), val, i, argc, argv and cmd: take the
@@ -149,6 +158,9 @@ void cli_cloud_opts_init(cli_cloud_opts* o);
 int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int* i);
 // Check option combinations after parsing; prints and returns EXIT_USAGE, or 0 when fine.
 int cli_cloud_check(const cli_cloud_opts* o, const char* cmd);
+// Check the writer options against the output (a file name, a format name "ply", or NULL when
+// nothing is written): --ascii needs PLY or PCD, --ply-scalar-prefix PLY. Prints, EXIT_USAGE.
+int cli_cloud_check_output(const cli_cloud_opts* o, const char* cmd, const char* out);
 // Help text lines for the cloud options.
 extern const char* cli_cloud_help;
 
@@ -308,6 +320,11 @@ void cli_view_record(const cli_view_opts* v, const cli_view* view, struct cJSON*
 // {elevation}, {eye}, {lookat}, {up}, {light}, {sky}, {floor}, arrays written A,B,...).
 void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
 
+// Rewrite the command line before dispatch (cli_args.c): --opt=value into --opt value, operands
+// after -- that start with '-' as ./-name, 'help CMD' as 'CMD --help'; a repeated -o/--output is
+// an error. Returns 0, or the exit code after printing why.
+int cli_args_normalize(int* argc, char*** argv);
+
 // Subcommands.
 int cli_harvest(int argc, char** argv);
 // verdant sim PLANT --grow (cli_sim_grow.c): growth with physics between the age steps.
@@ -318,5 +335,6 @@ int cli_dataset(int argc, char** argv);
 int cli_render(int argc, char** argv);
 int cli_sim(int argc, char** argv);
 int cli_validate(int argc, char** argv);
+int cli_export(int argc, char** argv);
 
 #endif

@@ -27,6 +27,8 @@ static const char* sim_help =
     "      --duration T        simulated time (s); default 1, or 0 after --settle/--statics\n"
     "      --dt H              time step (s), default 0.001\n"
     "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 1\n"
+    "      --threads N         threads for one plant's step (default 1): the direct solver's\n"
+    "                          subtrees; the same bytes for any N\n"
     "      --solver S          direct (exact tree solve, default) or gs (XPBD Gauss-Seidel)\n"
     "      --settle            first run damped dynamics until the plant is still\n"
     "      --statics           first solve the static equilibrium directly\n"
@@ -36,6 +38,8 @@ static const char* sim_help =
     "      --max-steps N       most time steps of a run, duration / dt (default 1000000000)\n"
     "model:\n"
     "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
+    "      --clamp L           the pot: the first L of the plant's base held fixed (m), default\n"
+    "                          0.01; 0 holds only the base node and its frame (a clamped end)\n"
     "      --max-segments N    most rod segments of the model (default 1000000, about 2 kB each)\n"
     "      --bend-measure M    bend-twist strain: log (rotation vector, default) or quat\n"
     "                          (Kugelstadt & Schomer's Im(q), the model before 2026-11)\n"
@@ -46,6 +50,8 @@ static const char* sim_help =
     "      --break-moment [C=]M    ... or above this moment (N m)\n"
     "      --break-strain [C=]CS,CB  ... or when |C_s| > CS or |C_b| > CB (1/m), Gazebo Plants' form\n"
     "      --no-fracture       nothing breaks\n"
+    ;
+static const char* sim_help_loads =
     "loads:\n"
     "      --gravity X,Y,Z     gravity (m/s^2), default 0,0,-9.81\n"
     "      --wind X,Y,Z        mean wind (m/s); pressure 0.613 |v|^2 Pa on the drag areas\n"
@@ -83,7 +89,10 @@ static const char* sim_help_output =
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
-    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n";
+    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n"
+    "      --profile           time each stage of the steps and the frame output; --stats then\n"
+    "                          has stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
+    "                          project, velocity, fracture, frames)\n";
 
 // a closed triangle mesh from a Wavefront OBJ file: "v x y z" and "f i j k ..." lines (1-based
 // or negative indices, "i/t/n" forms, polygons split in fans); other lines are skipped
@@ -240,7 +249,7 @@ typedef struct sim_opts {
   const char* out;
   double duration;
   int duration_set;
-  int settle, statics, stats;
+  int settle, statics, stats, profile;
   double ke_tol;
   const char* frames;
   double fps;
@@ -259,6 +268,7 @@ typedef struct sim_opts {
   vd_vec3 mesh_pos[8];     // ... and their placements (m)
   int nmesh;
   double max_steps;
+  int ke_tol_set, gust_set, fps_set;  // given on the command line (checked against what they need)
   vd_sim_def def;
   vd_sim_opt opt;
 } sim_opts;
@@ -373,7 +383,7 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
 // the summary
 
 static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant, double wall, int64_t steps,
-                       int settled, int settle_steps) {
+                       int settled, int settle_steps, double frames_s) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return 0;
   int node;
@@ -417,6 +427,12 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON* wk = cJSON_AddObjectToObject(root, "warning_counts");
   for (int k = 0; k < VD_SIM_WARN_COUNT; k++)
     cJSON_AddNumberToObject(wk, vd_sim_warning_name((vd_sim_warning)k), (double)d->warning[k]);
+  if (d->profile) {
+    cJSON* sg = cJSON_AddObjectToObject(root, "stage_seconds");
+    for (int k = 0; k < VD_SIM_STAGE_COUNT; k++)
+      cJSON_AddNumberToObject(sg, vd_sim_stage_name((vd_sim_stage)k), d->stage_seconds[k]);
+    cJSON_AddNumberToObject(sg, "frames", frames_s);
+  }
   char* text = cJSON_Print(root);
   cJSON_Delete(root);
   if (!text) return 0;
@@ -468,6 +484,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->opt.dt, x_ > 0 && x_ <= 1, "a time step in (0, 1] (s)");
     } else if (!strcmp(a, "--iterations")) {
       NUM(o->opt.iterations, x_ >= 1 && x_ <= 10000 && x_ == floor(x_), "an integer in 1..10000");
+    } else if (!strcmp(a, "--threads")) {
+      NUM(o->opt.threads, x_ >= 1 && x_ <= 64 && x_ == floor(x_), "an integer in 1..64");
     } else if (!strcmp(a, "--solver")) {
       VAL();
       if (!strcmp(val, "direct")) o->opt.solver = VD_SIM_DIRECT;
@@ -479,12 +497,15 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->statics = 1;
     } else if (!strcmp(a, "--ke-tol")) {
       NUM(o->ke_tol, x_ > 0, "an energy > 0 (J)");
+      o->ke_tol_set = 1;
     } else if (!strcmp(a, "--sag-free")) {
       o->def.sag_free = 1;
     } else if (!strcmp(a, "--stake")) {
       NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
     } else if (!strcmp(a, "--segment-length")) {
       NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
+    } else if (!strcmp(a, "--clamp")) {
+      NUM(o->def.clamp_length, x_ >= 0 && x_ <= 1e3, "a length >= 0 (m)");
     } else if (!strcmp(a, "--max-segments")) {
       NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
     } else if (!strcmp(a, "--bend-measure")) {
@@ -529,6 +550,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       double v[2];
       if (!parse_list(val, v, 2) || !(v[1] > 0)) return cli_usage_error(cmd, "--gust expects AMPLITUDE,PERIOD (-, s > 0), got '%s'", val);
       o->opt.gust_amplitude = v[0], o->opt.gust_period = v[1];
+      o->gust_set = 1;
     } else if (!strcmp(a, "--wind-file")) {
       VAL();
       o->wind_file = val;
@@ -588,6 +610,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->frames = val;
     } else if (!strcmp(a, "--fps")) {
       NUM(o->fps, x_ > 0 && x_ <= 100000, "a rate in (0, 100000] (1/s)");
+      o->fps_set = 1;
     } else if (!strcmp(a, "--final")) {
       VAL();
       if (!cli_has_ext(val, ".json") && !cli_has_ext(val, ".obj") && !cli_has_ext(val, ".ply"))
@@ -595,6 +618,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      o->profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error(cmd, "unknown option '%s'", a);
     } else if (!o->po.path) {
@@ -629,6 +654,21 @@ static int run_outputs(const sim_opts* o, char path[SIM_MAX_OUT][4200], unsigned
   return n;
 }
 
+// options that do nothing without another one are refused, not ignored
+static int check_applies(const sim_opts* o) {
+  const char* cmd = "sim";
+  if (o->frames && !o->out) return cli_usage_error(cmd, "--frames applies to a run folder (-o DIR)");
+  if (o->fps_set && (!o->out || (o->frames && !strcmp(o->frames, "none"))))
+    return cli_usage_error(cmd, "--fps sets the frame rate of DIR/frames: give -o DIR (and frames other than none)");
+  if (o->ramp_set && !o->npull) return cli_usage_error(cmd, "--ramp applies to --pull and --move");
+  if (o->ke_tol_set && !o->settle) return cli_usage_error(cmd, "--ke-tol applies to --settle");
+  if (o->gust_set && o->wind_file)
+    return cli_usage_error(cmd, "--gust does not apply with --wind-file (the series replaces the wind and its gusts)");
+  if (o->gust_set && o->opt.wind.x == 0 && o->opt.wind.y == 0 && o->opt.wind.z == 0)
+    return cli_usage_error(cmd, "--gust modulates the mean wind: give --wind X,Y,Z");
+  return 0;
+}
+
 // no output may replace an input (the plant, the wind series, collider meshes)
 static int check_clash(const sim_opts* o) {
   char opath[SIM_MAX_OUT][4200];
@@ -648,6 +688,7 @@ int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(sim_help, stdout);
+      fputs(sim_help_loads, stdout);
       fputs(sim_help_output, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;
@@ -665,7 +706,7 @@ int cli_sim(int argc, char** argv) {
   if (rc) return rc;
   if (!o.po.path) return cli_usage_error("sim", "missing PLANT (an .lpy or plant .json file)");
   if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
-  if (check_clash(&o)) return EXIT_USAGE;
+  if (check_clash(&o) || check_applies(&o)) return EXIT_USAGE;
   if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
   if (!o.frames) o.frames = "bin";
   // the run's steps, counted (a time sum stalls once time + dt == time): at most --max-steps
@@ -709,7 +750,10 @@ int cli_sim(int argc, char** argv) {
     m->opt.wind_series = wind;
     m->opt.nwind = nwind;
     d = vd_sim_data_create(m);
-    if (!d) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (!d)
+      st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    else
+      d->profile = o.profile;
   }
   // organs to pull, colliders
   for (int k = 0; !st && k < o.npull; k++) {
@@ -794,6 +838,7 @@ int cli_sim(int argc, char** argv) {
     double start = d->time, total = o.duration, next_frame = start;
     double ramp = o.ramp_set ? o.ramp : total;
     int show = o.po.progress && total / m->opt.dt > 2000;
+    double frames_s = 0;
     if (out.frames_open) cli_frames_write(&out, m, d), next_frame += 1.0 / o.fps;
     for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
       double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
@@ -813,7 +858,9 @@ int cli_sim(int argc, char** argv) {
       st = vd_sim_step(m, d);
       vd_sim_soil_update(m, d, held);
       if (out.frames_open && d->time >= next_frame - 1e-12) {
+        double tf = o.profile ? cli_now() : 0;
         if (cli_frames_write(&out, m, d)) break;  // reported by the commit below
+        if (o.profile) frames_s += cli_now() - tf;
         next_frame += 1.0 / o.fps;
       }
       if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);
@@ -887,7 +934,7 @@ int cli_sim(int argc, char** argv) {
       code = EXIT_FAIL;
       goto done;
     }
-    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps)) code = EXIT_FAIL;
+    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps, frames_s)) code = EXIT_FAIL;
   }
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);

@@ -7,11 +7,12 @@
 #include "test.h"
 #include "verdant/lsys.h"
 
-// parse (the native engine) and derive src (steps -1 = the file's), format the result into buf
-static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, vd_error* e) {
+// parse with an engine and derive src (steps -1 = the file's), format the result into buf
+static vd_status derive_engine(const char* src, vd_lsys_engine engine, int steps, char* buf, size_t cap,
+                               vd_error* e) {
   vd_lsystem* ls;
   buf[0] = 0;
-  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", VD_LSYS_NATIVE, &ls, e);
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", engine, &ls, e);
   if (st) return st;
   vd_lsys_def d = vd_lsys_def_default();
   d.steps = steps;
@@ -22,6 +23,11 @@ static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, 
   vd_lstring_free(&s);
   vd_lsys_destroy(ls);
   return st;
+}
+
+// the same with the native engine
+static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, vd_error* e) {
+  return derive_engine(src, VD_LSYS_NATIVE, steps, buf, cap, e);
 }
 
 #define DERIVES(src, steps, expected)                                                              \
@@ -255,4 +261,100 @@ TEST(lpy, nproduce_in_a_def) {
   DERIVES("def two(x):\n  nproduce B(x) B(x + 1)\ndef one():\n  produce C\n  nproduce D\n"
           "Axiom: A(1)\nproduction:\nA(x) :\n  two(x)\n  one()\n",
           1, "B(1)B(2)C");
+}
+
+TEST(lpy, absent_or_empty_axiom_and_spacing) {
+  // no Axiom: (a rule set) and an empty Axiom: give an empty string, as in L-Py
+  DERIVES("production:\nA --> B\n", 1, "");
+  DERIVES("Axiom:\nproduction:\nA --> B\n", 1, "");
+  // spaces between a module name and its parameters, in successors, patterns and declarations
+  DERIVES("module Leaf (a, b)\nAxiom: Leaf (1, 2) F (3)\nproduction:\nLeaf (a, b) --> Leaf (b, a)\n", 1,
+          "Leaf(2,1)F(3)");
+  // a non-ASCII character is one module; u'' strings are plain strings
+  DERIVES("Axiom: A(u'\xc3\xa9') \xc3\xa9\nproduction:\n\xc3\xa9 --> B\n", 1, "A('\xc3\xa9')B");
+}
+
+#define PY_DERIVES(src, steps, expected)                                                           \
+  do {                                                                                             \
+    char b_[4096];                                                                                 \
+    vd_error e_ = {0};                                                                             \
+    CHECK_STATUS(derive_engine(src, VD_LSYS_PYTHON, steps, b_, sizeof b_, &e_), VD_OK, e_);        \
+    CHECK_STR(b_, expected);                                                                       \
+  } while (0)
+
+TEST(lpy, argument_lists_in_patterns_python_engine) {
+  // *args, **kwds (the names of `module A(x, t)`, the last parameters) and x(...) variables
+  // bind lists and dicts, as L-Py's matching does; the native engine refuses them
+  PY_DERIVES("module A(x, t)\nAxiom: A(1, 2, 3) B\nproduction:\nA(*args, **kw) :\n"
+             "  assert args == [1] and kw == {'x': 2, 't': 3}\n  produce C(len(args))\n",
+             1, "C(1)B");
+  PY_DERIVES("module A(x, t)\nAxiom: A(1, 2)\nproduction:\n*(**kw) :\n  assert kw == {'name': 'A', 'x': 1, 't': 2}\n"
+             "  produce D\n",
+             1, "D");
+  PY_DERIVES("Axiom: A(5, 6)\nproduction:\n*(n, x, *rest) :\n  assert n == 'A' and x == 5 and rest == [6]\n"
+             "  produce E\n",
+             1, "E");
+  PY_DERIVES("Axiom: I(0) I(1) A\nproduction:\nx(I(t)) < A :\n  assert t == [0, 1]\n  produce B\n", 1, "I(0)I(1)B");
+  PY_DERIVES("Axiom: A I(0) I(1)\nproduction:\nA > x(I(t)) :\n  assert t == [0, 1]\n  produce B\n", 1, "BI(0)I(1)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// turtle errors and warnings name the file line of the rule or axiom (issue 12 items 7 and 8)
+
+static char logged[2048];
+
+static void keep_log(void* user, int level, const char* msg) {
+  (void)user;
+  (void)level;
+  size_t n = strlen(logged);
+  snprintf(logged + n, sizeof logged - n, "%s\n", msg);
+}
+
+// grow src (with --set-like overrides name=value), status and error in *e
+static vd_status grow_status(const char* src, const char* name, const char* value, vd_error* e) {
+  vd_lsystem* ls;
+  memset(e, 0, sizeof *e);
+  vd_status st = vd_lsys_parse(src, strlen(src), "t.lpy", &ls, e);
+  if (st) return st;
+  if (name) st = vd_lsys_set_global(ls, name, value, e);
+  vd_plant_spec* P = vd_plant_spec_create();
+  if (!st) st = vd_lsys_grow(ls, NULL, NULL, P, e);
+  vd_plant_spec_destroy(P);
+  vd_lsys_destroy(ls);
+  return st;
+}
+
+TEST(lpy, turtle_errors_name_the_file_line) {
+  const char* src =
+      "PHYLLO = 137.5\n"
+      "Axiom: A\n"
+      "derivation length: 2\n"
+      "production:\n"
+      "A --> F(1) /(PHYLLO) B\n"
+      "B --> F(1e308 * 10)\n";
+  vd_error e;
+  CHECK_STATUS(grow_status(src, NULL, NULL, &e), VD_ERR_VALUE, e);
+  CHECK_INT(e.line, 6);
+  CHECK_STR(e.file, "t.lpy");
+  CHECK_STATUS(grow_status(src, "PHYLLO", "1e400", &e), VD_ERR_VALUE, e);
+  CHECK_INT(e.line, 5);
+  CHECK_STATUS(grow_status("Axiom: F\nproduction:\nF --> F ] F\n", NULL, NULL, &e), VD_ERR_SYNTAX, e);
+  CHECK_INT(e.line, 3);
+  // the axiom's line when the module comes from the axiom
+  CHECK_STATUS(grow_status("x = 1\nAxiom: F ] F\n", NULL, NULL, &e), VD_ERR_SYNTAX, e);
+  CHECK_INT(e.line, 2);
+}
+
+TEST(lpy, turtle_warnings_name_the_file_line) {
+  // an unclosed '[' and negative widths and radii are accepted (as L-Py does) with a warning
+  logged[0] = 0;
+  vd_set_log(keep_log, NULL);
+  vd_error e;
+  vd_status st = grow_status("Axiom: F\nderivation length: 1\nproduction:\nF --> F [ F _(-0.1) F(1, -0.2)\n", NULL,
+                             NULL, &e);
+  vd_set_log(NULL, NULL);
+  CHECK_STATUS(st, VD_OK, e);
+  CHECK(strstr(logged, "t.lpy:4: turtle: module 3 '_': negative width") != NULL);
+  CHECK(strstr(logged, "t.lpy:4: turtle: module 4 'F': negative radius") != NULL);
+  CHECK(strstr(logged, "t.lpy:4: turtle: module 1 '[': 1 '[' not closed") != NULL);
 }

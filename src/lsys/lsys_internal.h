@@ -19,7 +19,9 @@ typedef enum vtype {
   V_BUILTIN,  // n = builtin id
   V_NS,       // n = namespace id (NS_MATH, NS_RANDOM)
   V_UNDEF,    // a global slot that has no value yet
-  V_OBJ       // n = a boxed Python object handle (the Python engine's object table)
+  V_OBJ,      // n = a boxed Python object handle (the Python engine's object table)
+  V_LIST,     // n = a list bound by the match of a rule (*args, x(...) variables): ls->mlist[n]
+  V_DICT      // n = a dict bound by the match (**kwds): ls->mlist[n], keys and values alternate
 } vtype;
 
 typedef struct value {
@@ -146,6 +148,8 @@ typedef struct pmod {
 
 // What a few pattern elements need beyond a module.
 typedef struct pext {
+  int args_slot;   // PK_MOD / PK_ANY: slot of a trailing `*args` (a list), -1 none
+  int kwds_slot;   // slot of a trailing `**kwds` (a dict of the declared parameter names), -1 none
   int has_name;    // PK_ANY: written with parameters, the first one is the module name
   int name_slot;   // PK_ANY: slot of the name, -1 when the name is a constant (name_val)
   value name_val;  // PK_ANY: constant name (a string)
@@ -284,6 +288,21 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int opt_module_matching;      // 0 simple, 1 with *args, 2 with value constraints (default)
   int opt_axiom_decomposition;  // 1: the axiom is decomposed before the first step
   int has_bases;                // a module declaration names base modules (inheritance)
+  // parameter names declared with `module A(x, t)` (**kwds patterns): symbol, names (string ids)
+  int npdecl, cappdecl;
+  struct pdecl {
+    int32_t sym;
+    int n;
+    int* name;  // string ids (arena)
+  }* pdecl;
+  // lists and dicts bound by one rule match (*args, **kwds, x(...) variables): valid while the
+  // rule runs; mlist[i] = the values mval[at .. at + n)
+  struct mlist {
+    int at, n;
+  }* mlist;
+  int nmlist, capmlist;
+  value* mval;
+  int nmval, capmval;
   // labels declared by the file
   int nlabel;
   int* label_id;
@@ -309,6 +328,11 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
   struct vm_out* cur_out;  // where produce writes in the rule body (or hook) being run, NULL outside
+  // tracing a turtle error or warning back to the file (lsys_trace_lines)
+  vd_lsys_def last_def;    // the settings of the last derivation
+  int has_last_def;        // a derivation ran
+  int track_lines;         // keep the file line of every module (vd_lstring.line)
+  int quiet;               // print() says nothing (the run is a repeat)
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -337,6 +361,8 @@ int global_slot(vd_lsystem* ls, const char* name, int len, int create);
 int lstr_reserve(vd_lstring* s, int64_t nmod, int64_t nval);
 void lstr_clear(vd_lstring* s);
 int lstr_enable_src(vd_lstring* s);
+// Give s a line array (file line of the rule or axiom of each module); 0 out of memory.
+int lstr_enable_line(vd_lstring* s);
 // Copy src into dst (dst's arrays reused; src indices copied when src has them); 0 out of memory.
 int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src);
 
@@ -419,10 +445,19 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
                          int level, int* matched);
 // Free a run's scratch.
 void lsys_pass_free(lsys_pass* P);
+// A new list (or dict) of n values for the match being made: its id, -1 out of memory; its
+// values at ls->mval[ls->mlist[id].at] (to be filled).
+int lsys_mlist_new(vd_lsystem* ls, int n);
 // Run the turtle over s without keeping geometry, writing the turtle's position and frame into
 // the parameters of the query modules ?P ?H ?U ?L ?R of s.
 vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
 #define LSYS_SRC_IDENTITY (INT64_C(1) << 62)  // on a source index: the module was copied unchanged
+// File lines of the modules idx[0..n) of s, a string the last derivation made (interpreted or
+// not): the derivation runs again keeping lines; 1 when s is that string (lines[k] is 0 where
+// unknown), 0 otherwise.
+int lsys_trace_lines(vd_lsystem* ls, const vd_lstring* s, const int64_t* idx, int n, int* lines);
+// The file name of an lsystem ("" when parsed from text without one).
+const char* lsys_file(const vd_lsystem* ls);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
 int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
 
@@ -491,6 +526,21 @@ void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 void lsys_py_reset_objects(vd_lsystem* ls);
 vd_status lsys_py_set_global(vd_lsystem* ls, const char* name, const char* text);
 vd_status lsys_py_get_global(vd_lsystem* ls, const char* name, double* out);
+// What the turtle reads from object parameters (the Python engine's curves, functions and
+// geometry). Arrays are vd_malloc'd, the caller frees them (sizes from the counts). Each returns
+// VD_ERR_TYPE with a message in why (cap bytes) when v is not such an object (or no object at all).
+// A curve as points at equal steps of its parameter (its stride): n points of dim (2 or 3) coordinates.
+vd_status lsys_obj_points(const vd_lsystem* ls, double v, double** p, int* n, int* dim, char* why, size_t cap);
+// A guide: the curve's length, m + 1 points, unit tangents and unit normals at equal steps of
+// normalised arc length, and the dimension.
+vd_status lsys_obj_guide(const vd_lsystem* ls, double v, int m, double* length, double** p, double** tan,
+                         double** nrm, int* dim, char* why, size_t cap);
+// A function of x: its range and its n samples at equal steps (QuantisedFunction).
+vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* lx, double** val, int* n, char* why,
+                            size_t cap);
+// A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
+vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
+                        char* why, size_t cap);
 // repr() of an object parameter into buf (cap bytes); "None" for a stale handle
 void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 

@@ -28,7 +28,7 @@ static int rule_is_simple(const rule* r) {
   for (int p = 0; p < 3; p++)
     for (int k = 0; k < parts[p]->n; k++) {
       const pmod* m = &parts[p]->m[k];
-      if (m->kind != PK_MOD || m->exact) return 0;
+      if (m->kind != PK_MOD || m->exact || m->x) return 0;
       if (p < 2 && (m->sym == VD_SYM_SB || m->sym == VD_SYM_EB)) return 0;
     }
   return 1;
@@ -319,6 +319,7 @@ static inline vd_status copy_module(vd_lsystem* ls, const vd_lstring* in, int64_
   int64_t n = out->n;
   out->sym[n] = in->sym[i];
   if (out->src) out->src[n] = src;
+  if (out->line) out->line[n] = in->line ? in->line[i] : 0;
   int64_t v = out->par[n];
   for (int64_t k = 0; k < np; k++) out->val[v + k] = in->val[a + k];
   out->par[n + 1] = v + np;
@@ -355,6 +356,11 @@ void lsys_reverse_tail(vd_lstring* s, int64_t a) {
       int64_t u = s->src[x];
       s->src[x] = s->src[y];
       s->src[y] = u;
+    }
+    if (s->line) {
+      int32_t u = s->line[x];
+      s->line[x] = s->line[y];
+      s->line[y] = u;
     }
   }
   int64_t off = v0;
@@ -440,6 +446,19 @@ static inline __attribute__((always_inline)) int apply_try(vd_lsystem* ls, const
 }
 
 // ---------------------------------------------------------------------------------------------
+// lists bound by a match
+
+int lsys_mlist_new(vd_lsystem* ls, int n) {
+  if (!vd_grow((void**)&ls->mlist, &ls->capmlist, ls->nmlist + 1, sizeof(struct mlist)) ||
+      !vd_grow((void**)&ls->mval, &ls->capmval, ls->nmval + n, sizeof(value)))
+    return -1;
+  ls->mlist[ls->nmlist].at = ls->nmval;
+  ls->mlist[ls->nmlist].n = n;
+  ls->nmval += n;
+  return ls->nmlist++;
+}
+
+// ---------------------------------------------------------------------------------------------
 // passes
 
 void lsys_pass_free(lsys_pass* P) {
@@ -489,6 +508,7 @@ static vd_status step_simple(vd_lsystem* ls, int sec, const lsys_mctx* M, vd_lst
   const int* first = ls->rule_first[sec];
   const int* list = ls->rule_list[sec];
   int nsym = ls->rule_index_nsym;
+  const int py = ls->py != NULL;  // the engine does not change during a step
   value small[64];
   vm_out vo = {out, 0, max_modules, 0, 0};
   for (int64_t i = 0; i < in->n;) {
@@ -521,7 +541,7 @@ static vd_status step_simple(vd_lsystem* ls, int sec, const lsys_mctx* M, vd_lst
           vo.src = src;
           vo.produced = vo.nproduced = 0;
           vd_status st;
-          if (ls->py) {
+          if (py) {
             st = lsys_py_apply_rule(ls, r, frame, &vo);
           } else if (r->succ) {
             st = vm_emit_tmpl(ls, r->succ, frame, &vo);
@@ -632,7 +652,7 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
       // the production is rewritten again, on its own, one level deeper
       vd_lstring* buf = &P->lvl[level].buf;
       lstr_clear(buf);
-      if (!lstr_reserve(buf, 16, 16) || (out->src && !lstr_enable_src(buf)))
+      if (!lstr_reserve(buf, 16, 16) || (out->src && !lstr_enable_src(buf)) || (out->line && !lstr_enable_line(buf)))
         return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
       r = apply_try(ls, &M, P->max_modules, sec, i, buf, &b, &e, &st, 0);
       if (r < 0) return st;
