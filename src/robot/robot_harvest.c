@@ -15,6 +15,8 @@
 
 #include "robot_internal.h"
 
+
+#define KROT 2.0  // torsion spring of the grasp: k = KROT I / h^2 (explicit; stable below 4)
 #define GRIP_SPEED 0.02  // finger target speed (m/s): closes 20 mm in a second
 
 const char* vd_harvest_phase_name(vd_harvest_phase p) {
@@ -309,10 +311,10 @@ static void grasp_drive(vd_harvest* h, vd_pose e, vd_vec3* torque) {
   const robot_fruit* f = &h->fruit[h->target];
   vd_sim_data* sd = h->sd;
   sd->tie[h->tie].target = vd_add(e.pos, vd_quat_rotate(e.rot, h->hold_local));
-  // orientation: a spring on the fruit's stalk frame, stable explicitly (k h^2 / I = 0.5)
+  // orientation: a spring on the fruit's stalk frame, explicit (k h^2 / I = KROT)
   int t = f->seg;
   double ib = h->sm->seg_inertia[2 * t], it = h->sm->seg_inertia[2 * t + 1], dt = h->sm->opt.dt;
-  double inr = ib < it ? ib : it, k = 0.5 * inr / (dt * dt), c = sqrt(k * inr);
+  double inr = ib < it ? ib : it, k = KROT * inr / (dt * dt), c = sqrt(k * inr);
   vd_quat want = vd_quat_mul(e.rot, h->hold_rot);
   vd_vec3 tau = vd_sub(vd_scale(quat_log_v(vd_quat_mul(want, vd_quat_conj(sd->seg_quat[t]))), k),
                        vd_scale(sd->seg_omega[t], c));
