@@ -37,7 +37,7 @@ echo "== rendering pictures (headless: EGL, software rendering without a GPU)"
 "$V" render data/tomato.lpy --seed 1 -o out/tomato-arm.png --robot data/robots/arm6.xml --camera orbit:-60:20
 # the labelled cloud written above (200k sampled points)
 "$V" render out/tomato-cloud.ply -o out/tomato-cloud.png --camera orbit:-30:25 --point-size 0.004
-echo "   out/tomato.png (+ .label.png, .instance.png, .depth.png, .json), tomato-instance.png,"
+echo "   out/tomato.png (+ .label.png, .instance.png, .depth.png, .png.json), tomato-instance.png,"
 echo "   tomato-arm.png, tomato-cloud.png"
 echo "== physics: the tomato settles under gravity, then (sag-free) a probe pushes through it"
 "$V" sim data/tomato.lpy --seed 1 --settle --no-progress --stats > out/tomato-settle.json

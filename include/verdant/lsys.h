@@ -204,6 +204,15 @@ int vd_lsys_derivation_length(const vd_lsystem* ls);
 // `derivation length` (or def->steps) production steps with decomposition; the result is the
 // derived string (before interpretation) in *out, which is overwritten.
 vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err);
+// Derive step by step (growth loops): begin resets the globals (with --set overrides), runs the
+// Start hook and puts the axiom into *out; each vd_lsys_derive_step then applies one production
+// step with decomposition (StartEach/EndEach hooks) to s in place and sets s->src[j] to the
+// index, in the string before the step, of the module that module j came from, so a caller can
+// follow each module through the steps. def->steps is not read; the same seed gives the same
+// strings as vd_lsys_derive. VD_ERR_VALUE after Stop() was called.
+vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err);
+// One derivation step of a run started by vd_lsys_derive_begin (see there).
+vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* s, vd_error* err);
 // Apply interpretation (homomorphism) rules to a derived string; out->src maps each module back
 // to its module in `in`.
 vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lstring* in,

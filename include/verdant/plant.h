@@ -116,13 +116,18 @@ typedef struct vd_plant_spec {
   int* tri;                 // mesh triangles, indices into vert, counter-clockwise (ntri x 3)
   vd_label* label;          // label table sorted by id (nlabel)
   int cap_node, cap_seg, cap_sphere, cap_mesh, cap_vert, cap_tri, cap_label;  // capacities
+  double* node_stress;      // Nullable: stress at each node's section (Pa), NaN where none, set by
+                            // vd_plant_set_stress (nstress_node); stale once nodes are added
+  double* seg_stress;       // Nullable: largest stress of each segment (Pa), NaN where none
+                            // (nstress_seg)
+  int nstress_node, nstress_seg;  // lengths of the stress arrays
 } vd_plant_spec;
 
 // Create an empty spec; NULL when out of memory.
 vd_plant_spec* vd_plant_spec_create(void);
 // Free a spec (NULL is fine).
 void vd_plant_spec_destroy(vd_plant_spec* s);
-// Deep copy of a spec (every element and the label table); NULL when out of memory.
+// Deep copy of a spec (every element, the label table and the stress); NULL when out of memory.
 vd_plant_spec* vd_plant_spec_copy(const vd_plant_spec* s);
 // Remove every element, keeping the memory.
 void vd_plant_spec_clear(vd_plant_spec* s);
@@ -151,6 +156,12 @@ vd_status vd_plant_complete_labels(vd_plant_spec* s);
 // Default display colour of a label id: a fixed palette for 0..6 (grey, brown, green, red,
 // yellow, blue, purple), then a colour hashed from the id.
 void vd_plant_default_rgb(int id, float rgb[3]);
+
+// Attach stress (a simulation's result) to a spec: node (Nullable, nnode values) and seg
+// (Nullable, nseg values) in Pa, NaN where there is none; copied. Both NULL removes it.
+vd_status vd_plant_set_stress(vd_plant_spec* s, const double* node, const double* seg);
+// 1 when the spec carries stress for its current nodes and segments.
+int vd_plant_has_stress(const vd_plant_spec* s);
 
 // Summary of a plant for --stats.
 typedef struct vd_plant_stats {

@@ -21,6 +21,7 @@
 #include "verdant/render.h"
 #include "verdant/sim.h"
 #include "verdant/collide.h"
+#include "verdant/growth.h"
 #include "verdant/robot.h"
 
 #endif

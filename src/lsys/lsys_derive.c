@@ -354,7 +354,7 @@ static vd_status eval_max_depth(vd_lsystem* ls, int sec) {
 static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, lsys_pass* P,
                                  int* matched) {
   lstr_clear(tmp);
-  if (!lstr_reserve(tmp, cur->n + 16, cur->par[cur->n] + 16) || (cur->src && !lstr_enable_src(tmp)))
+  if (!lstr_reserve(tmp, cur->n + 16, (cur->par ? cur->par[cur->n] : 0) + 16) || (cur->src && !lstr_enable_src(tmp)))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
   vd_status st = lsys_recursive(ls, sec, cur, tmp, P, ls->max_depth[sec], 0, matched);
   if (st) return st;
@@ -364,17 +364,23 @@ static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_ls
 
 static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 
-vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
-  vd_error local = {0};
-  ls->err = err ? err : &local;
+// the run's settings with defaults filled in; the interpreter budget starts
+static vd_lsys_def run_def(vd_lsystem* ls, const vd_lsys_def* def, lsys_pass* P) {
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
   if (d.max_modules <= 0) d.max_modules = 50000000;
   vm_budget(ls, d.max_ops);
-  vd_lstring tmp = vd_lstring_empty();
-  lsys_pass P;
-  memset(&P, 0, sizeof P);
-  P.max_modules = d.max_modules;
+  memset(P, 0, sizeof *P);
+  P->max_modules = d.max_modules;
+  return d;
+}
+
+// the start of a run: top-level code, derivation length (steps Nullable), maximum depths, rule
+// index, hooks, axiom, Start hook and the axiom's decomposition; *early is set when L-Py returns
+// at once (no rule or no axiom)
+static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
+                           int* steps, int* early) {
   vd_status st = VD_OK;
+  *early = 0;
   if (ls->py) {
     lsys_py_enter(ls);
     lsys_py_reset_objects(ls);
@@ -383,6 +389,18 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     vd_free(out->src, sizeof(int64_t) * (size_t)out->cap);
     out->src = NULL;
   }
+  if ((st = run_toplevel(ls, d->seed))) return st;
+  if (steps) {
+    *steps = d->steps;
+    if (*steps < 0) {
+      *steps = 1;
+      if (ls->derivation_length) {
+        value v;
+        if ((st = vm_eval(ls, ls->derivation_length, NULL, &v))) return st;
+        if (!v_isnum(v) || v.n != floor(v.n) || v.n < 0 || v.n > 1e9)
+          return vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
+                          "derivation length must be a non-negative integer");
+        *steps = (int)v.n;
   if ((st = run_toplevel(ls, d.seed))) goto done;
   int steps = d.steps;
   if (steps < 0 && ls->py) {
@@ -397,20 +415,28 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
                       "derivation length must be a non-negative integer");
         goto done;
       }
-      steps = (int)v.n;
     }
   }
-  if ((st = eval_max_depth(ls, SEC_DECOMPOSITION)) || (st = eval_max_depth(ls, SEC_INTERPRETATION))) goto done;
-  if ((st = lsys_build_index(ls, 0, ls->backward))) {
-    vm_error(ls, st, 0, 0, "out of memory");
-    goto done;
-  }
+  if ((st = eval_max_depth(ls, SEC_DECOMPOSITION)) || (st = eval_max_depth(ls, SEC_INTERPRETATION))) return st;
+  if ((st = lsys_build_index(ls, 0, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
   ls->hook_start = find_hook(ls, "Start");
   ls->hook_end = find_hook(ls, "End");
   ls->hook_starteach = find_hook(ls, "StartEach");
   ls->hook_endeach = find_hook(ls, "EndEach");
+  ls->steps_done = 0;
   // axiom
   lstr_clear(out);
+  if (!lstr_reserve(out, 64, 64)) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  vm_out vo = {out, 0, d->max_modules, 0, 0};
+  if (ls->axiom) {
+    st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
+  } else if (ls->axiom_body) {
+    int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
+    value* frame = vd_malloc(sizeof(value) * (size_t)nl);
+    if (!frame) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
+    st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
+    vd_free(frame, sizeof(value) * (size_t)nl);
   if (!lstr_reserve(out, 64, 64)) {
     st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
     goto done;
@@ -434,16 +460,56 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     }
     if (st) goto done;
   }
+  if (st) return st;
   // L-Py returns at once, without calling any hook, when there is no rule or no axiom (and
   // "Early return when no matching" is on, its default)
-  if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) goto done;
+  if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) {
+    *early = 1;
+    return VD_OK;
+  }
   ls->iteration = 0;
+  if ((st = call_hook(ls, ls->hook_start))) return st;
   if ((st = call_hook(ls, ls->hook_start))) goto done;
   if (ls->py && (st = lsys_py_hook(ls, "Start", out, &tmp, d.max_modules))) goto done;
   if (ls->opt_axiom_decomposition && !lsys_section_empty(ls, SEC_DECOMPOSITION)) {
     int dm = 0;
-    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
+    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, tmp, P, &dm))) return st;
   }
+  return VD_OK;
+}
+
+// one derivation step up to EndEach (excluded): StartEach, productions, decomposition; *matching
+// tells whether a rule matched
+static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
+                          int* matching) {
+  ls->iteration = step;
+  ls->steps_done = step + 1;
+  ls->frame_displayed = last;
+  vd_status st = call_hook(ls, ls->hook_starteach);
+  if (st) return st;
+  // useGroup() and backward() take effect at the next step
+  if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
+  if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
+    if ((st = lsys_step(ls, SEC_PRODUCTION, out, tmp, P, matching))) return st;
+    lstr_swap(out, tmp);
+  }
+  if (!lsys_section_empty(ls, SEC_DECOMPOSITION)) {
+    int dm = 0;
+    if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, tmp, P, &dm))) return st;
+    if (dm) *matching = 1;
+  }
+  return VD_OK;
+}
+
+vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  vd_lsys_def d = run_def(ls, def, &P);
+  vd_lstring tmp = vd_lstring_empty();
+  int steps = 0, early = 0;
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, &steps, &early);
+  if (st || early) goto done;
   int matching = 1, step = 0;
   // DiscardNewString() (L-Py's __lpyfuture__) drops a step's result for the string at the end
   // of the step before; it works through the EndEach that module provides (or decorates)
@@ -451,6 +517,7 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
                 (ls->hook_endeach < 0 || ls->funcs[ls->hook_endeach]->discard_wrapped);
   int has_saved = 0;
   for (; (matching || !ls->opt_early_return) && step < steps; step++) {
+    if ((st = run_step(ls, step, step == steps - 1, out, &tmp, &P, &matching))) goto done;
     ls->iteration = step;
     ls->frame_displayed = step == steps - 1;
     if ((st = call_hook(ls, ls->hook_starteach))) goto done;
@@ -491,6 +558,38 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   if (step == steps && (st = call_hook(ls, ls->hook_end))) goto done;
   if (ls->py && step == steps && (st = lsys_py_hook(ls, "End", out, &tmp, d.max_modules))) goto done;
 done:
+  return end_run(ls, st, &tmp, &P);
+}
+
+vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  vd_lsys_def d = run_def(ls, def, &P);
+  vd_lstring tmp = vd_lstring_empty();
+  int early = 0;
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, NULL, &early);
+  return end_run(ls, st, &tmp, &P);
+}
+
+vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* s, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  vd_lsys_def d = run_def(ls, def, &P);
+  vd_lstring tmp = vd_lstring_empty();
+  vd_status st = VD_OK;
+  int matching = 1;
+  if (global_slot(ls, "DiscardNewString", 16, 0) >= 0)
+    st = vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0, "unsupported: DiscardNewString() in a step-by-step derivation");
+  else if (ls->stop_requested)
+    st = vm_error(ls, VD_ERR_VALUE, 0, 0, "the L-system has stopped (Stop() was called): no more steps");
+  // every module names itself as its source; the passes carry that to what it becomes
+  if (!st && (!lstr_enable_src(s) || !lstr_enable_src(&tmp))) st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  for (int64_t i = 0; !st && s->src && i < s->n; i++) s->src[i] = i;
+  if (!st) st = run_step(ls, ls->steps_done, 0, s, &tmp, &P, &matching);
+  if (!st) st = call_hook(ls, ls->hook_endeach);
+  if (!st && d.progress) d.progress(d.progress_user, ls->steps_done, ls->steps_done, s->n);
   return end_run(ls, st, &tmp, &P);
 }
 

@@ -303,6 +303,7 @@ struct vd_lsystem {
   int frame_displayed;     // the step is the last one (L-Py draws a frame then)
   int discard_requested;   // DiscardNewString(): the step's result is dropped
   int call_depth;
+  int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
   int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run

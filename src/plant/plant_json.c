@@ -114,6 +114,25 @@ static void w_col(jw* w, const char* indent, const char* key, col_type t, const 
   fprintf(w->fp, "]%s\n", last ? "" : ",");
 }
 
+// a stress column: NaN (no stress there) is written as null
+static void w_stress(jw* w, const char* key, const double* v, int n, int last) {
+  fprintf(w->fp, "    \"%s\": [", key);
+  for (int k = 0; k < n; k++) {
+    if (k) fputc(',', w->fp);
+    if (isnan(v[k])) fputs("null", w->fp);
+    else w_double(w, v[k]);
+  }
+  fprintf(w->fp, "]%s\n", last ? "" : ",");
+}
+
+static void write_stress(jw* w, const vd_plant_spec* s) {
+  if (!vd_plant_has_stress(s)) return;
+  fprintf(w->fp, "  \"stress\": {\n    \"unit\": \"Pa\",\n");
+  w_stress(w, "node", s->node_stress, s->nnode, 0);
+  w_stress(w, "segment", s->seg_stress, s->nseg, 1);
+  fprintf(w->fp, "  },\n");
+}
+
 static void write_labels(jw* w, const vd_plant_spec* s) {
   fprintf(w->fp, "  \"labels\": [");
   for (int i = 0; i < s->nlabel; i++) {
@@ -209,6 +228,7 @@ vd_status vd_plant_write_json(const vd_plant_spec* s, const char* path, vd_error
   write_segments(&w, s);
   write_spheres(&w, s);
   write_meshes(&w, s);
+  write_stress(&w, s);
   w_col(&w, "  ", "vertices", COL_DBL, s->vert, sizeof(vd_vec3), 0, s->nvert, 3, 0);
   w_col(&w, "  ", "triangles", COL_INT, s->tri, 3 * sizeof(int), 0, s->ntri, 3, 1);
   fprintf(f.fp, "}\n");
@@ -477,6 +497,50 @@ static int alloc_exact(void** p, int* cap, int n, size_t esz) {
 }
 
 // the body of parse: root object to spec
+// "stress": {"unit": "Pa", "node": [...], "segment": [...]}, numbers >= 0 or null (none)
+static vd_status read_stress(rd* r, const cJSON* root, vd_plant_spec* s) {
+  const cJSON* sec = cJSON_GetObjectItemCaseSensitive(root, "stress");
+  if (!sec) return VD_OK;
+  if (!cJSON_IsObject(sec)) return fail(r, "stress: expected an object of columns");
+  const cJSON* unit = cJSON_GetObjectItemCaseSensitive(sec, "unit");
+  if (unit && (!cJSON_IsString(unit) || strcmp(unit->valuestring, "Pa") != 0)) return fail(r, "stress.unit: expected \"Pa\"");
+  const char* keys[2] = {"node", "segment"};
+  int want[2] = {s->nnode, s->nseg};
+  double* col[2] = {NULL, NULL};
+  vd_status st = VD_OK;
+  for (int k = 0; k < 2 && !st; k++) {
+    const cJSON* a = cJSON_GetObjectItemCaseSensitive(sec, keys[k]);
+    if (!a || !cJSON_IsArray(a)) {
+      st = fail(r, "stress.%s: expected an array", keys[k]);
+      break;
+    }
+    if (cJSON_GetArraySize(a) != want[k]) {
+      st = fail(r, "stress.%s: expected %d values (one per %s), got %d", keys[k], want[k], keys[k], cJSON_GetArraySize(a));
+      break;
+    }
+    col[k] = vd_malloc(sizeof(double) * (size_t)(want[k] ? want[k] : 1));
+    if (!col[k]) {
+      st = vd_error_set(r->err, VD_ERR_NOMEM, r->file, 0, 0, "out of memory reading plant");
+      break;
+    }
+    int i = 0;
+    for (const cJSON* v = a->child; v; v = v->next, i++) {
+      if (cJSON_IsNull(v)) {
+        col[k][i] = NAN;
+      } else if (cJSON_IsNumber(v) && v->valuedouble >= 0 && isfinite(v->valuedouble)) {
+        col[k][i] = v->valuedouble;
+      } else {
+        st = fail(r, "stress.%s[%d]: expected a stress >= 0 (Pa) or null", keys[k], i);
+        break;
+      }
+    }
+  }
+  if (!st && vd_plant_set_stress(s, col[0], col[1]))
+    st = vd_error_set(r->err, VD_ERR_NOMEM, r->file, 0, 0, "out of memory reading plant");
+  for (int k = 0; k < 2; k++) vd_free(col[k], sizeof(double) * (size_t)(want[k] ? want[k] : 1));
+  return st;
+}
+
 static vd_status read_root(rd* r, const cJSON* root, vd_plant_spec* s) {
   vd_status st = VD_OK;
   if (!cJSON_IsObject(root)) return fail(r, "expected a JSON object at the top level");
@@ -532,6 +596,8 @@ static vd_status read_root(rd* r, const cJSON* root, vd_plant_spec* s) {
   if (segs && (st = read_segments(r, segs, s, nseg))) return st;
   if (sphs && (st = read_spheres(r, sphs, s, nsph))) return st;
   if (mshs && (st = read_meshes(r, mshs, s, nmesh))) return st;
+
+  if ((st = read_stress(r, root, s))) return st;
 
   // largest instance id in use
   for (int i = 0; i < nseg; i++)

@@ -26,7 +26,34 @@ void vd_plant_spec_destroy(vd_plant_spec* s) {
   vd_free(s->vert, (size_t)s->cap_vert * sizeof *s->vert);
   vd_free(s->tri, (size_t)s->cap_tri * 3 * sizeof *s->tri);
   vd_free(s->label, (size_t)s->cap_label * sizeof *s->label);
+  vd_plant_set_stress(s, NULL, NULL);
   vd_free(s, sizeof *s);
+}
+
+vd_status vd_plant_set_stress(vd_plant_spec* s, const double* node, const double* seg) {
+  vd_free(s->node_stress, (size_t)s->nstress_node * sizeof(double));
+  vd_free(s->seg_stress, (size_t)s->nstress_seg * sizeof(double));
+  s->node_stress = s->seg_stress = NULL;
+  s->nstress_node = s->nstress_seg = 0;
+  if (!node && !seg) return VD_OK;
+  size_t nn = (size_t)(s->nnode ? s->nnode : 1), ns = (size_t)(s->nseg ? s->nseg : 1);
+  double* a = vd_malloc(nn * sizeof(double));
+  double* b = vd_malloc(ns * sizeof(double));
+  if (!a || !b) {
+    vd_free(a, nn * sizeof(double));
+    vd_free(b, ns * sizeof(double));
+    return VD_ERR_NOMEM;
+  }
+  for (int i = 0; i < s->nnode; i++) a[i] = node ? node[i] : NAN;
+  for (int i = 0; i < s->nseg; i++) b[i] = seg ? seg[i] : NAN;
+  s->node_stress = a, s->nstress_node = (int)nn;
+  s->seg_stress = b, s->nstress_seg = (int)ns;
+  return VD_OK;
+}
+
+int vd_plant_has_stress(const vd_plant_spec* s) {
+  return s->node_stress && s->seg_stress && s->nstress_node == (s->nnode ? s->nnode : 1) &&
+         s->nstress_seg == (s->nseg ? s->nseg : 1);
 }
 
 // copy n elements of size elem into a new block of exactly n (capacity n); 1 on success
@@ -59,6 +86,11 @@ vd_plant_spec* vd_plant_spec_copy(const vd_plant_spec* s) {
   }
   c->nnode = s->nnode, c->nseg = s->nseg, c->nsphere = s->nsphere, c->nmesh = s->nmesh;
   c->nvert = s->nvert, c->ntri = s->ntri, c->nlabel = s->nlabel, c->ninstance = s->ninstance;
+  // the stress a simulation attached comes along
+  if (vd_plant_has_stress(s) && vd_plant_set_stress(c, s->node_stress, s->seg_stress)) {
+    vd_plant_spec_destroy(c);
+    return NULL;
+  }
   return c;
 }
 
@@ -66,6 +98,7 @@ void vd_plant_spec_clear(vd_plant_spec* s) {
   if (!s) return;
   s->nnode = s->nseg = s->nsphere = s->nmesh = s->nvert = s->ntri = s->nlabel = 0;
   s->ninstance = 0;
+  vd_plant_set_stress(s, NULL, NULL);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -11,28 +11,9 @@
 // numerical damping, never as the air model.
 #include "sim_internal.h"
 
+// the rods' wind: the one implementation the mass-spring trees use too (sim_mss_forces.c)
 vd_vec3 sim_wind_at(const vd_sim_opt* o, double t) {
-  // a time series replaces the mean wind and the gusts; linear between rows, held at the ends
-  if (o->wind_series && o->nwind > 0) {
-    const double* w = o->wind_series;
-    if (t <= w[0] || o->nwind == 1) return vd_v3(w[1], w[2], w[3]);
-    const double* z = w + 4 * (o->nwind - 1);
-    if (t > z[0]) return vd_v3(z[1], z[2], z[3]);
-    // the first row i with t <= t_i, by bisection (long series: no scan per step)
-    int lo = 0, hi = o->nwind - 1;  // t > t_lo, t <= t_hi
-    while (hi - lo > 1) {
-      int mid = lo + (hi - lo) / 2;
-      if (t <= w[4 * mid]) hi = mid;
-      else lo = mid;
-    }
-    const double* a = w + 4 * (hi - 1);
-    const double* b = w + 4 * hi;
-    double s = b[0] > a[0] ? (t - a[0]) / (b[0] - a[0]) : 1.0;
-    return vd_v3(a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]));
-  }
-  double f = 1.0;
-  if (o->gust_period > 0) f += o->gust_amplitude * sin(2 * VD_PI * t / o->gust_period);
-  return vd_scale(o->wind, f);
+  return vd_wind_at(o->wind, o->gust_amplitude, o->gust_period, o->wind_series, o->nwind, t);
 }
 
 // velocity of a node (zero when kinematic)

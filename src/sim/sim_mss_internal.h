@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: MIT
+// Private pieces of the mass-spring trees (sim_mss*.c, sim_rigid.c): the scratch of a state and
+// the functions the files share.
+#ifndef VERDANT_SIM_MSS_INTERNAL_H
+#define VERDANT_SIM_MSS_INTERNAL_H
+
+#include "sim_internal.h"
+
+// Scratch of one state, one block (vd_mss_data::work).
+typedef struct mss_work {
+  vd_vec3* fint;   // internal forces: springs, hinges, damping (N) (nnode)
+  vd_vec3* ftot;   // all forces on a node (N) (nnode)
+  vd_vec3* cg_r;   // conjugate gradients: residual, preconditioned residual, direction, A p,
+  vd_vec3* cg_z;   // solution and right-hand side (nnode each)
+  vd_vec3* cg_p;
+  vd_vec3* cg_ap;
+  vd_vec3* cg_x;
+  vd_vec3* cg_b;
+  vd_vec3* dvs;    // eq. 3: predicted velocity changes of the neighbours; eq. 4: their sum (nnode)
+  vd_vec3* pos0;   // state at the start of the substep (undo after a non-finite result) (nnode)
+  vd_vec3* vel0;
+  vd_vec3* fsub;   // stress: force and moment of each subtree (nnode)
+  vd_vec3* msub;
+  double* pre;     // block-Jacobi preconditioner, inverted diagonal blocks (nnode x 9)
+  double* cdrag;   // derivative of the air drag with respect to the node's velocity (N s/m) (nnode)
+  double* ksum;    // eqs. 3-4: sum of the spring constants at each node (N/m) (nnode)
+  double* spring_c;// damping coefficient of each spring this substep, eq. 5 (N s/m) (nspring)
+  unsigned char* con;  // 1: the node's velocity change is fixed at 0 in this substep (nnode)
+  // the direct solver: block LDL^T in an elimination order where the couplings of a tree of
+  // springs and hinges (parent, grandparent, sibling arm) make little fill
+  int direct;      // 1 when the structure fits MSS_LINKS links per node (else conjugate gradients)
+  int* elim;       // elimination order: children before parents (nnode)
+  int* epos;       // position of each node in it (nnode)
+  int* nlink;      // links of each node to nodes eliminated after it (nnode)
+  int* link;       // their targets (nnode x MSS_LINKS)
+  double* lblk;    // block A[target][node] of each link (nnode x MSS_LINKS x 9)
+  double* diag;    // diagonal blocks, inverted during the factorisation (nnode x 9)
+} mss_work;
+
+#define MSS_LINKS 8  // most links (couplings to later nodes, fill included) per node
+
+// Put the rigid body's members at the body's pose and velocity.
+void mss_rigid_sync(const vd_mss_model* m, vd_mss_data* d);
+// External loads of a substep into d->fext (gravity, caller's force, wind, drag, tropisms) and
+// each node's drag derivative into w->cdrag.
+void mss_external(const vd_mss_model* m, vd_mss_data* d, mss_work* w);
+// Internal forces of springs and hinges (and damping) at the current state into w->fint; rigid
+// pairs are skipped.
+void mss_internal(const vd_mss_model* m, const vd_mss_data* d, mss_work* w);
+// Subtree equilibrium: force and moment of the loads beyond every node (w->fsub, w->msub).
+void mss_subtrees(const vd_mss_model* m, const vd_mss_data* d, mss_work* w);
+// Remove the subtree beyond spring s (a break); returns the nodes removed.
+int mss_remove_subtree(const vd_mss_model* m, vd_mss_data* d, int s);
+// Add an event; 0 when out of memory.
+int mss_event(vd_mss_data* d, const vd_mss_event* e);
+
+// whether a node moves with the springs (not fixed, not rigid, not removed)
+static inline int mss_free(const vd_mss_model* m, const vd_mss_data* d, int i) {
+  return !(m->node_flags[i] & VD_MSS_FIXED) && !d->rigid[i] && !d->removed[i];
+}
+
+#endif

@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: MIT
+// growth: derivation step by step with module sources, the growth loop on the bundled tree with
+// each model (stable ids, eq. 1 momentum, mass update, rigid joins), determinism, bad settings,
+// stress carried into plant JSON.
+#include <stdlib.h>
+
+#include "test.h"
+#include "verdant/verdant.h"
+
+static vd_lsystem* load(const char* rel) {
+  vd_error e = {0};
+  vd_lsystem* ls = NULL;
+  if (vd_lsys_load(vdt_path(rel), &ls, &e)) return NULL;
+  return ls;
+}
+
+TEST(growth, derive_step_matches_derive) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  vd_lsys_def def = vd_lsys_def_default();
+  def.seed = 3;
+  vd_lstring a = vd_lstring_empty(), b = vd_lstring_empty();
+  REQUIRE(vd_lsys_derive_begin(ls, &def, &a, &e) == VD_OK);
+  for (int k = 1; k <= 4; k++) {
+    int64_t nprev = a.n;
+    REQUIRE(vd_lsys_derive_step(ls, &def, &a, &e) == VD_OK);
+    // every module names a module of the string before the step, in order
+    REQUIRE(a.src);
+    int ok = 1;
+    for (int64_t j = 0; j < a.n; j++) ok &= a.src[j] >= 0 && a.src[j] < nprev && (j == 0 || a.src[j] >= a.src[j - 1]);
+    CHECK(ok);
+    // the same strings as a derivation of k steps
+    vd_lsys_def dk = def;
+    dk.steps = k;
+    REQUIRE(vd_lsys_derive(ls, &dk, &b, &e) == VD_OK);
+    REQUIRE(a.n == b.n);
+    CHECK(memcmp(a.sym, b.sym, sizeof(int32_t) * (size_t)a.n) == 0);
+    CHECK(memcmp(a.val, b.val, sizeof(double) * (size_t)a.par[a.n]) == 0);
+  }
+  vd_lstring_free(&a);
+  vd_lstring_free(&b);
+  vd_lsys_destroy(ls);
+}
+
+static vd_growth* grow_tree(vd_lsystem* ls, vd_growth_model model, int ages, double wind, vd_error* e) {
+  vd_growth_def def = vd_growth_def_default();
+  def.model = model;
+  def.substeps = 10;
+  def.opt.wind = vd_v3(wind, 0, 0);
+  vd_growth* g = NULL;
+  if (vd_growth_create(ls, &def, &g, e)) return NULL;
+  for (int k = 0; k < ages; k++)
+    if (vd_growth_step(g, e)) {
+      vd_growth_destroy(g);
+      return NULL;
+    }
+  return g;
+}
+
+TEST(growth, tree_mss_and_mrl_conserve_momentum) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  for (int model = VD_GROWTH_MSS; model <= VD_GROWTH_MRL; model++) {
+    vd_growth* g = grow_tree(ls, (vd_growth_model)model, 5, 10, &e);
+    REQUIRE(g);
+    vd_growth_stats st;
+    vd_growth_get_stats(g, &st);
+    CHECK_INT(st.age, 5);
+    CHECK(st.nphys > 100);
+    CHECK(st.momentum_error < 1e-12);
+    CHECK(st.height > 0.9 * st.height0 && st.height0 > 3);
+    CHECK(!st.collapsed);
+    CHECK(st.max_stress > 0);
+    if (model == VD_GROWTH_MRL) CHECK(st.nrigid > 0);
+    else CHECK_INT(st.nrigid, 0);
+    vd_growth_destroy(g);
+  }
+  vd_lsys_destroy(ls);
+}
+
+TEST(growth, deterministic_plant_and_stress) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  char path[2][512];
+  for (int run = 0; run < 2; run++) {
+    vd_growth* g = grow_tree(ls, VD_GROWTH_MRL, 4, 12, &e);
+    REQUIRE(g);
+    vd_plant_spec* p = NULL;
+    REQUIRE(vd_growth_plant(g, &p, &e) == VD_OK);
+    CHECK(vd_plant_has_stress(p));
+    snprintf(path[run], sizeof path[run], "%s/growth_det_%d.json", vdt_tmpdir(), run);
+    CHECK(vd_plant_write_json(p, path[run], &e) == VD_OK);
+    vd_plant_spec_destroy(p);
+    vd_growth_destroy(g);
+  }
+  char *a = NULL, *b = NULL;
+  size_t la = 0, lb = 0;
+  REQUIRE(vd_file_read(path[0], &a, &la, &e) == VD_OK);
+  REQUIRE(vd_file_read(path[1], &b, &lb, &e) == VD_OK);
+  CHECK(la == lb && memcmp(a, b, la) == 0);
+  // the stress comes back from the file
+  vd_plant_spec* r = NULL;
+  REQUIRE(vd_plant_read_json(path[0], &r, &e) == VD_OK);
+  CHECK(vd_plant_has_stress(r));
+  int finite = 0;
+  for (int j = 0; j < r->nseg; j++) finite += isfinite(r->seg_stress[j]);
+  CHECK(finite > 10);
+  vd_plant_spec_destroy(r);
+  vd_free(a, la + 1);
+  vd_free(b, lb + 1);
+  vd_lsys_destroy(ls);
+}
+
+TEST(growth, bad_settings) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  vd_growth* g = NULL;
+  vd_growth_def def = vd_growth_def_default();
+  def.substeps = 0;
+  CHECK_INT(vd_growth_create(ls, &def, &g, &e), VD_ERR_VALUE);
+  CHECK(g == NULL);
+  def = vd_growth_def_default();
+  def.mss.density_wood = -900;
+  CHECK_INT(vd_growth_create(ls, &def, &g, &e), VD_ERR_VALUE);
+  def = vd_growth_def_default();
+  def.opt.dt = 0;
+  CHECK_INT(vd_growth_create(ls, &def, &g, &e), VD_ERR_VALUE);
+  // a light inside the plant: an error at the first step that puts it inside
+  def = vd_growth_def_default();
+  def.substeps = 2;
+  def.opt.light = 1;
+  def.opt.light_pos = vd_v3(0, 0, -0.1);  // among the roots
+  vd_status st = vd_growth_create(ls, &def, &g, &e);
+  for (int k = 0; !st && k < 2; k++) st = vd_growth_step(g, &e);
+  CHECK_INT(st, VD_ERR_VALUE);
+  vd_growth_destroy(g);
+  vd_lsys_destroy(ls);
+}
