@@ -392,7 +392,9 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
   if ((st = run_toplevel(ls, d->seed))) return st;
   if (steps) {
     *steps = d->steps;
-    if (*steps < 0) {
+    if (*steps < 0 && ls->py) {
+      if ((st = lsys_py_dlength_eval(ls, steps))) return st;
+    } else if (*steps < 0) {
       *steps = 1;
       if (ls->derivation_length) {
         value v;
@@ -401,19 +403,6 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
           return vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
                           "derivation length must be a non-negative integer");
         *steps = (int)v.n;
-  if ((st = run_toplevel(ls, d.seed))) goto done;
-  int steps = d.steps;
-  if (steps < 0 && ls->py) {
-    if ((st = lsys_py_dlength_eval(ls, &steps))) goto done;
-  } else if (steps < 0) {
-    steps = 1;
-    if (ls->derivation_length) {
-      value v;
-      if ((st = vm_eval(ls, ls->derivation_length, NULL, &v))) goto done;
-      if (!v_isnum(v) || v.n != floor(v.n) || v.n < 0 || v.n > 1e9) {
-        st = vm_error(ls, VD_ERR_VALUE, ls->derivation_length->line, ls->derivation_length->col,
-                      "derivation length must be a non-negative integer");
-        goto done;
       }
     }
   }
@@ -428,7 +417,9 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
   lstr_clear(out);
   if (!lstr_reserve(out, 64, 64)) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
   vm_out vo = {out, 0, d->max_modules, 0, 0};
-  if (ls->axiom) {
+  if (ls->py) {
+    st = lsys_py_emit_axiom(ls, &vo);
+  } else if (ls->axiom) {
     st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
   } else if (ls->axiom_body) {
     int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
@@ -437,28 +428,6 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
     for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
     st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
     vd_free(frame, sizeof(value) * (size_t)nl);
-  if (!lstr_reserve(out, 64, 64)) {
-    st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-    goto done;
-  }
-  {
-    vm_out vo = {out, 0, d.max_modules, 0, 0};
-    if (ls->py) {
-      st = lsys_py_emit_axiom(ls, &vo);
-    } else if (ls->axiom) {
-      st = vm_emit_tmpl(ls, ls->axiom, NULL, &vo);
-    } else if (ls->axiom_body) {
-      int nl = ls->axiom_nlocal > 0 ? ls->axiom_nlocal : 1;
-      value* frame = vd_malloc(sizeof(value) * (size_t)nl);
-      if (!frame) {
-        st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-        goto done;
-      }
-      for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
-      st = vm_exec_block(ls, ls->axiom_body, frame, &vo, NULL, NULL);
-      vd_free(frame, sizeof(value) * (size_t)nl);
-    }
-    if (st) goto done;
   }
   if (st) return st;
   // L-Py returns at once, without calling any hook, when there is no rule or no axiom (and
@@ -469,8 +438,7 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
   }
   ls->iteration = 0;
   if ((st = call_hook(ls, ls->hook_start))) return st;
-  if ((st = call_hook(ls, ls->hook_start))) goto done;
-  if (ls->py && (st = lsys_py_hook(ls, "Start", out, &tmp, d.max_modules))) goto done;
+  if (ls->py && (st = lsys_py_hook(ls, "Start", out, tmp, d->max_modules))) return st;
   if (ls->opt_axiom_decomposition && !lsys_section_empty(ls, SEC_DECOMPOSITION)) {
     int dm = 0;
     if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, tmp, P, &dm))) return st;
@@ -487,6 +455,7 @@ static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, v
   ls->frame_displayed = last;
   vd_status st = call_hook(ls, ls->hook_starteach);
   if (st) return st;
+  if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, tmp, P->max_modules))) return st;
   // useGroup() and backward() take effect at the next step
   if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
   if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
@@ -518,24 +487,6 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   int has_saved = 0;
   for (; (matching || !ls->opt_early_return) && step < steps; step++) {
     if ((st = run_step(ls, step, step == steps - 1, out, &tmp, &P, &matching))) goto done;
-    ls->iteration = step;
-    ls->frame_displayed = step == steps - 1;
-    if ((st = call_hook(ls, ls->hook_starteach))) goto done;
-    if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, &tmp, d.max_modules))) goto done;
-    // useGroup() and backward() take effect at the next step
-    if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) {
-      vm_error(ls, st, 0, 0, "out of memory");
-      goto done;
-    }
-    if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
-      if ((st = lsys_step(ls, SEC_PRODUCTION, out, &tmp, &P, &matching))) goto done;
-      lstr_swap(out, &tmp);
-    }
-    if (!lsys_section_empty(ls, SEC_DECOMPOSITION)) {
-      int dm = 0;
-      if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, &tmp, &P, &dm))) goto done;
-      if (dm) matching = 1;
-    }
     if (!(discard && ls->discard_requested) && (st = call_hook(ls, ls->hook_endeach))) goto done;
     if (ls->py && (st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules))) goto done;
     if (discard) {
@@ -580,6 +531,7 @@ vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring
   vd_lstring tmp = vd_lstring_empty();
   vd_status st = VD_OK;
   int matching = 1;
+  if (ls->py) lsys_py_enter(ls);
   if (global_slot(ls, "DiscardNewString", 16, 0) >= 0)
     st = vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0, "unsupported: DiscardNewString() in a step-by-step derivation");
   else if (ls->stop_requested)
@@ -589,6 +541,7 @@ vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring
   for (int64_t i = 0; !st && s->src && i < s->n; i++) s->src[i] = i;
   if (!st) st = run_step(ls, ls->steps_done, 0, s, &tmp, &P, &matching);
   if (!st) st = call_hook(ls, ls->hook_endeach);
+  if (!st && ls->py) st = lsys_py_hook(ls, "EndEach", s, &tmp, d.max_modules);
   if (!st && d.progress) d.progress(d.progress_user, ls->steps_done, ls->steps_done, s->n);
   return end_run(ls, st, &tmp, &P);
 }
