@@ -209,3 +209,50 @@ TEST(lpy, discard_new_string) {
       "  produce A B\n";
   DERIVES(src, -1, "ABB");
 }
+
+TEST(lpy, query_modules_filled_before_each_step) {
+  // the turtle fills ?P before the step (L-Py's environmental programs)
+  DERIVES("Axiom: ?P(0,0,0) F(2) ?P(0,0,0) +(90) F(1) ?P(0,0,0)\nproduction:\n?P(x, y, z) --> B(x, y, z)\n", 1,
+          "B(0,0,0)F(2)B(0,0,2)+(90)F(1)B(0,-1,2)");
+  // a model that prunes what grows above z = 3 stops; unfilled, it grew without bound
+  DERIVES("Axiom: A ?P(0,0,0)\nderivation length: 6\nproduction:\nA ?P(x, y, z) :\n  if z > 3: produce\n"
+          "  produce F(1) A ?P(0,0,0)\n",
+          -1, "F(1)F(1)F(1)F(1)");
+  // a module an interpretation rule rewrites keeps its values (L-Py fills the rewritten copy)
+  DERIVES("Axiom: F(1) ?H(0,0,0) ?U(0,0,0) ?L(0,0,0) ?R(0,0,0) ?P(7,7,7)\nproduction:\n"
+          "?H(a,b,c) ?U(d,e,f) ?L(g,h,i) ?R(j,k,l) ?P(x,y,z) --> H(a,b,c) U(d,e,f) L(g,h,i) R(j,k,l) P(x,y,z)\n"
+          "interpretation:\n?P(x,y,z) --> ?P(x,y,z)\n",
+          1, "F(1)H(0,0,1)U(1,0,0)L(0,-1,0)R(0,1,0)P(7,7,7)");
+  REFUSED("Axiom: ?P\nproduction:\n?P --> A\n", "?P without parameters");
+  REFUSED("Axiom: ?F(0,0,0,0)\nproduction:\n?F(p,h,u,l) --> A\n", "?F");
+}
+
+TEST(lpy, start_end_interpretation_produce) {
+  // what StartInterpretation / EndInterpretation produce is drawn before / after the string
+  const char* src =
+      "def StartInterpretation():\n  produce @O(0.2) +(90)\n"
+      "def EndInterpretation():\n  nproduce @O(0.3)\n"
+      "Axiom: F(1)\n";
+  vd_lsystem* ls;
+  vd_error e = {0};
+  CHECK_STATUS(vd_lsys_parse(src, strlen(src), "t.lpy", &ls, &e), VD_OK, e);
+  vd_plant_spec* P = vd_plant_spec_create();
+  CHECK_STATUS(vd_lsys_grow(ls, NULL, NULL, P, &e), VD_OK, e);
+  CHECK_INT(P->nsphere, 2);
+  CHECK_INT(P->nseg, 1);
+  if (P->nseg == 1) {
+    vd_vec3 b = P->node[P->seg[0].node1];
+    CHECK_NEAR(b.y, -1, 1e-12);
+    CHECK_NEAR(b.z, 0, 1e-12);
+  }
+  vd_plant_spec_destroy(P);
+  vd_lsys_destroy(ls);
+}
+
+TEST(lpy, nproduce_in_a_def) {
+  // nproduce in a helper adds to the production of the rule that calls it; produce in a def
+  // adds and returns from the def
+  DERIVES("def two(x):\n  nproduce B(x) B(x + 1)\ndef one():\n  produce C\n  nproduce D\n"
+          "Axiom: A(1)\nproduction:\nA(x) :\n  two(x)\n  one()\n",
+          1, "B(1)B(2)C");
+}

@@ -364,6 +364,58 @@ static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_ls
 
 static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 
+// StartInterpretation / EndInterpretation: what they produce is drawn before / after the string
+// (with source index src)
+static vd_status interpretation_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src,
+                                     int64_t max_modules) {
+  int fi = find_hook(ls, name);
+  if (fi < 0) return VD_OK;
+  func* f = ls->funcs[fi];
+  if (f->nparam != 0)
+    return vm_error(ls, VD_ERR_UNSUPPORTED, f->line, 1, "unsupported: hook %s(turtle) (the turtle object)", f->name);
+  vm_out vo = {out, src, max_modules, 0, 0};
+  vm_out* outer = ls->cur_out;
+  ls->cur_out = &vo;
+  value r;
+  vd_status st = vm_call_func(ls, fi, 0, NULL, &r, f->line, 1);
+  ls->cur_out = outer;
+  return st;
+}
+
+// the string through the interpretation rules, the hooks' modules around it; out->src maps
+// each module to the module of in it came from (in->n and in->n + 1 for the hooks)
+static vd_status interpret_into(vd_lsystem* ls, const vd_lstring* in, vd_lstring* out, lsys_pass* P) {
+  vd_status st = lsys_build_index(ls, ls->current_group, 0);  // interpretation reads forward
+  if (st) return vm_error(ls, st, 0, 0, "out of memory");
+  lstr_clear(out);
+  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16))
+    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  if ((st = interpretation_hook(ls, "StartInterpretation", out, in->n, P->max_modules))) return st;
+  int m = 0;
+  if ((st = lsys_recursive(ls, SEC_INTERPRETATION, in, out, P, ls->max_depth[SEC_INTERPRETATION], 0, &m))) return st;
+  return interpretation_hook(ls, "EndInterpretation", out, in->n + 1, P->max_modules);
+}
+
+// L-Py's environmental programs: before a step whose rules read query modules, the turtle
+// interprets the string and fills ?P ?H ?U ?L ?R with its position and frame (in the modules
+// the interpretation rules leave as they are)
+static vd_status query_pass(vd_lsystem* ls, vd_lstring* s, lsys_pass* P) {
+  vd_lstring* geo = &P->geo;
+  P->identity_bit = LSYS_SRC_IDENTITY;
+  vd_status st = interpret_into(ls, s, geo, P);
+  P->identity_bit = 0;
+  if (st) return st;
+  if ((st = lsys_turtle_query(ls, geo, ls->err))) return st;
+  for (int64_t k = 0; k < geo->n; k++) {
+    int32_t sym = geo->sym[k];
+    if (sym < VD_SYM_GETPOS || sym > VD_SYM_GETRIGHT || !(geo->src[k] & LSYS_SRC_IDENTITY)) continue;
+    int64_t j = geo->src[k] & ~LSYS_SRC_IDENTITY;
+    int64_t np = geo->par[k + 1] - geo->par[k];
+    memcpy(s->val + s->par[j], geo->val + geo->par[k], sizeof(double) * (size_t)np);
+  }
+  return VD_OK;
+}
+
 // the run's settings with defaults filled in; the interpreter budget starts
 static vd_lsys_def run_def(vd_lsystem* ls, const vd_lsys_def* def, lsys_pass* P) {
   vd_lsys_def d = def ? *def : vd_lsys_def_default();
@@ -446,8 +498,8 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
   return VD_OK;
 }
 
-// one derivation step up to EndEach (excluded): StartEach, productions, decomposition; *matching
-// tells whether a rule matched
+// one derivation step up to EndEach (excluded): StartEach, the query pass, productions,
+// decomposition; *matching tells whether a rule matched
 static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
                           int* matching) {
   ls->iteration = step;
@@ -459,6 +511,11 @@ static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, v
   // useGroup() and backward() take effect at the next step
   if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
   if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
+    if (ls->has_query[SEC_PRODUCTION]) {
+      if ((st = query_pass(ls, out, P))) return st;
+      if ((st = lsys_build_index(ls, ls->current_group, ls->backward)))
+        return vm_error(ls, st, 0, 0, "out of memory");
+    }
     if ((st = lsys_step(ls, SEC_PRODUCTION, out, tmp, P, matching))) return st;
     lstr_swap(out, tmp);
   }
@@ -550,31 +607,13 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
                             vd_error* err) {
   vd_error local = {0};
   ls->err = err ? err : &local;
-  vd_lsys_def d = def ? *def : vd_lsys_def_default();
-  if (d.max_modules <= 0) d.max_modules = 50000000;
-  vm_budget(ls, d.max_ops);
   lsys_pass P;
-  memset(&P, 0, sizeof P);
-  P.max_modules = d.max_modules;
+  run_def(ls, def, &P);
   vd_lstring tmp = vd_lstring_empty();
-  vd_status st = VD_OK;
   if (ls->py) lsys_py_enter(ls);
   // interpretation rules of the group in use at the end of the derivation, read forward
-  if ((st = lsys_build_index(ls, ls->current_group, 0))) {
-    vm_error(ls, st, 0, 0, "out of memory");
-    goto done;
-  }
   if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
-  lstr_clear(out);
-  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16)) {
-    st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-    goto done;
-  }
-  {
-    int m = 0;
-    st = lsys_recursive(ls, SEC_INTERPRETATION, in, out, &P, ls->max_depth[SEC_INTERPRETATION], 0, &m);
-  }
-done:
+  vd_status st = interpret_into(ls, in, out, &P);
   return end_run(ls, st, &tmp, &P);
 }
 

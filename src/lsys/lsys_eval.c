@@ -639,6 +639,7 @@ enum { FLOW_NONE = 0, FLOW_BREAK, FLOW_CONTINUE, FLOW_RETURN };
 
 typedef struct exec_state {
   vm_out* out;
+  int in_func;   // a def's body: produce emits and returns from the def (L-Py's pproduce)
   int flow;
   value ret;
 } exec_state;
@@ -763,8 +764,18 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
       case S_PRODUCE:
       case S_NPRODUCE:
         if (!X->out)
-          return vm_error(ls, VD_ERR_SYNTAX, s->line, s->col, "'produce' called outside a rule or the axiom");
+          return vm_error(ls, VD_ERR_SYNTAX, s->line, s->col,
+                          "'%s' called where no L-string is being written (outside a rule, the axiom or a hook "
+                          "that produces)",
+                          s->op == S_PRODUCE ? "produce" : "nproduce");
         if (vm_emit_tmpl(ls, s->t, frame, X->out)) return ls->err->status;
+        if (s->op == S_PRODUCE && X->in_func) {
+          // in a def, produce adds to what the rule produces and returns from the def
+          X->out->nproduced = 1;
+          X->flow = FLOW_RETURN;
+          X->ret = (value){V_NONE, 0};
+          return VD_OK;
+        }
         if (s->op == S_PRODUCE) {
           X->out->produced = 1;
           X->flow = FLOW_RETURN;
@@ -813,8 +824,12 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
 }
 
 vd_status vm_exec_block(vd_lsystem* ls, stmt* s, value* frame, vm_out* out, int* returned, value* retval) {
-  exec_state X = {out, FLOW_NONE, {V_NONE, 0}};
+  exec_state X = {out, 0, FLOW_NONE, {V_NONE, 0}};
+  // defs called from here (nproduce in a helper) write where this block writes
+  vm_out* outer = ls->cur_out;
+  ls->cur_out = out;
   vd_status st = exec_list(ls, s, frame, &X);
+  ls->cur_out = outer;
   if (returned) *returned = X.flow == FLOW_RETURN;
   if (retval) *retval = X.ret;
   return st;
@@ -839,8 +854,8 @@ vd_status vm_call_func(vd_lsystem* ls, int fi, int nargs, const value* args, val
   for (int i = 0; i < nl; i++) frame[i] = (value){V_UNDEF, 0};
   for (int i = 0; i < nargs; i++) frame[i] = args[i];
   ls->call_depth++;
-  // produce inside a function called from a rule is not part of the subset
-  exec_state X = {NULL, FLOW_NONE, {V_NONE, 0}};
+  // produce / nproduce inside a def write to the string of the rule (or hook) that called it
+  exec_state X = {ls->cur_out, 1, FLOW_NONE, {V_NONE, 0}};
   vd_status st = exec_list(ls, f->body, frame, &X);
   ls->call_depth--;
   *ret = X.ret;

@@ -231,7 +231,7 @@ typedef struct toplevel {
   stmt* body;  // top-level statements in file order
 } toplevel;
 
-struct vd_lsystem {
+struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields grouped by meaning; one per model
   char file[256];
   lsys_py* py;             // Python engine state (NULL for the native engine)
   vd_arena arena;          // all parse structures
@@ -272,6 +272,7 @@ struct vd_lsystem {
   int rule_index_group, rule_index_dir;  // what the index was built for
   int has_context[SEC_COUNT];   // some rule of the index reads a context (brackets matched)
   int has_generic[SEC_COUNT];   // some rule of the index needs the general matcher
+  int has_query[SEC_COUNT];     // some rule of the index has a query module (?P ...) in a pattern
   int nfilter, capfilter;
   cfilter* filters;             // consider/ignore filters (nfilter)
   unsigned char* no_filter;     // all zero: what a rule without filter ignores (ign_nsym + 1)
@@ -307,6 +308,7 @@ struct vd_lsystem {
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
   int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
+  struct vm_out* cur_out;  // where produce writes in the rule body (or hook) being run, NULL outside
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -394,6 +396,8 @@ typedef struct lsys_pass {
   unsigned char** ignored;  // per-filter tables handed to the matcher (cap_ignored)
   int cap_ignored;
   vd_lstring saved;       // the string at the end of the previous step (DiscardNewString)
+  int64_t identity_bit;   // LSYS_SRC_IDENTITY in a query pass: marks modules copied unchanged
+  vd_lstring geo;         // the interpreted string of a query pass (with source indices)
 } lsys_pass;
 
 // (Re)build the rule index for a group and a direction (no-op when up to date).
@@ -415,6 +419,10 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
                          int level, int* matched);
 // Free a run's scratch.
 void lsys_pass_free(lsys_pass* P);
+// Run the turtle over s without keeping geometry, writing the turtle's position and frame into
+// the parameters of the query modules ?P ?H ?U ?L ?R of s.
+vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
+#define LSYS_SRC_IDENTITY (INT64_C(1) << 62)  // on a source index: the module was copied unchanged
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
 int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
 

@@ -34,6 +34,18 @@ static int rule_is_simple(const rule* r) {
   return 1;
 }
 
+// does the pattern hold a query module (?P ?H ?U ?L ?R ?F)?
+static int has_query_module(const pstr* p) {
+  for (int k = 0; k < p->n; k++) {
+    const pmod* m = &p->m[k];
+    if (m->kind == PK_MOD && m->sym >= VD_SYM_GETPOS && m->sym <= VD_SYM_GETFRAME) return 1;
+    if (m->x)
+      for (int a = 0; a < m->x->nsub; a++)
+        if (has_query_module(&m->x->sub[a])) return 1;
+  }
+  return 0;
+}
+
 static int rule_applies(const rule* r, int sec, int group, int backward) {
   if (r->section != sec || r->group != group) return 0;
   // a new right context needs backward derivation, a new left one forward (L-Py)
@@ -81,6 +93,7 @@ vd_status lsys_build_index(vd_lsystem* ls, int group, int backward) {
     ls->rule_first[s] = first;
     ls->has_context[s] = 0;
     ls->has_generic[s] = 0;
+    ls->has_query[s] = 0;
     int64_t nstar = 0;
     for (int g = 0; g < ngroups; g++)
       for (int r = 0; r < ls->nrule; r++) {
@@ -89,6 +102,9 @@ vd_status lsys_build_index(vd_lsystem* ls, int group, int backward) {
         R->simple = rule_is_simple(R) && !backward && ls->opt_string_matching;
         if (R->left.n || R->right.n || R->nleft.n || R->nright.n) ls->has_context[s] = 1;
         if (!R->simple) ls->has_generic[s] = 1;
+        if (has_query_module(&R->pred) || has_query_module(&R->left) || has_query_module(&R->right) ||
+            has_query_module(&R->nleft) || has_query_module(&R->nright))
+          ls->has_query[s] = 1;
         int k = key_symbol(R, backward);
         if (k < 0) nstar++;
         else first[k + 1]++;
@@ -435,6 +451,7 @@ void lsys_pass_free(lsys_pass* P) {
   vd_free(P->lvl, sizeof(lsys_level) * (size_t)P->caplvl);
   vd_free(P->ignored, sizeof(unsigned char*) * (size_t)P->cap_ignored);
   vd_lstring_free(&P->saved);
+  vd_lstring_free(&P->geo);
   memset(P, 0, sizeof *P);
 }
 
@@ -632,7 +649,9 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
     if (r) {
       i = e;
     } else {
-      if ((st = copy_module(ls, in, i, out, in->src ? in->src[i] : i, P->max_modules))) return st;
+      // a query pass marks (at the top level) the modules it copies unchanged
+      int64_t src = (in->src ? in->src[i] : i) | (level == 0 ? P->identity_bit : 0);
+      if ((st = copy_module(ls, in, i, out, src, P->max_modules))) return st;
       i++;
     }
   }

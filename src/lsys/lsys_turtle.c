@@ -12,7 +12,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "verdant/lsys.h"
+#include "lsys/lsys_internal.h"
 
 #define EPS 1e-10                // lengths and radii below this draw nothing (m)
 #define NF_MAX_STEPS 100000000.0 // nF refuses to draw more segments than this in one module
@@ -91,6 +91,7 @@ typedef struct turtle {  // NOLINT(clang-analyzer-optin.performance.Padding): fi
   // cached sine and cosine of the last angle (degrees)
   double c_deg, c_sin, c_cos;
   int warned_guide, warned_width, warned_color; // warnings already logged once
+  double* query; // Nullable: parameter values of the string (query run: ?P ?H ... are filled)
 } turtle;
 
 // ---------------------------------------------------------------------------------------------
@@ -887,6 +888,32 @@ static void euler_angles(turtle* T, double az, double el, double roll) {
   T->nrot = 0;
 }
 
+// ?P ?H ?U ?L ?R in a query run: the position or a frame vector into the module's parameters
+// (L-Py: 3 parameters take x, y, z; fewer take the first coordinates; none would append a
+// Vector3 object, which the native engine does not have)
+static vd_status query_fill(turtle* T) {
+  if (!T->query) return VD_OK;
+  if (T->sym == VD_SYM_GETFRAME)
+    return fail(T, VD_ERR_UNSUPPORTED, "unsupported: ?F (GetFrame fills Vector3 objects)");
+  if (T->np == 0)
+    return fail(T, VD_ERR_UNSUPPORTED, "unsupported: %s without parameters (L-Py appends a Vector3 object)",
+                sym_name(T, T->sym));
+  const tstate* t = &T->t;
+  vd_vec3 v = T->sym == VD_SYM_GETPOS    ? t->pos
+              : T->sym == VD_SYM_GETHEAD ? t->h
+              : T->sym == VD_SYM_GETUP   ? t->u
+              : T->sym == VD_SYM_GETLEFT ? t->l
+                                         : vd_sub(vd_v3(0, 0, 0), t->l);
+  double* p = T->query + T->s->par[T->i];
+  double c[3] = {v.x, v.y, v.z};
+  for (int k = 0; k < T->np && k < 3; k++) {
+    if (isnan(p[k]))  // a string or an object (NaN-boxed)
+      return fail(T, VD_ERR_UNSUPPORTED, "unsupported: %s with a non-number parameter", sym_name(T, T->sym));
+    p[k] = c[k];
+  }
+  return VD_OK;
+}
+
 // ---------------------------------------------------------------------------------------------
 // one module
 
@@ -1128,6 +1155,15 @@ static vd_status step(turtle* T) {
     t->age = a;
     return VD_OK;
 
+  // query modules: filled in a query run (before a derivation step), nothing drawn
+  case VD_SYM_GETPOS:
+  case VD_SYM_GETHEAD:
+  case VD_SYM_GETUP:
+  case VD_SYM_GETLEFT:
+  case VD_SYM_GETRIGHT:
+  case VD_SYM_GETFRAME:
+    return query_fill(T);
+
   // PlantGL mirrors the shapes drawn after a reflection (not the frame): not supported
   case VD_SYM_LEFTREFLECTION:
   case VD_SYM_UPREFLECTION:
@@ -1164,12 +1200,6 @@ static vd_status step(turtle* T) {
   case VD_SYM_TEXBASECOLOR:
   case VD_SYM_INTERPTEXCOLORS:
   case VD_SYM_TEXTRANSFORM:
-  case VD_SYM_GETPOS:
-  case VD_SYM_GETHEAD:
-  case VD_SYM_GETUP:
-  case VD_SYM_GETLEFT:
-  case VD_SYM_GETRIGHT:
-  case VD_SYM_GETFRAME:
   case VD_SYM_PREDEFINED_COUNT:
     return VD_OK;
   }
@@ -1214,11 +1244,12 @@ static void release(turtle* T) {
   vd_free(T->ibuf, (size_t)T->cap_ibuf * sizeof *T->ibuf);
 }
 
-vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
-                        vd_plant_spec* plant, vd_error* err) {
+static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
+                            vd_plant_spec* plant, vd_error* err, double* query) {
   VD_ASSERT(s && plant);
   turtle T;
   memset(&T, 0, sizeof T);
+  T.query = query;
   T.def = def ? *def : vd_turtle_def_default();
   vd_status st = check_def(&T.def, err);
   if (st) return st;
@@ -1293,5 +1324,19 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
   // the largest instance id in use, whether or not the plant's add functions track it
   if (T.ninst > plant->ninstance) plant->ninstance = T.ninst;
   release(&T);
+  return st;
+}
+
+vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
+                        vd_plant_spec* plant, vd_error* err) {
+  return turtle_run(ls, s, def, plant, err, NULL);
+}
+
+vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err) {
+  vd_plant_spec* scratch = vd_plant_spec_create();
+  if (!scratch) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_turtle_def d = vd_turtle_def_default();
+  vd_status st = turtle_run(ls, s, &d, scratch, err, s->val);
+  vd_plant_spec_destroy(scratch);
   return st;
 }
