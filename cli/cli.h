@@ -64,6 +64,10 @@ void cli_grow_info_free(cli_grow_info* info);
 int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out);
 // Parse two whole decimal integers A<sep>B, each within [lo, hi] ("640x480", "2/8"); 1 on success.
 int cli_parse_i64_pair(const char* s, char sep, int64_t lo, int64_t hi, int64_t* a, int64_t* b);
+// Parse n comma-separated finite numbers, the whole text ("1,2.5,3"); 1 on success.
+int cli_parse_nums(const char* s, double* x, int n);
+// Parse X,Y,Z (three finite numbers, the whole text); 1 on success.
+int cli_parse_vec3(const char* s, vd_vec3* v);
 // Parse a whole finite number; 1 on success.
 int cli_parse_num(const char* s, double* out);
 // Inside an option parser with locals a (the option), val, i, argc, argv and cmd: take the
@@ -313,5 +317,6 @@ int cli_dataset(int argc, char** argv);
 int cli_render(int argc, char** argv);
 int cli_sim(int argc, char** argv);
 int cli_validate(int argc, char** argv);
+int cli_export(int argc, char** argv);
 
 #endif

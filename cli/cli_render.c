@@ -84,8 +84,8 @@ int cli_parse_palette(const char* s, vd_palette* out) {
   return 1;
 }
 
-// n comma-separated finite numbers, no more
-static int parse_list(const char* s, double* x, int n) {
+int cli_parse_nums(const char* s, double* x, int n) {
+  if (!s) return 0;
   for (int k = 0; k < n; k++) {
     char* end;
     errno = 0;
@@ -111,7 +111,7 @@ int cli_look_opt(cli_render_opts* o, const char* cmd, int argc, char** argv, int
     // AZ,EL in degrees, then the key light, headlight and ambient intensities
     int n = 0;
     for (int k = 2; k <= 5 && !n; k++)
-      if (parse_list(val, x, k)) n = k;
+      if (cli_parse_nums(val, x, k)) n = k;
     int ok = n >= 2 && x[0] >= -360 && x[0] <= 360 && x[1] > 0 && x[1] <= 90;
     for (int k = 2; ok && k < n; k++)
       ok = x[k] >= 0 && x[k] <= 1;
@@ -127,7 +127,7 @@ int cli_look_opt(cli_render_opts* o, const char* cmd, int argc, char** argv, int
     return 1;
   }
   // two colours (or one for both)
-  int n = parse_list(val, x, 6) ? 6 : parse_list(val, x, 3) ? 3 : 0;
+  int n = cli_parse_nums(val, x, 6) ? 6 : cli_parse_nums(val, x, 3) ? 3 : 0;
   for (int k = 0; k < n; k++)
     if (x[k] < 0 || x[k] > 1) n = 0;
   if (!n) {
@@ -152,21 +152,9 @@ vd_status cli_apply_look(const cli_render_opts* o, vd_renderer* r, vd_error* err
   return vd_render_set_look(r, &look, err);
 }
 
-// three comma-separated numbers
-static int parse_vec(const char* s, vd_vec3* v) {
-  char* end;
+int cli_parse_vec3(const char* s, vd_vec3* v) {
   double x[3];
-  for (int k = 0; k < 3; k++) {
-    errno = 0;
-    x[k] = strtod(s, &end);
-    if (end == s || errno || !isfinite(x[k])) return 0;
-    s = end;
-    if (k < 2) {
-      if (*s != ',') return 0;
-      s++;
-    }
-  }
-  if (*s) return 0;
+  if (!cli_parse_nums(s, x, 3)) return 0;
   *v = vd_v3(x[0], x[1], x[2]);
   return 1;
 }
@@ -241,15 +229,15 @@ static int parse_args(int argc, char** argv, cli_render_opts* o) {
     } else if (!strcmp(a, "--camera")) {
       camera_text = val;
     } else if (!strcmp(a, "--eye")) {
-      if (!parse_vec(val, &o->eye))
+      if (!cli_parse_vec3(val, &o->eye))
         return cli_usage_error("render", "--eye expects X,Y,Z in metres, got '%s'", val);
       o->has_eye = 1;
     } else if (!strcmp(a, "--lookat")) {
-      if (!parse_vec(val, &o->lookat))
+      if (!cli_parse_vec3(val, &o->lookat))
         return cli_usage_error("render", "--lookat expects X,Y,Z in metres, got '%s'", val);
       has_lookat = 1;
     } else if (!strcmp(a, "--up")) {
-      if (!parse_vec(val, &o->up))
+      if (!cli_parse_vec3(val, &o->up))
         return cli_usage_error("render", "--up expects X,Y,Z, got '%s'", val);
     } else if (!strcmp(a, "--fov")) {
       if (!cli_parse_num(val, &o->fov) || o->fov <= 0 || o->fov >= 180)

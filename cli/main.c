@@ -23,6 +23,7 @@ static const char* main_help =
     "  sim       plant physics (Cosserat rods): gravity, wind, probes, fracture → frames, events\n"
     "  validate  the physics against analytic references (--json, --full)\n"
     "  harvest   a MuJoCo robot picks a fruit (pull, bend, twist) → summary, events, frames\n"
+    "  export    plant → URDF, SDF or MuJoCo MJCF for robot simulators\n"
     "\n"
     "Run 'verdant <command> --help' for the options of a command.\n"
     "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
   if (!strcmp(cmd, "sim")) return cli_sim(argc - 1, argv + 1);
   if (!strcmp(cmd, "validate")) return cli_validate(argc - 1, argv + 1);
   if (!strcmp(cmd, "harvest")) return cli_harvest(argc - 1, argv + 1);
+  if (!strcmp(cmd, "export")) return cli_export(argc - 1, argv + 1);
   fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
   fputs(main_help, stderr);
   return EXIT_USAGE;

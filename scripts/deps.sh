@@ -16,9 +16,12 @@ need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-d
 # --dev adds the tools of CI's hardening runs: clang with libFuzzer (make fuzz, fuzz-smoke),
 # clang-tidy and cppcheck (make lint); and the Python package's optional peers, so that CI runs
 # their tests: python3-torch (verdant.torch's DataLoader test) and python3-open3d (to_open3d, the
-# Open3D peer of make bench); about 3 minutes of installing on 2 busy cores, 0.5 GB
+# Open3D peer of make bench); about 3 minutes of installing on 2 busy cores, 0.5 GB; and the
+# robot-format checkers that `verdant export`'s tests use when installed: check_urdf
+# (liburdfdom-tools) and `ign sdf -k` (ignition-tools with libsdformat-dev's command plugin)
 if [ "${1:-}" = "--dev" ]; then
-  need+=(clang libclang-rt-14-dev clang-tidy cppcheck python3-torch python3-open3d)
+  need+=(clang libclang-rt-14-dev clang-tidy cppcheck python3-torch python3-open3d
+    liburdfdom-tools ignition-tools libsdformat-dev)
 fi
 missing=()
 for p in "${need[@]}"; do

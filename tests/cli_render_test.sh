@@ -172,32 +172,13 @@ for m in mesh.ply mesh.obj mesha.ply mesh.json; do
   expect "render $m" 0 "$V" render "$T/$m" -o "$T/r_${m%.*}_${m##*.}.png" --masks --size 320x240
 done
 expect "mesh by displacement refused" 2 "$V" render "$T/mesh.obj" -o "$T/x.png" --color-by displacement
-if python3 - "$T" <<'PY'
-import json, struct, sys, zlib
+if python3 - "$T" "$SRC/tests" <<'PY'
+import json, sys
 d = sys.argv[1]
+sys.path.insert(0, sys.argv[2])
+from png_util import png
 def png16(path):
-    b = open(path, "rb").read()
-    pos, idat = 8, b""
-    while pos < len(b):
-        n, kind = struct.unpack(">I4s", b[pos:pos + 8])
-        if kind == b"IHDR": w, h = struct.unpack(">II", b[pos + 8:pos + 16])
-        if kind == b"IDAT": idat += b[pos + 8:pos + 8 + n]
-        pos += 12 + n
-    raw, stride, prev, vals = zlib.decompress(idat), 2 * w + 1, bytearray(2 * w), []
-    for y in range(h):
-        f, line = raw[y * stride], bytearray(raw[y * stride + 1:(y + 1) * stride])
-        for i in range(len(line)):
-            a = line[i - 2] if i >= 2 else 0
-            c = prev[i - 2] if i >= 2 else 0
-            if f == 1: line[i] = (line[i] + a) & 255
-            elif f == 2: line[i] = (line[i] + prev[i]) & 255
-            elif f == 3: line[i] = (line[i] + (a + prev[i]) // 2) & 255
-            elif f == 4:
-                p = a + prev[i] - c; pa, pb, pc = abs(p - a), abs(p - prev[i]), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else prev[i] if pb <= pc else c)) & 255
-        vals += struct.unpack(">%dH" % w, line)
-        prev = line
-    return vals
+    return png(path)[4]
 ref = {k: png16(f"{d}/r_mesh_json.{k}.png") for k in ("label", "instance")}
 names = {l["id"]: l["name"] for l in json.load(open(f"{d}/r_mesh_json.png.json"))["labels"]}
 fg = sum(1 for v in ref["label"] if v)

@@ -139,6 +139,17 @@ vd_status vd_file_read(const char* path, char** text, size_t* len, vd_error* err
 // Largest file vd_file_read accepts (bytes).
 #define VD_FILE_MAX ((size_t)1 << 30)
 
+// Lines of a text in memory, read one at a time by vd_text_line: { text, length, offset of the
+// next line, number of the last line read (1-based; 0 before the first) }.
+typedef struct vd_text {
+  const char* s;
+  size_t len, pos;
+  int line;
+} vd_text;
+// The next line of t, without its newline (or the carriage return before it), into *ls and *ll;
+// 0 at the end of the text.
+int vd_text_line(vd_text* t, const char** ls, size_t* ll);
+
 // ---------------------------------------------------------------------------------------------
 // assertions for programmer errors
 

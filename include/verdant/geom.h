@@ -95,6 +95,42 @@ vd_status vd_geom_parse_mesh(const char* data, size_t len, int obj, const char* 
 // .ply without one is a point cloud).
 int vd_geom_is_mesh_file(const char* path);
 
+// ---------------------------------------------------------------------------------------------
+// robot-simulator formats
+
+#define VD_EXPORT_FORMAT_VERSION 1 // version of the URDF/SDF/MJCF conventions (docs/formats.md)
+
+// File formats of vd_geom_export.
+typedef enum vd_export_format {
+  VD_EXPORT_URDF = 0, // URDF: one link per organ on fixed joints, meshes as OBJ files
+  VD_EXPORT_SDF,      // SDF 1.7: a static model, one link per organ, meshes as OBJ files
+  VD_EXPORT_MJCF,     // MuJoCo MJCF: one body per organ (no joints), meshes inline
+} vd_export_format;
+
+// Settings of an export.
+typedef struct vd_export_def {
+  vd_export_format format; // default VD_EXPORT_MJCF
+  const char* name;        // model name and (MJCF) name prefix "<name>/": letters, digits, '_',
+                           // '-', 1..48 characters; default "plant"
+  vd_vec3 pos;             // where the plant's origin goes (m): the MJCF root body's and the SDF
+                           // model's pose; default 0, 0, 0
+  double leaf_thickness;   // thickness given to open meshes (leaves) so that they have a volume
+                           // (m), in (0, 0.1); default 2e-4
+} vd_export_def;
+
+// Defaults: MJCF, name "plant", at the origin, leaves 0.2 mm thick.
+vd_export_def vd_export_def_default(void);
+// "urdf", "sdf" or "mjcf".
+const char* vd_export_format_name(vd_export_format f);
+// Write plant m in state d (Nullable: its rest shape) for a robot simulator: every organ instance
+// (label, instance) a link or body named "<label>_<instance>" with a visual and a collision
+// shape per primitive (segment: cylinder of the mean radius in URDF/SDF, capsule in MJCF; sphere;
+// mesh: closed, open ones as slabs of leaf_thickness). URDF and SDF write the meshes as OBJ files
+// into "<path without extension>_meshes/" first (referred to relative to path); every file is
+// atomic and a failure leaves none of them. docs/formats.md has the conventions.
+vd_status vd_geom_export(const vd_model* m, const vd_data* d, const vd_export_def* def,
+                         const char* path, vd_error* err);
+
 // Write OBJ with normals plus a sibling .mtl (same base name), faces grouped by label/instance.
 vd_status vd_geom_write_obj(const vd_mesh* mesh, const vd_label* labels, int nlabel,
                             const char* path, vd_error* err);

@@ -159,6 +159,27 @@ vd_status vd_render_set_look(vd_renderer* r, const vd_render_look* look, vd_erro
 // Set the robot's joint positions (MuJoCo qpos, nq values) for the next frames.
 vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, vd_error* err);
 
+// What MuJoCo makes of an MJCF file (a robot, a plant from vd_geom_export, a scene including
+// both), loaded as the renderer loads a robot and brought to its first state (mj_forward); no
+// OpenGL context is needed.
+typedef struct vd_mjcf_info {
+  int nbody, ngeom, nmesh, njoint; // sizes of the model (the world body counted)
+  int nbody_prefix;                // bodies whose names start with the prefix
+  int ngeom_prefix;                // geoms of those bodies
+  int ncontact;                    // contacts of the first state
+  int ncontact_prefix;             // of them, between a geom of a prefix body and one of a body
+                                   // that is neither a prefix body nor the world (a robot's)
+} vd_mjcf_info;
+
+// Load MJCF files with MuJoCo and count what they hold (prefix Nullable: no prefix counts): one
+// file as it is; several (a robot and a plant from vd_geom_export) in a scene that includes each,
+// made in memory with the files of their folders (MuJoCo 2.2.2 resolves every include against
+// the top file's folder, so a robot that includes its gripper would not load from a scene file
+// elsewhere). VD_ERR_IO when a file cannot be opened, VD_ERR_FORMAT with MuJoCo's message when it
+// does not load, VD_ERR_VALUE for a MuJoCo error after loading.
+vd_status vd_render_mjcf_info(const char* const* files, int nfiles, const char* prefix,
+                              vd_mjcf_info* info, vd_error* err);
+
 // ---------------------------------------------------------------------------------------------
 // what is drawn
 

@@ -182,26 +182,7 @@ static void finish_views(reader* r, vd_cloud* c, int has_view) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// line reading over the whole file
-
-typedef struct text {
-  const char* s;
-  size_t len, pos;
-  int line;
-} text;
-
-// next line (without its newline) into *ls, *ll; 0 at the end
-static int next_line(text* t, const char** ls, size_t* ll) {
-  if (t->pos >= t->len) return 0;
-  const char* start = t->s + t->pos;
-  const char* nl = memchr(start, '\n', t->len - t->pos);
-  size_t n = nl ? (size_t)(nl - start) : t->len - t->pos;
-  t->pos += n + (nl != NULL);
-  t->line++;
-  *ls = start;
-  *ll = n && start[n - 1] == '\r' ? n - 1 : n;
-  return 1;
-}
+// line reading over the whole file (vd_text_line)
 
 // split a line into at most cap tokens on sep (' ' means any run of blanks), NUL-terminated in buf
 static int split(const char* ls, size_t ll, char sep, char* buf, size_t bcap, char** tok, int cap) {
@@ -233,14 +214,14 @@ static int split(const char* ls, size_t ll, char sep, char* buf, size_t bcap, ch
 }
 
 // ASCII records: one per line, one value per column
-static vd_status read_ascii_rows(reader* r, text* t, const cols* cs, char sep, vd_cloud* c) {
+static vd_status read_ascii_rows(reader* r, vd_text* t, const cols* cs, char sep, vd_cloud* c) {
   char buf[4096];
   char* tok[64];
   for (int64_t i = 0; i < c->n; i++) {
     const char* ls;
     size_t ll;
     do {
-      if (!next_line(t, &ls, &ll)) return fail(r, t->line, "expected %lld points, the file ends", (long long)c->n);
+      if (!vd_text_line(t, &ls, &ll)) return fail(r, t->line, "expected %lld points, the file ends", (long long)c->n);
     } while (ll == 0 || ls[0] == '#');
     int n = split(ls, ll, sep, buf, sizeof buf, tok, 64);
     if (n != cs->n) return fail(r, t->line, "expected %lld values", (long long)cs->n);
@@ -281,10 +262,10 @@ static vd_status read_binary_rows(reader* r, const unsigned char* data, size_t a
 // PLY
 
 static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
-  text t = {s, len, 0, 0};
+  vd_text t = {s, len, 0, 0};
   const char* ls;
   size_t ll;
-  if (!next_line(&t, &ls, &ll) || ll != 3 || memcmp(ls, "ply", 3) != 0)
+  if (!vd_text_line(&t, &ls, &ll) || ll != 3 || memcmp(ls, "ply", 3) != 0)
     return fail(r, 1, "not a PLY file (expected 'ply')");
   int binary = -1, in_vertex = 0, seen_vertex = 0;
   int64_t n = -1;
@@ -293,7 +274,7 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
   char buf[512];
   char* tok[8];
   for (;;) {
-    if (!next_line(&t, &ls, &ll)) return fail(r, t.line, "no end_header");
+    if (!vd_text_line(&t, &ls, &ll)) return fail(r, t.line, "no end_header");
     if (ll >= 8 && !memcmp(ls, "comment ", 8)) {
       vd_status st = comment_line(r, ls + 8, ll - 8, t.line);
       if (st) return st;
@@ -365,7 +346,7 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
 // PCD
 
 static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
-  text t = {s, len, 0, 0};
+  vd_text t = {s, len, 0, 0};
   const char* ls;
   size_t ll;
   cols cs;
@@ -376,7 +357,7 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
   char buf[4096];
   char* tok[66];
   while (binary < 0) {
-    if (!next_line(&t, &ls, &ll)) return fail(r, t.line, "no DATA line");
+    if (!vd_text_line(&t, &ls, &ll)) return fail(r, t.line, "no DATA line");
     if (ll == 0) continue;
     if (ls[0] == '#') {
       vd_status st = comment_line(r, ls + 1, ll - 1, t.line);
@@ -458,7 +439,7 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
 // or the first line that is not a comment (CSV)
 
 static vd_status read_text(reader* r, const char* s, size_t len, int csv, vd_cloud* out) {
-  text t = {s, len, 0, 0};
+  vd_text t = {s, len, 0, 0};
   const char* ls;
   size_t ll;
   cols cs;
@@ -473,7 +454,7 @@ static vd_status read_text(reader* r, const char* s, size_t len, int csv, vd_clo
   for (;;) {
     size_t before = t.pos;
     int line_before = t.line;
-    if (!next_line(&t, &ls, &ll)) {
+    if (!vd_text_line(&t, &ls, &ll)) {
       data_pos = t.pos, data_line = t.line;
       break;
     }
@@ -520,8 +501,8 @@ static vd_status read_text(reader* r, const char* s, size_t len, int csv, vd_clo
   if (st) return st;
   // count the data lines, then read them
   int64_t n = 0;
-  text c = {s, len, data_pos, data_line};
-  while (next_line(&c, &ls, &ll))
+  vd_text c = {s, len, data_pos, data_line};
+  while (vd_text_line(&c, &ls, &ll))
     if (ll && ls[0] != '#') n++;
   st = start_cloud(r, out, n);
   if (st) return st;

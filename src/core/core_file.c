@@ -118,3 +118,15 @@ vd_status vd_file_read(const char* path, char** text, size_t* len, vd_error* err
   *len = n;
   return VD_OK;
 }
+
+int vd_text_line(vd_text* t, const char** ls, size_t* ll) {
+  if (t->pos >= t->len) return 0;
+  const char* start = t->s + t->pos;
+  const char* nl = memchr(start, '\n', t->len - t->pos);
+  size_t n = nl ? (size_t)(nl - start) : t->len - t->pos;
+  t->pos += n + (nl != NULL);
+  t->line++;
+  *ls = start;
+  *ll = n && start[n - 1] == '\r' ? n - 1 : n;
+  return 1;
+}

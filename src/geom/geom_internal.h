@@ -28,4 +28,8 @@ int geom_seg_cut(const vd_data* d, int i, double* f);
 // "<name>_<id>" when an earlier entry of the table gives the same name.
 void geom_obj_name(const vd_label* labels, int nlabel, int id, char* buf, size_t cap);
 
+// Allocate a mesh of nvert vertices and ntri triangles in one zeroed block (vd_mesh_free frees
+// it); 0 when out of memory (the mesh is then empty).
+int geom_mesh_alloc(vd_mesh* mesh, int nvert, int ntri);
+
 #endif

@@ -106,26 +106,7 @@ static vd_status comment_label(mreader* r, const char* s, size_t len, int line) 
 }
 
 // ---------------------------------------------------------------------------------------------
-// lines and numbers
-
-typedef struct text {
-  const char* s;
-  size_t len, pos;
-  int line;
-} text;
-
-// next line (without its newline and a carriage return) into *ls, *ll; 0 at the end
-static int next_line(text* t, const char** ls, size_t* ll) {
-  if (t->pos >= t->len) return 0;
-  const char* start = t->s + t->pos;
-  const char* nl = memchr(start, '\n', t->len - t->pos);
-  size_t n = nl ? (size_t)(nl - start) : t->len - t->pos;
-  t->pos += n + (nl != NULL);
-  t->line++;
-  *ls = start;
-  *ll = n && start[n - 1] == '\r' ? n - 1 : n;
-  return 1;
-}
+// lines (vd_text_line) and numbers
 
 // cut a line into blank-separated words in buf; -1 when it is too long or has too many
 static int words(const char* ls, size_t ll, char* buf, size_t cap, char** w, int maxw) {
@@ -236,7 +217,7 @@ static int obj_corner(const char* s, int nv, int nvn, int* v, int* n) {
 }
 
 static vd_status read_obj(mreader* r, const char* s, size_t len) {
-  text t = {s, len, 0, 0};
+  vd_text t = {s, len, 0, 0};
   const char* ls;
   size_t ll;
   char buf[4096];
@@ -244,7 +225,7 @@ static vd_status read_obj(mreader* r, const char* s, size_t len) {
   int label = 0, inst = 0;
   objnames on = {NULL, 0, 0};
   vd_status st = VD_OK;
-  while (!st && next_line(&t, &ls, &ll)) {
+  while (!st && vd_text_line(&t, &ls, &ll)) {
     if (ll > 0 && ls[0] == '#') {
       if (ll > 1) st = comment_label(r, ls + 1, ll - 1, t.line);
       continue;
@@ -366,7 +347,7 @@ static int ply_feed(const char* elem, const char* name, int list) {
 // a value source: the ASCII words of the body, or the binary bytes
 typedef struct pbody {
   int binary;
-  text t;               // ASCII: the lines after end_header
+  vd_text t;            // ASCII: the lines after end_header
   char buf[8192];       // ASCII: the current line's words
   char* w[1024];
   int nw, iw;
@@ -393,7 +374,7 @@ static int ply_next(mreader* r, pbody* pb, ptype ty, double* x, vd_status* st) {
   while (pb->iw == pb->nw) {
     const char* ls;
     size_t ll;
-    if (!next_line(&pb->t, &ls, &ll)) {
+    if (!vd_text_line(&pb->t, &ls, &ll)) {
       *st = fail(r, pb->t.line, "the file ends before every element was read");
       return 0;
     }
@@ -412,19 +393,19 @@ static int ply_next(mreader* r, pbody* pb, ptype ty, double* x, vd_status* st) {
 }
 
 static vd_status read_ply(mreader* r, const char* s, size_t len) {
-  text t = {s, len, 0, 0};
+  vd_text t = {s, len, 0, 0};
   const char* ls;
   size_t ll;
   char buf[512];
   char* w[8];
-  if (!next_line(&t, &ls, &ll) || ll != 3 || memcmp(ls, "ply", 3) != 0)
+  if (!vd_text_line(&t, &ls, &ll) || ll != 3 || memcmp(ls, "ply", 3) != 0)
     return fail(r, 1, "not a PLY file (expected 'ply')");
   int binary = -1, nelem = 0, ivert = -1, iface = -1;
   pelem* el = vd_calloc(PLY_MAX_ELEM, sizeof(pelem));
   if (!el) return nomem(r);
   vd_status st = VD_OK;
   for (;;) {
-    if (!next_line(&t, &ls, &ll)) {
+    if (!vd_text_line(&t, &ls, &ll)) {
       st = fail(r, t.line, "no end_header");
       break;
     }
@@ -521,7 +502,7 @@ static vd_status read_ply(mreader* r, const char* s, size_t len) {
     pb = vd_calloc(1, sizeof(pbody));
     if (pb) {
       pb->binary = binary;
-      pb->t = (text){s + t.pos, len - t.pos, 0, t.line};
+      pb->t = (vd_text){s + t.pos, len - t.pos, 0, t.line};
       pb->b = (const unsigned char*)s + t.pos, pb->nb = len - t.pos;
     } else {
       st = nomem(r);
@@ -610,20 +591,7 @@ static vd_status build(mreader* r, vd_mesh* mesh) {
       if (n >= 0 && r->nvn <= r->f[8 * k + c]) shared = 0;
     }
   size_t nt = (size_t)r->nf, nv = shared ? (size_t)r->nv : 3 * nt;
-  size_t nbytes = nv * 6 * sizeof(double) + nt * 7 * sizeof(int);
-  char* block = vd_calloc(1, nbytes ? nbytes : 1);
-  if (!block) return nomem(r);
-  memset(mesh, 0, sizeof *mesh);
-  mesh->nvert = (int)nv;
-  mesh->ntri = (int)nt;
-  mesh->nbytes = nbytes ? nbytes : 1;
-  mesh->pos = (double*)block;
-  mesh->normal = mesh->pos + 3 * nv;
-  mesh->tri = (int*)(mesh->normal + 3 * nv);
-  mesh->tri_label = mesh->tri + 3 * nt;
-  mesh->tri_instance = mesh->tri_label + nt;
-  mesh->tri_prim = mesh->tri_instance + nt;
-  mesh->tri_kind = mesh->tri_prim + nt;
+  if (!geom_mesh_alloc(mesh, (int)nv, (int)nt)) return nomem(r);
   if (shared) memcpy(mesh->pos, r->v, sizeof(double) * 3 * nv);
   for (size_t k = 0; k < nt; k++) {
     const int* f = r->f + 8 * k;

@@ -404,27 +404,10 @@ vd_status vd_geom_tessellate(const vd_model* m, const vd_data* d, const vd_mesh_
     plan_free(&p);
     return st;
   }
-  // sizes first, then one block: doubles, then ints
-  size_t nv = (size_t)p.nvert, nt = (size_t)p.ntri;
-  size_t nbytes = nv * 6 * sizeof(double) + nt * 7 * sizeof(int);
-  mesh->nvert = (int)nv;
-  mesh->ntri = (int)nt;
-  if (nbytes > 0) {
-    char* block = vd_malloc(nbytes);
-    if (!block) {
-      plan_free(&p);
-      memset(mesh, 0, sizeof *mesh);
-      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory tessellating");
-    }
-    memset(block, 0, nbytes);
-    mesh->nbytes = nbytes;
-    mesh->pos = (double*)block;
-    mesh->normal = mesh->pos + 3 * nv;
-    mesh->tri = (int*)(mesh->normal + 3 * nv);
-    mesh->tri_label = mesh->tri + 3 * nt;
-    mesh->tri_instance = mesh->tri_label + nt;
-    mesh->tri_prim = mesh->tri_instance + nt;
-    mesh->tri_kind = mesh->tri_prim + nt;
+  size_t nv = (size_t)p.nvert;
+  if (!geom_mesh_alloc(mesh, (int)p.nvert, (int)p.ntri)) {
+    plan_free(&p);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory tessellating");
   }
   // segments, spheres, meshes in index order
   out o = {mesh, 0};
@@ -448,6 +431,30 @@ vd_status vd_geom_tessellate(const vd_model* m, const vd_data* d, const vd_mesh_
   }
   plan_free(&p);
   return VD_OK;
+}
+
+int geom_mesh_alloc(vd_mesh* mesh, int nvert, int ntri) {
+  // sizes first, then one block: doubles, then ints
+  memset(mesh, 0, sizeof *mesh);
+  size_t nv = (size_t)nvert, nt = (size_t)ntri;
+  size_t nbytes = nv * 6 * sizeof(double) + nt * 7 * sizeof(int);
+  mesh->nvert = nvert;
+  mesh->ntri = ntri;
+  if (nbytes == 0) return 1;
+  char* block = vd_calloc(1, nbytes);
+  if (!block) {
+    memset(mesh, 0, sizeof *mesh);
+    return 0;
+  }
+  mesh->nbytes = nbytes;
+  mesh->pos = (double*)block;
+  mesh->normal = mesh->pos + 3 * nv;
+  mesh->tri = (int*)(mesh->normal + 3 * nv);
+  mesh->tri_label = mesh->tri + 3 * nt;
+  mesh->tri_instance = mesh->tri_label + nt;
+  mesh->tri_prim = mesh->tri_instance + nt;
+  mesh->tri_kind = mesh->tri_prim + nt;
+  return 1;
 }
 
 void vd_mesh_free(vd_mesh* mesh) {

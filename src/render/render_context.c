@@ -2,12 +2,16 @@
 // The renderer's lifetime: defaults, the OpenGL context, the stage model (floor, sky) written as
 // MJCF into MuJoCo's in-memory file system or a robot's MJCF, MuJoCo's scene and context, image
 // buffers.
+#define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
 
 #include "render_internal.h"
 
@@ -44,6 +48,16 @@ static int in_range(double x, double lo, double hi) {
   return isfinite(x) && x >= lo && x <= hi;
 }
 
+// the first light setting out of range (its name and range), NULL when all are fine
+static const char* check_lights(double az, double el, double light, double head, double amb) {
+  if (!in_range(az, -1e3, 1e3)) return "light_azimuth (finite, rad)";
+  if (!in_range(el, 1e-3, VD_PI / 2 + 1e-9)) return "light_elevation (0..pi/2 rad)";
+  if (!in_range(light, 0, 1)) return "light (0..1)";
+  if (!in_range(head, 0, 1)) return "headlight (0..1)";
+  if (!in_range(amb, 0, 1)) return "ambient (0..1)";
+  return NULL;
+}
+
 // check the settings, naming the first bad field
 static vd_status check_def(const vd_render_def* d, vd_error* err) {
   const char* bad = NULL;
@@ -55,18 +69,9 @@ static vd_status check_def(const vd_render_def* d, vd_error* err) {
     bad = "supersample (1..4)";
   else if ((long)d->width * d->supersample > 16384 || (long)d->height * d->supersample > 16384)
     bad = "width or height x supersample (at most 16384 pixels)";
-  else if (!in_range(d->light_azimuth, -1e3, 1e3))
-    bad = "light_azimuth (finite, rad)";
-  else if (!in_range(d->light_elevation, 1e-3, VD_PI / 2 + 1e-9))
-    bad = "light_elevation (0..pi/2 rad)";
-  else if (!in_range(d->light, 0, 1))
-    bad = "light (0..1)";
-  else if (!in_range(d->headlight, 0, 1))
-    bad = "headlight (0..1)";
-  else if (!in_range(d->ambient, 0, 1))
-    bad = "ambient (0..1)";
   else if (d->max_geoms < 1 || d->max_geoms > 10000000)
     bad = "max_geoms (1..10000000)";
+  if (!bad) bad = check_lights(d->light_azimuth, d->light_elevation, d->light, d->headlight, d->ambient);
   for (int k = 0; !bad && k < 3; k++)
     if (!in_range(d->background[k], 0, 1)) bad = "background (each in 0..1)";
   if (bad) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "bad render setting: %s", bad);
@@ -311,17 +316,8 @@ static void recolour(vd_renderer* r, int id, const float a[2][3], const float b[
 }
 
 vd_status vd_render_set_look(vd_renderer* r, const vd_render_look* look, vd_error* err) {
-  const char* bad = NULL;
-  if (!in_range(look->light_azimuth, -1e3, 1e3))
-    bad = "light_azimuth (finite, rad)";
-  else if (!in_range(look->light_elevation, 1e-3, VD_PI / 2 + 1e-9))
-    bad = "light_elevation (0..pi/2 rad)";
-  else if (!in_range(look->light, 0, 1))
-    bad = "light (0..1)";
-  else if (!in_range(look->headlight, 0, 1))
-    bad = "headlight (0..1)";
-  else if (!in_range(look->ambient, 0, 1))
-    bad = "ambient (0..1)";
+  const char* bad = check_lights(look->light_azimuth, look->light_elevation, look->light,
+                                 look->headlight, look->ambient);
   for (int j = 0; !bad && j < 2; j++)
     for (int k = 0; k < 3; k++) {
       if (!in_range(look->sky[j][k], 0, 1)) bad = "sky colour (each in 0..1)";
@@ -377,3 +373,137 @@ vd_status vd_render_set_robot_qpos(vd_renderer* r, const double* qpos, int nq, v
   vd_mj_trap_end(&trap);
   return VD_OK;
 }
+
+// is name a file MJCF models refer to (an include, a mesh, a texture)?
+static int mjcf_part(const char* name) {
+  static const char* ext[] = {".xml", ".stl", ".obj", ".msh", ".png", ".skn"};
+  size_t n = strlen(name);
+  for (size_t k = 0; k < sizeof ext / sizeof ext[0]; k++)
+    if (n > 4 && !strcasecmp(name + n - 4, ext[k])) return 1;
+  return 0;
+}
+
+// add the files of folder dir (and of its folders, one level down) that MJCF refers to
+static void vfs_add_folder(mjVFS* vfs, const char* dir, int depth) {
+  DIR* d = opendir(dir);
+  if (!d) return;
+  for (struct dirent* e; (e = readdir(d)) && vfs->nfile < mjMAXVFS - 8;) {
+    if (e->d_name[0] == '.') continue;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    struct stat sb;
+    if (stat(path, &sb) != 0) continue;
+    if (S_ISDIR(sb.st_mode) && depth == 0) vfs_add_folder(vfs, path, 1);
+    // 2.2.2 reads the file by the name given (the folder argument is not used for reading)
+    if (S_ISREG(sb.st_mode) && mjcf_part(e->d_name)) mj_addFileVFS(vfs, NULL, path);
+  }
+  closedir(d);
+}
+
+// a scene including the files, in a VFS: their folders' files by name (MuJoCo 2.2.2 resolves
+// every include, nested ones too, against the top file's folder; in a VFS, by file name), each
+// part under a name of its own; NULL with *st set on failure
+static mjVFS* scene_vfs(const char* const* files, int nfiles, vd_status* st, vd_error* err) {
+  mjVFS* vfs = vd_malloc(sizeof *vfs);
+  if (!vfs) {
+    *st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    return NULL;
+  }
+  mj_defaultVFS(vfs);
+  char scene[16384];
+  size_t n = (size_t)snprintf(scene, sizeof scene, "<mujoco model=\"verdant_scene\">\n");
+  for (int k = 0; k < nfiles && !*st; k++) {
+    char dir[4200], part[64];
+    FILE* f = fopen(files[k], "rb");
+    if (!f) {
+      *st = vd_error_set(err, VD_ERR_IO, files[k], 0, 0, "cannot open: %s", strerror(errno));
+      break;
+    }
+    long len = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (len > 0 && fseek(f, 0, SEEK_SET) != 0) len = -1;
+    snprintf(part, sizeof part, "verdant_part%d.xml", k);
+    if (len <= 0 || mj_makeEmptyFileVFS(vfs, part, (int)len) != 0 ||
+        fread(vfs->filedata[mj_findFileVFS(vfs, part)], 1, (size_t)len, f) != (size_t)len)
+      *st = vd_error_set(err, VD_ERR_IO, files[k], 0, 0, "cannot read it");
+    fclose(f);
+    snprintf(dir, sizeof dir, "%s", files[k]);
+    char* slash = strrchr(dir, '/');
+    if (slash) *slash = 0;
+    vfs_add_folder(vfs, slash ? dir : ".", 0);
+    n += (size_t)snprintf(scene + n, n < sizeof scene ? sizeof scene - n : 0,
+                          "  <include file=\"%s\"/>\n", part);
+  }
+  n += (size_t)snprintf(scene + n, n < sizeof scene ? sizeof scene - n : 0, "</mujoco>\n");
+  if (!*st && (n >= sizeof scene || mj_makeEmptyFileVFS(vfs, "verdant_scene.xml", (int)n) != 0))
+    *st = vd_error_set(err, VD_ERR_LIMIT, "", 0, 0, "too many files for one MuJoCo scene");
+  if (!*st) memcpy(vfs->filedata[mj_findFileVFS(vfs, "verdant_scene.xml")], scene, n);
+  if (*st) {
+    mj_deleteVFS(vfs);
+    vd_free(vfs, sizeof *vfs);
+    return NULL;
+  }
+  return vfs;
+}
+
+vd_status vd_render_mjcf_info(const char* const* files, int nfiles, const char* prefix,
+                              vd_mjcf_info* info, vd_error* err) {
+  memset(info, 0, sizeof *info);
+  if (nfiles < 1) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "no MJCF file");
+  vd_mj_trap_install();
+  vd_mj_trap trap;
+  mjModel* volatile m = NULL;
+  mjData* volatile d = NULL;
+  mjVFS* volatile vfs = NULL;
+  vd_status st = VD_OK;
+  if (VD_MJ_TRY(&trap)) {
+    mjModel* loaded = NULL;
+    if (nfiles == 1) {
+      st = vd_mj_load_xml(files[0], "MJCF", &loaded, err);
+    } else {
+      // several: a scene that includes them, in memory
+      vfs = scene_vfs(files, nfiles, &st, err);
+      char msg[1000] = "";
+      if (vfs) loaded = mj_loadXML("verdant_scene.xml", vfs, msg, sizeof msg);
+      if (vfs && !loaded) {
+        for (char* c = msg; *c; c++)
+          if (*c == '\n' || *c == '\r') *c = ' ';
+        st = vd_error_set(err, VD_ERR_FORMAT, files[0], 0, 0, "MJCF scene of %d files: %s", nfiles,
+                          msg);
+      }
+    }
+    m = loaded;
+    if (m) {      d = mj_makeData(m);
+      mj_forward(m, d);
+      info->nbody = m->nbody, info->ngeom = m->ngeom, info->nmesh = m->nmesh;
+      info->njoint = m->njnt, info->ncontact = d->ncon;
+      size_t np = prefix ? strlen(prefix) : 0;
+      // bodies named with the prefix, their geoms, and their contacts with other moving parts
+      for (int b = 1; b < m->nbody; b++) {
+        const char* name = mj_id2name(m, mjOBJ_BODY, b);
+        info->nbody_prefix += np && name && !strncmp(name, prefix, np);
+      }
+      for (int g = 0; g < m->ngeom; g++) {
+        const char* name = mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]);
+        info->ngeom_prefix += np && name && !strncmp(name, prefix, np);
+      }
+      for (int c = 0; c < d->ncon; c++) {
+        int b1 = m->geom_bodyid[d->contact[c].geom1], b2 = m->geom_bodyid[d->contact[c].geom2];
+        const char* n1 = mj_id2name(m, mjOBJ_BODY, b1);
+        const char* n2 = mj_id2name(m, mjOBJ_BODY, b2);
+        int p1 = np && n1 && !strncmp(n1, prefix, np), p2 = np && n2 && !strncmp(n2, prefix, np);
+        info->ncontact_prefix += (p1 && !p2 && b2 > 0) || (p2 && !p1 && b1 > 0);
+      }
+    }
+    vd_mj_trap_end(&trap);
+  } else {
+    st = vd_mj_trap_status(&trap, err);
+  }
+  if (d) mj_deleteData(d);
+  if (m) mj_deleteModel(m);
+  if (vfs) {
+    mj_deleteVFS(vfs);
+    vd_free(vfs, sizeof *vfs);
+  }
+  return st;
+}
+

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# End-to-end tests of `verdant export`: URDF, SDF and MJCF files of the tomato; the MJCF loads in
+# MuJoCo alone and beside the arm (--check, --check-with: always run, no OpenGL needed); the URDF
+# passes check_urdf (liburdfdom-tools) and the SDF `ign sdf -k` (ignition-tools, libsdformat)
+# when they are installed; bad usage is exit 2, an unwritable output exit 1, nothing left.
+# Usage: cli_export_test.sh VERDANT_BINARY SOURCE_DIR
+source "$(dirname "$0")/cli_lib.sh" cli_export "$@"
+
+expect "export help" 0 "$V" export --help
+expect "export without output" 2 "$V" export "$SRC/data/tomato.lpy"
+expect "export unknown format" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.stl"
+expect "export check on urdf" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.urdf" --check
+expect "export bad pos" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.xml" --pos 1,2
+expect "export bad thickness" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.xml" --leaf-thickness 0
+expect "export bad name" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.xml" --name "a b"
+expect "export two outputs" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.xml" -o "$T/y.xml"
+expect "export missing plant" 2 "$V" export "$T/missing.lpy" -o "$T/x.xml"
+expect_err "missing plant named" "missing.lpy"
+if ls "$T"/x.* >/dev/null 2>&1; then bad "nothing written after errors"; else ok "nothing written after errors"; fi
+
+# MJCF: loads in MuJoCo; beside the arm the plant touches it (the arm's reference pose reaches in)
+expect "export mjcf" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.xml" --check
+cp "$T/out" "$T/alone.json"
+expect "export mjcf with the arm" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.xml" \
+  --check-with "$SRC/data/robots/arm6.xml"
+cp "$T/out" "$T/arm.json"
+expect "export mjcf moved away" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/far.xml" --pos 3,0,0 \
+  --check-with "$SRC/data/robots/arm6.xml"
+cp "$T/out" "$T/far.json"
+if python3 - "$T" <<'PY'
+import json, sys
+t = sys.argv[1]
+alone, arm, far = (json.load(open(f"{t}/{n}.json")) for n in ("alone", "arm", "far"))
+assert alone["joints"] == 0 and alone["plant_bodies"] == alone["bodies"] - 2 > 50, alone
+assert alone["plant_geoms"] == alone["geoms"] and alone["meshes"] > 20, alone
+assert arm["plant_bodies"] == alone["plant_bodies"] and arm["joints"] > 0, arm
+assert arm["plant_robot_contacts"] > 0 and far["plant_robot_contacts"] == 0, (arm, far)
+PY
+then ok "mjcf loads, alone and with the arm"; else bad "mjcf loads, alone and with the arm"; fi
+if ls "$T"/*.scene.xml >/dev/null 2>&1; then bad "no scene left behind"; else ok "no scene left behind"; fi
+# the Lite 6, whose MJCF includes its gripper's
+if [ -f "$SRC/data/robots/lite6.xml" ]; then
+  expect "export mjcf with the Lite 6" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.xml" \
+    --check-with "$SRC/data/robots/lite6.xml"
+  if grep -Eq '"plant_bodies":[[:space:]]+[1-9]' "$T/out" && grep -Eq '"joints":[[:space:]]+[1-9]' "$T/out"; then ok "Lite 6 scene loads"; else bad "Lite 6 scene loads: $(head -c 300 "$T/out")"; fi
+fi
+
+# URDF and SDF, with their meshes as OBJ files; the standard checkers when installed
+expect "export urdf" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.urdf"
+expect "export sdf" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.sdf"
+n=$(ls "$T"/plant_meshes/*.obj 2>/dev/null | wc -l)
+if [ "$n" -gt 20 ]; then ok "mesh files written ($n)"; else bad "mesh files written ($n)"; fi
+if command -v check_urdf >/dev/null 2>&1; then
+  expect "check_urdf accepts the URDF" 0 check_urdf "$T/plant.urdf"
+else
+  echo "skip: check_urdf is not installed (Debian: liburdfdom-tools)"
+fi
+if command -v ign >/dev/null 2>&1 && ign sdf --help >/dev/null 2>&1; then
+  expect "ign sdf -k accepts the SDF" 0 ign sdf -k "$T/plant.sdf"
+  if grep -q "^Valid" "$T/out"; then ok "ign sdf says valid"; else bad "ign sdf says valid: $(head -c 300 "$T/out")"; fi
+else
+  echo "skip: ign sdf is not installed (Debian: ignition-tools, libsdformat-dev)"
+fi
+
+# an unwritable output: exit 1, nothing left (no mesh folder either)
+expect "unwritable export" 1 "$V" export "$SRC/data/tomato.lpy" -o "/nonexistent-dir/p.urdf"
+if [ -e /nonexistent-dir ]; then bad "nothing left after a failed export"; else ok "nothing left after a failed export"; fi
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
