@@ -135,12 +135,25 @@ extern PyTypeObject* vdpy_cloud_class;
 // buffer, valid until the next call).
 const vd_data* vdpy_sim_plant_state(PyObject* sim, const vd_model** plant);
 
+// Harvest episodes (py_harvest.c): the type, the plant state of the current step with the
+// colliders the robot's geoms are to the plant, and its busy flag (set >= 0 sets it; returns the
+// old value).
+typedef struct vdpy_harvest vdpy_harvest;
+extern PyTypeObject vdpy_harvest_type;
+const vd_data* vdpy_harvest_plant_state(PyObject* harvest, const vd_model** plant,
+                                        const vd_sim_collider** col, int* ncol);
+int vdpy_harvest_busy(PyObject* harvest, int set);
+
 // Module functions.
 PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_load(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_cloud(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_png(PyObject* self, PyObject* args, PyObject* kw);
 
+// Grow (or read) the plant file path as grow() does with seed, steps (-1: the file's) and
+// "NAME=VALUE" overrides; *out is a new spec. No Python calls: run it without the GIL.
+vd_status vdpy_grow_file(const char* path, uint64_t seed, int steps, char* const* sets, int nset,
+                         vd_plant_spec** out, vd_error* err);
 // A new Plant owning spec (taken) with its model compiled; NULL with an exception set (spec
 // freed).
 PyObject* vdpy_plant_new(vd_plant_spec* spec, uint64_t seed, const char* source, PyObject* info);

@@ -237,9 +237,9 @@ PyMODINIT_FUNC PyInit__verdant(void) {
   import_array();
   PyObject* mod = PyModule_Create(&module);
   if (!mod) return NULL;
-  PyTypeObject* types[] = {&vdpy_plant_type, &vdpy_mesh_type, &vdpy_cloud_type, &vdpy_sim_type,
-                           &vdpy_renderer_type};
-  const char* names[] = {"Plant", "Mesh", "Cloud", "Sim", "Renderer"};
+  PyTypeObject* types[] = {&vdpy_plant_type, &vdpy_mesh_type,     &vdpy_cloud_type,
+                           &vdpy_sim_type,   &vdpy_renderer_type, &vdpy_harvest_type};
+  const char* names[] = {"Plant", "Mesh", "Cloud", "Sim", "Renderer", "Harvest"};
   for (int k = 0; k < (int)(sizeof types / sizeof types[0]); k++)
     if (PyType_Ready(types[k]) < 0 || PyModule_AddObjectRef(mod, names[k], (PyObject*)types[k]) < 0)
       goto fail;

@@ -33,6 +33,7 @@ typedef struct grow_args {
   int* label_id;         // --label ids (nlabel)
   char (*label_name)[VD_LABEL_NAME_MAX];  // --label names
   double curve[3];       // curve step, connect, distance (m), < 0: file's or default
+  vd_lsys_engine engine; // who runs the file's Python (--engine)
 } grow_args;
 
 // What grow() made.
@@ -152,7 +153,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
     if (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0)
       return vd_error_set(err, VD_ERR_ARG, name, 0, 0, "curve_* options apply to curves files only");
     vd_lsystem* ls;
-    vd_status st = vd_lsys_parse(a->text, len, name, &ls, err);
+    vd_status st = vd_lsys_parse_engine(a->text, len, name, a->engine, &ls, err);
     if (st) return st;
     st = grow_lsys(a, ls, name, out, err);
     vd_lsys_destroy(ls);
@@ -170,10 +171,45 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   if (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0)
     return vd_error_set(err, VD_ERR_ARG, a->path, 0, 0, "curve_* options apply to curves files only");
   vd_lsystem* ls;
-  vd_status st = vd_lsys_load(a->path, &ls, err);
+  vd_status st = vd_lsys_load_engine(a->path, a->engine, &ls, err);
   if (st) return st;
   st = grow_lsys(a, ls, a->path, out, err);
   vd_lsys_destroy(ls);
+  return st;
+}
+
+vd_status vdpy_grow_file(const char* path, uint64_t seed, int steps, char* const* sets, int nset,
+                         vd_plant_spec** out, vd_error* err) {
+  grow_args a;
+  memset(&a, 0, sizeof a);
+  a.def = vd_lsys_def_default();
+  a.def.max_modules = 50000000;
+  a.def.seed = seed;
+  a.def.steps = steps;
+  a.curve[0] = a.curve[1] = a.curve[2] = -1;
+  snprintf(a.path, sizeof a.path, "%s", path);
+  // "NAME=VALUE" overrides, split into the arrays grow_run reads
+  char(*names)[128] = nset ? vd_calloc((size_t)nset, sizeof *names) : NULL;
+  char** values = nset ? vd_calloc((size_t)nset, sizeof *values) : NULL;
+  if (nset && (!names || !values)) {
+    vd_free(names, (size_t)nset * sizeof *names);
+    vd_free(values, (size_t)nset * sizeof *values);
+    return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  }
+  for (int i = 0; i < nset; i++) {
+    const char* eq = strchr(sets[i], '=');
+    size_t n = eq ? (size_t)(eq - sets[i]) : strlen(sets[i]);
+    snprintf(names[i], sizeof names[i], "%.*s", (int)(n < 127 ? n : 127), sets[i]);
+    values[i] = eq ? (char*)eq + 1 : (char*)"";
+  }
+  a.nset = nset, a.set_name = names, a.set_value = values;
+  grow_out o;
+  memset(&o, 0, sizeof o);
+  vd_status st = grow_run(&a, &o, err);
+  if (!st) *out = o.spec, o.spec = NULL;
+  grow_out_free(&o);
+  vd_free(names, (size_t)nset * sizeof *names);
+  vd_free(values, (size_t)nset * sizeof *values);
   return st;
 }
 
@@ -204,7 +240,7 @@ static PyObject* set_text(PyObject* v, const char* name) {
 
 PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   static const char* const names[] = {"seed", "steps", "set", "labels", "max_modules", "max_ops",
-                                      "curve_step", "curve_connect", "curve_distance", NULL};
+                                      "curve_step", "curve_connect", "curve_distance", "engine", NULL};
   PyObject* source;
   if (!PyArg_ParseTuple(args, "O:grow", &source) || !vdpy_kw_check(kw, "grow", names)) return NULL;
   grow_args a;
@@ -243,6 +279,14 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   if ((o = vdpy_kw(kw, "max_ops"))) {
     if (!vdpy_i64(o, "max_ops", 0, INT64_MAX, &v)) return NULL;
     a.def.max_ops = v;
+  }
+  if ((o = vdpy_kw(kw, "engine"))) {
+    char e[16];
+    if (!vdpy_str(o, "engine", e, sizeof e)) return NULL;
+    if (!strcmp(e, "auto")) a.engine = VD_LSYS_AUTO;
+    else if (!strcmp(e, "native")) a.engine = VD_LSYS_NATIVE;
+    else if (!strcmp(e, "python")) a.engine = VD_LSYS_PYTHON;
+    else return vdpy_arg_error("engine expects 'auto', 'native' or 'python', got '%s'", e);
   }
   const char* curve_names[3] = {"curve_step", "curve_connect", "curve_distance"};
   for (int k = 0; k < 3; k++)
@@ -457,6 +501,13 @@ static PyGetSetDef plant_getset[] = {
     {NULL, NULL, NULL, NULL, NULL},
 };
 
+// a mesh with the plant's label table as OBJ (with its MTL) or PLY (binary unless ascii)
+static vd_status write_mesh(const vd_mesh* mesh, const vd_model* m, const char* out, int obj, int ascii,
+                            vd_error* err) {
+  return obj ? vd_geom_write_obj(mesh, m->labels, m->nlabel, out, err)
+             : vd_geom_write_ply(mesh, m->labels, m->nlabel, out, !ascii, err);
+}
+
 // write the spec (JSON) or the rest shape's tessellation (OBJ with MTL, PLY), as `verdant grow -o`
 static PyObject* plant_save(vdpy_plant* p, PyObject* args, PyObject* kw) {
   static char* names[] = {"path", "ascii", NULL};
@@ -476,8 +527,7 @@ static PyObject* plant_save(vdpy_plant* p, PyObject* args, PyObject* kw) {
     vd_mesh mesh;
     st = vd_geom_tessellate(p->model, NULL, NULL, &mesh, &err);
     if (!st) {
-      st = obj ? vd_geom_write_obj(&mesh, p->model->labels, p->model->nlabel, out, &err)
-               : vd_geom_write_ply(&mesh, p->model->labels, p->model->nlabel, out, !ascii, &err);
+      st = write_mesh(&mesh, p->model, out, obj, ascii, &err);
       vd_mesh_free(&mesh);
     }
   }
@@ -608,8 +658,7 @@ static PyObject* mesh_save(vdpy_mesh* m, PyObject* args, PyObject* kw) {
   vd_error err = {0};
   vd_status st;
   Py_BEGIN_ALLOW_THREADS
-  st = obj ? vd_geom_write_obj(&m->mesh, pm->labels, pm->nlabel, out, &err)
-           : vd_geom_write_ply(&m->mesh, pm->labels, pm->nlabel, out, !ascii, &err);
+  st = write_mesh(&m->mesh, pm, out, obj, ascii, &err);
   Py_END_ALLOW_THREADS
   if (st) return vdpy_raise(st, &err);
   Py_RETURN_NONE;

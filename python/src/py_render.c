@@ -91,6 +91,7 @@ typedef struct item {
   const vd_sim_collider* col;  // a Sim's colliders (drawn as solids)
   int ncol;
   vdpy_sim* sim;           // the Sim drawn (kept busy while drawing)
+  PyObject* harvest;       // the Harvest drawn (kept busy while drawing)
 } item;
 
 static int item_of(PyObject* o, item* it, int color_by) {
@@ -126,7 +127,16 @@ static int item_of(PyObject* o, item* it, int color_by) {
     it->points = p;
     return 1;
   }
-  PyErr_Format(PyExc_TypeError, "render draws a Plant, a Sim or a Cloud (or a list of them), got %s",
+  if (PyObject_TypeCheck(o, &vdpy_harvest_type)) {
+    if (color_by == VD_COLOR_STRESS) return (vdpy_arg_error("color_by='stress' is for a Sim"), 0);
+    if (vdpy_harvest_busy(o, -1)) return (vdpy_busy("this Harvest"), 0);
+    it->kind = 1;
+    it->harvest = o;
+    it->state = vdpy_harvest_plant_state(o, &it->model, &it->col, &it->ncol);
+    if (!it->state) return (vdpy_raise(VD_ERR_VALUE, NULL), 0);
+    return 1;
+  }
+  PyErr_Format(PyExc_TypeError, "render draws a Plant, a Sim, a Cloud or a Harvest (or a list of them), got %s",
                Py_TYPE(o)->tp_name);
   return 0;
 }
@@ -317,15 +327,18 @@ static PyObject* renderer_draw(vdpy_renderer* r, PyObject* args, PyObject* kw) {
   if (ok && !n) ok = (vdpy_arg_error("nothing to draw"), 0);
   if (ok) ok = busy_check(r);
   for (Py_ssize_t i = 0; ok && i < n; i++)
-    if (it[i].sim) {
-      if (it[i].sim->busy) ok = (vdpy_busy("this Sim"), 0);  // the same Sim twice, or stepping
+    if (it[i].sim || it[i].harvest) {
+      if (it[i].sim && it[i].sim->busy) ok = (vdpy_busy("this Sim"), 0);  // stepping elsewhere
       for (Py_ssize_t j = 0; j < i; j++)
-        if (it[j].sim == it[i].sim) ok = (vdpy_arg_error("the same Sim twice in one picture"), 0);
+        if ((it[i].sim && it[j].sim == it[i].sim) || (it[i].harvest && it[j].harvest == it[i].harvest))
+          ok = (vdpy_arg_error("the same Sim or Harvest twice in one picture"), 0);
     }
   if (ok) {
     r->busy = 1;
-    for (Py_ssize_t i = 0; i < n; i++)
+    for (Py_ssize_t i = 0; i < n; i++) {
       if (it[i].sim) it[i].sim->busy = 1;
+      if (it[i].harvest) vdpy_harvest_busy(it[i].harvest, 1);
+    }
     vd_error err = {0};
     vd_status st = VD_OK;
     vd_frame f;
@@ -370,8 +383,10 @@ static PyObject* renderer_draw(vdpy_renderer* r, PyObject* args, PyObject* kw) {
     vd_render_release(r->r);
     Py_END_ALLOW_THREADS
     r->busy = 0;
-    for (Py_ssize_t i = 0; i < n; i++)
+    for (Py_ssize_t i = 0; i < n; i++) {
       if (it[i].sim) it[i].sim->busy = 0;
+      if (it[i].harvest) vdpy_harvest_busy(it[i].harvest, 0);
+    }
   }
   for (Py_ssize_t i = 0; it && i < n; i++) vd_free(it[i].stress, it[i].nstress * sizeof(double));
   PyMem_Free(it);

@@ -18,6 +18,7 @@ QUICK = {
     "render_masks.py": [],
     "torch_dataset.py": ["--steps", "3", "--points", "512"],
     "parallel_plants.py": ["--count", "2", "--steps", "30"],
+    "harvest_env.py": ["--episodes", "1"],
 }
 
 

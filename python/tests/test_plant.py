@@ -134,3 +134,32 @@ def test_steps_set_seed():
     assert len(d.segments) < len(b.segments)
     e = verdant.grow(data("tomato.lpy"), seed=3, set={"NODES": "5 * 2"})
     assert np.array_equal(d.nodes, e.nodes)
+
+
+def test_python_engine_equals_cli(tmp_path, cli):
+    # a file beyond the native subset runs in embedded CPython: inside this interpreter, with the
+    # GIL let go while growing; the same plant as the command line's
+    p = verdant.grow(data("python_bud.lpy"), seed=4)
+    assert p.stats["engine"] == "python"
+    p.save(tmp_path / "py.json")
+    cli("grow", data("python_bud.lpy"), "--seed", "4", "-o", tmp_path / "cli.json")
+    assert read(tmp_path / "py.json") == read(tmp_path / "cli.json")
+    assert verdant.grow(data("tomato.lpy"), engine="python").stats["engine"] == "python"
+    assert verdant.grow(TINY).stats["engine"] == "native"
+    with pytest.raises(verdant.UnsupportedError):
+        verdant.grow(data("python_bud.lpy"), engine="native")
+    with pytest.raises(verdant.ArgumentError):
+        verdant.grow(TINY, engine="jython")
+
+
+def test_python_engine_in_threads():
+    import threading
+    ref = verdant.grow(data("python_bud.lpy"), seed=2).nodes.copy()
+    out = []
+    ts = [threading.Thread(target=lambda: out.append(verdant.grow(data("python_bud.lpy"), seed=2).nodes))
+          for _ in range(3)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert len(out) == 3 and all(np.array_equal(o, ref) for o in out)

@@ -47,7 +47,7 @@ __version__ = _verdant.version
 
 __all__ = [
     "grow", "load", "read_cloud", "read_png", "render", "Plant", "Mesh", "Cloud", "Sim",
-    "Renderer",
+    "Renderer", "HarvestEnv",
     "Error", "ParseError", "UnsupportedError", "UndefinedNameError", "WrongTypeError",
     "BadValueError", "ModelAssertionError", "LimitError", "FileError", "FormatError",
     "OutOfMemoryError", "ArgumentError",
@@ -132,7 +132,7 @@ class Plant(_verdant.Plant):
         per_label = np.unique(np.unique(keys) >> 32, return_counts=True)
         count = dict(zip(per_label[0].tolist(), per_label[1].tolist()))
         return {
-            **({"engine": info["engine"]} if "engine" in info else {}),
+            **({"engine": info["engine"]} if info.get("engine") else {}),
             "modules": info.get("modules", 0),
             "module_counts": info.get("module_counts", {}),
             "nodes": geo["nodes"], "segments": geo["segments"], "spheres": geo["spheres"],
@@ -310,9 +310,11 @@ def render(objects, *, camera="orbit", azimuth=-60, elevation=20, eye=None, look
 
 _verdant._register(plant=Plant, mesh=Mesh, cloud=Cloud)
 
+from .env import HarvestEnv  # noqa: E402  (needs Plant and Renderer above)
+
 
 def grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=None, max_ops=None,
-         curve_step=None, curve_connect=None, curve_distance=None):
+         curve_step=None, curve_connect=None, curve_distance=None, engine=None):
     """Grow a plant: derive an L-Py file (.lpy), read a plant file (.json), build one from a
     curves file (.json with "format": "verdant-curves"), or take the text itself (a str with a
     newline: L-Py, or JSON when it starts with '{').
@@ -323,13 +325,15 @@ def grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=None,
         numbers, bools, lists). labels: {id: name} naming label ids after the file's LABELS.
     max_modules (default 50e6), max_ops (default 1e9): limits (LimitError beyond).
     curve_step, curve_connect, curve_distance: curves files' sampling (m).
+    engine: who runs the file's Python: 'auto' (default: the native subset interpreter when the
+        file stays within it, else embedded CPython, as L-Py would), 'native' or 'python'.
 
     The same plant as `verdant grow SOURCE --seed SEED ...`. Raises ParseError, FileError, ...
     (verdant.Error subclasses with file, line, column, message). The GIL is released.
     """
     kw = dict(seed=seed, steps=steps, set=set, labels=labels, max_modules=max_modules,
               max_ops=max_ops, curve_step=curve_step, curve_connect=curve_connect,
-              curve_distance=curve_distance)
+              curve_distance=curve_distance, engine=engine)
     return _verdant.grow(source, **{k: v for k, v in kw.items() if v is not None})
 
 

@@ -1,0 +1,387 @@
+// SPDX-License-Identifier: MIT
+// Harvest episodes: the Harvest type over vd_harvest (robot.h), the engine of verdant.HarvestEnv.
+// It reads a scene, grows and places its plant, and steps an episode one control step at a time
+// under an action (end-effector velocity and gripper) without the GIL; episode k of a seed gets
+// the scene's randomisation (vd_scene_episode: plant seed, target, method parameters), the plant
+// regrown only when its seed changes.
+#include "py_internal.h"
+
+#include <math.h>
+#include <structmember.h>
+
+#include "verdant/robot.h"
+
+#define PATH_CAP 4096
+
+struct vdpy_harvest {
+  PyObject_HEAD
+  vd_scene base;         // the scene as read (owned)
+  vd_scene scene;        // the current episode's scene (owned)
+  vd_plant_spec* spec;   // the episode's plant, placed (owned)
+  vd_model* plant;       // compiled (owned; the episode borrows it)
+  uint64_t plant_seed;   // the seed spec was grown with
+  vd_harvest* h;         // the episode (owned)
+  vd_data* pstate;       // the plant state of the current step (owned)
+  int stepped;           // step() was called in this episode (the scripted controller is off)
+  int busy;
+};
+
+static int busy_check(vdpy_harvest* o) {
+  if (o->busy) return (vdpy_busy("this Harvest"), 0);
+  return 1;
+}
+
+static void harvest_free_episode(vdpy_harvest* o) {
+  vd_harvest_destroy(o->h);
+  vd_data_destroy(o->pstate);
+  vd_model_destroy(o->plant);
+  vd_plant_spec_destroy(o->spec);
+  o->h = NULL, o->pstate = NULL, o->plant = NULL, o->spec = NULL;
+}
+
+static void harvest_dealloc(vdpy_harvest* o) {
+  harvest_free_episode(o);
+  vd_scene_free(&o->scene);
+  vd_scene_free(&o->base);
+  Py_TYPE(o)->tp_free((PyObject*)o);
+}
+
+// the method parameters an episode draws: a new episode needs a new vd_harvest when they change
+static int same_method(const vd_method_def* a, const vd_method_def* b) {
+  return a->method == b->method && a->approach_speed == b->approach_speed && a->pregrasp == b->pregrasp &&
+         a->speed == b->speed && a->distance == b->distance && a->angle == b->angle &&
+         a->angular_speed == b->angular_speed && a->grip_force == b->grip_force &&
+         a->grip_friction == b->grip_friction && a->touch_force == b->touch_force && a->hold == b->hold;
+}
+
+// the episode of scene s (taken into o->scene): plant grown when its seed differs, episode built
+// or reused, reset with target_seed; no Python calls (run it without the GIL)
+static vd_status episode(vdpy_harvest* o, vd_scene* s, uint64_t target_seed, vd_error* err) {
+  int regrow = !o->spec || s->plant_seed != o->plant_seed;
+  int rebuild = regrow || !o->h || !same_method(&s->method, &o->scene.method) ||
+                s->target_instance != o->scene.target_instance;
+  vd_scene_free(&o->scene);
+  o->scene = *s;
+  memset(s, 0, sizeof *s);
+  vd_status st = VD_OK;
+  if (regrow) {
+    harvest_free_episode(o);
+    st = vdpy_grow_file(o->scene.plant_path, o->scene.plant_seed, o->scene.plant_steps, o->scene.plant_set,
+                        o->scene.nplant_set, &o->spec, err);
+    if (st) {
+      if (err && !err->file[0]) snprintf(err->file, sizeof err->file, "%.255s", o->scene.plant_path);
+      return st;
+    }
+    o->plant_seed = o->scene.plant_seed;
+    vd_scene_place_plant(&o->scene, o->spec);
+    st = vd_plant_compile(o->spec, &o->plant, err);
+    if (!st && !(o->pstate = vd_data_create(o->plant))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (st) return st;
+  }
+  if (rebuild) {
+    vd_harvest_destroy(o->h);
+    o->h = NULL;
+    st = vd_harvest_create(&o->scene, o->plant, &o->h, err);
+    if (o->h && st == VD_ERR_VALUE) st = VD_OK;  // an unreachable target is an outcome: done
+    if (st) return st;
+  }
+  memset(err, 0, sizeof *err);
+  st = vd_harvest_reset(o->h, target_seed, err);
+  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) st = VD_OK;  // no reachable fruit: done
+  o->stepped = 0;
+  return st;
+}
+
+static PyObject* harvest_new(PyTypeObject* type, PyObject* args, PyObject* kw) {
+  static char* names[] = {"scene", NULL};
+  PyObject* src;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "O:Harvest", names, &src)) return NULL;
+  vdpy_harvest* o = (vdpy_harvest*)type->tp_alloc(type, 0);
+  if (!o) return NULL;
+  vd_scene_default(&o->base);
+  vd_scene_default(&o->scene);
+  vd_error err = {0};
+  vd_status st;
+  // a scene file, or its JSON text
+  const char* text = NULL;
+  Py_ssize_t len = 0;
+  char path[PATH_CAP] = "";
+  // text: a str with a newline or whose first character (past blanks) is '{'
+  int is_text = 0;
+  if (PyUnicode_Check(src)) {
+    Py_ssize_t n = PyUnicode_GET_LENGTH(src), i = 0;
+    while (i < n && Py_UNICODE_ISSPACE(PyUnicode_READ_CHAR(src, i))) i++;
+    is_text = PyUnicode_FindChar(src, '\n', 0, n, 1) >= 0 || (i < n && PyUnicode_READ_CHAR(src, i) == '{');
+  }
+  if (is_text) {
+    text = PyUnicode_AsUTF8AndSize(src, &len);
+    if (!text) goto fail;
+  } else if (!vdpy_path(src, "scene", path, sizeof path)) {
+    goto fail;
+  }
+  Py_BEGIN_ALLOW_THREADS
+  st = text ? vd_scene_parse(text, (size_t)len, NULL, &o->base, &err) : vd_scene_read(path, &o->base, &err);
+  if (!st) {
+    vd_scene s;
+    st = vd_scene_copy(&o->base, &s, &err);
+    if (!st) st = episode(o, &s, 0, &err);
+    vd_scene_free(&s);
+  }
+  Py_END_ALLOW_THREADS
+  if (st) {
+    vdpy_raise(st, &err);
+    goto fail;
+  }
+  return (PyObject*)o;
+fail:
+  Py_DECREF(o);
+  return NULL;
+}
+
+// reset(seed, episode): episode k of the scene's randomisation under seed
+static PyObject* harvest_reset(vdpy_harvest* o, PyObject* args, PyObject* kw) {
+  static char* names[] = {"seed", "episode", "randomize", NULL};
+  PyObject *so, *ko = NULL;
+  int randomize = 1;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "O|O$p:reset", names, &so, &ko, &randomize)) return NULL;
+  int64_t seed, k = 0;
+  if (!vdpy_i64(so, "seed", 0, INT64_MAX, &seed)) return NULL;
+  if (ko && !vdpy_i64(ko, "episode", 0, INT64_MAX, &k)) return NULL;
+  if (!busy_check(o)) return NULL;
+  o->busy = 1;
+  vd_error err = {0};
+  vd_status st;
+  Py_BEGIN_ALLOW_THREADS
+  vd_scene s;
+  uint64_t tseed = (uint64_t)seed;
+  st = randomize ? vd_scene_episode(&o->base, (uint64_t)seed, k, &s, &tseed, &err) : vd_scene_copy(&o->base, &s, &err);
+  if (!st) st = episode(o, &s, tseed, &err);
+  vd_scene_free(&s);
+  Py_END_ALLOW_THREADS
+  o->busy = 0;
+  if (st) return vdpy_raise(st, &err);
+  Py_RETURN_NONE;
+}
+
+static int have_episode(vdpy_harvest* o) {
+  if (!o->h) return (vdpy_raise(VD_ERR_VALUE, NULL), 0);  // a failed reset left none
+  return 1;
+}
+
+// step(lin_vel, ang_vel, gripper) -> ok: False when the episode failed (then done)
+static PyObject* harvest_step(vdpy_harvest* o, PyObject* args, PyObject* kw) {
+  static char* names[] = {"lin_vel", "ang_vel", "gripper", NULL};
+  PyObject *lo, *ao, *go;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO:step", names, &lo, &ao, &go)) return NULL;
+  double l[3], w[3], g;
+  if (!vdpy_vec(lo, "lin_vel", 3, l) || !vdpy_vec(ao, "ang_vel", 3, w) || !vdpy_f64(go, "gripper", 0, 1, &g))
+    return NULL;
+  for (int k = 0; k < 3; k++)
+    if (fabs(l[k]) > 10 || fabs(w[k]) > 100)
+      return vdpy_arg_error("lin_vel within +-10 m/s and ang_vel within +-100 rad/s");
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  if (vd_harvest_done(o->h)) return vdpy_arg_error("the episode is over: reset() first");
+  vd_harvest_action a = {vd_v3(l[0], l[1], l[2]), vd_v3(w[0], w[1], w[2]), g};
+  o->busy = 1;
+  o->stepped = 1;
+  vd_error err = {0};
+  vd_status st;
+  Py_BEGIN_ALLOW_THREADS
+  st = vd_harvest_step(o->h, &a, &err);
+  Py_END_ALLOW_THREADS
+  o->busy = 0;
+  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) Py_RETURN_FALSE;  // MuJoCo or the plant failed
+  if (st) return vdpy_raise(st, &err);
+  Py_RETURN_TRUE;
+}
+
+// run(): the scene's scripted controller to the end of the episode (as `verdant harvest`)
+static PyObject* harvest_run(vdpy_harvest* o, PyObject* unused) {
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  if (o->stepped) return vdpy_arg_error("run() drives an episode from its start: reset() first");
+  o->busy = 1;
+  vd_error err = {0};
+  vd_status st = VD_OK;
+  Py_BEGIN_ALLOW_THREADS
+  if (!vd_harvest_done(o->h)) st = vd_harvest_run(o->h, NULL, NULL, &err);
+  Py_END_ALLOW_THREADS
+  o->busy = 0;
+  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) Py_RETURN_FALSE;
+  if (st) return vdpy_raise(st, &err);
+  Py_RETURN_TRUE;
+}
+
+static PyObject* vec(const double* v, npy_intp n) {
+  npy_intp d[1] = {n};
+  PyObject* a = PyArray_EMPTY(1, d, NPY_DOUBLE, 0);
+  if (a && n) memcpy(PyArray_DATA((PyArrayObject*)a), v, (size_t)n * sizeof(double));
+  return a;
+}
+
+static PyObject* harvest_observe(vdpy_harvest* o, PyObject* unused) {
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  vd_harvest_obs b;
+  vd_harvest_observe(o->h, &b);
+  double ee[3] = {b.ee_pos.x, b.ee_pos.y, b.ee_pos.z}, eq[4] = {b.ee_quat.w, b.ee_quat.x, b.ee_quat.y, b.ee_quat.z};
+  double fp[3] = {b.fruit_pos.x, b.fruit_pos.y, b.fruit_pos.z}, fv[3] = {b.fruit_vel.x, b.fruit_vel.y, b.fruit_vel.z};
+  double cp[3] = {b.cmd_pos.x, b.cmd_pos.y, b.cmd_pos.z}, pf[3] = {b.pull_force.x, b.pull_force.y, b.pull_force.z};
+  double rf[3] = {b.robot_force.x, b.robot_force.y, b.robot_force.z};
+  double touch[2] = {b.touching[0], b.touching[1]};
+  return Py_BuildValue(
+      "{s:d,s:L,s:s,s:N,s:N,s:d,s:N,s:N,s:N,s:i,s:N,s:N,s:O,s:N,s:N,s:d,s:N,s:d,s:d,s:N,s:O,s:s,s:d}", "time",
+      b.time, "step", (long long)b.step, "phase", vd_harvest_phase_name(b.phase), "q", vec(b.q, b.nq), "qd",
+      vec(b.qd, b.nq), "gripper_opening", b.gripper_opening, "ee_pos", vec(ee, 3), "ee_quat", vec(eq, 4),
+      "cmd_pos", vec(cp, 3), "target_instance", b.target_instance, "fruit_pos", vec(fp, 3), "fruit_vel",
+      vec(fv, 3), "held", b.held ? Py_True : Py_False, "touching", vec(touch, 2), "finger_force",
+      vec(b.finger_force, 2), "grip_force", b.grip_force, "pull_force", vec(pf, 3), "pull_torque",
+      b.pull_torque, "slip", b.slip, "robot_force", vec(rf, 3), "detached", b.detached ? Py_True : Py_False,
+      "site", vd_harvest_site_name(b.site), "ik_error", b.ik_error);
+}
+
+// events from index `since` on
+static PyObject* harvest_events(vdpy_harvest* o, PyObject* args, PyObject* kw) {
+  static char* names[] = {"since", NULL};
+  PyObject* so = NULL;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "|O:events", names, &so)) return NULL;
+  int64_t since = 0;
+  if (so && !vdpy_i64(so, "since", 0, INT32_MAX, &since)) return NULL;
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  const vd_harvest_event* ev;
+  int n = vd_harvest_events(o->h, &ev);
+  PyObject* list = PyList_New(0);
+  for (int k = (int)since; list && k < n; k++) {
+    const vd_harvest_event* e = &ev[k];
+    PyObject* d = Py_BuildValue("{s:d,s:s,s:d,s:i,s:i,s:s,s:d,s:d,s:s}", "time", e->time, "kind",
+                                vd_harvest_event_name(e->kind), "value", e->value, "segment", e->seg, "instance",
+                                e->instance, "class", e->cls >= 0 ? vd_sim_class_name((vd_sim_class)e->cls) : "",
+                                "force", e->force, "moment", e->moment, "site", vd_harvest_site_name(e->site));
+    if (!d || PyList_Append(list, d) < 0) Py_CLEAR(list);
+    Py_XDECREF(d);
+  }
+  return list;
+}
+
+static PyObject* harvest_summary(vdpy_harvest* o, PyObject* unused) {
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  vd_harvest_summary s;
+  vd_harvest_summarize(o->h, &s);
+  return Py_BuildValue("{s:O,s:O,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:i,s:i,s:d,s:d,s:d,s:d,s:L,s:L,s:i,s:s,s:K}",
+                       "detached", s.detached ? Py_True : Py_False, "grasped", s.grasped ? Py_True : Py_False,
+                       "site", vd_harvest_site_name(s.site), "time", s.time, "detach_force", s.detach_force,
+                       "detach_moment", s.detach_moment, "pull_force", s.pull_force, "max_pull_force",
+                       s.max_pull_force, "max_displacement", s.max_displacement, "fruits_hit", s.fruits_hit,
+                       "fruits_dropped", s.fruits_dropped, "ik_error", s.ik_error, "track_error", s.track_error,
+                       "slip", s.slip, "duration", s.duration, "steps", (long long)s.steps, "plant_warnings",
+                       (long long)s.plant_warnings, "target_instance", s.target_instance, "reason", s.reason,
+                       "plant_seed", (unsigned long long)o->plant_seed);
+}
+
+static PyObject* harvest_done(vdpy_harvest* o, void* c) {
+  return PyBool_FromLong(o->h ? vd_harvest_done(o->h) : 1);
+}
+
+static PyObject* harvest_info(vdpy_harvest* o, void* c) {
+  const vd_scene* s = &o->scene;
+  vd_harvest_obs b;
+  memset(&b, 0, sizeof b);
+  if (o->h) vd_harvest_observe(o->h, &b);
+  return Py_BuildValue("{s:s,s:s,s:s,s:d,s:d,s:i,s:d,s:d,s:s,s:K,s:O}", "scene", s->path, "plant", s->plant_path,
+                       "robot", s->robot_path, "control_dt", s->control_dt, "duration", s->duration, "nq", b.nq,
+                       "gripper_open", s->gripper_open, "gripper_closed", s->gripper_closed, "method",
+                       vd_harvest_method_name(s->method.method), "plant_seed", (unsigned long long)o->plant_seed,
+                       "two_way", s->two_way ? Py_True : Py_False);
+}
+
+// the robot's full joint positions (pictures with the robot's MJCF)
+static PyObject* harvest_qpos(vdpy_harvest* o, void* c) {
+  if (!have_episode(o)) return NULL;
+  int nq = 0;
+  const double* q = vd_harvest_qpos(o->h, &nq);
+  return vec(q, nq);
+}
+
+// the plant state of the current step, and the colliders the robot's geoms are to the plant
+const vd_data* vdpy_harvest_plant_state(PyObject* obj, const vd_model** plant, const vd_sim_collider** col,
+                                        int* ncol) {
+  vdpy_harvest* o = (vdpy_harvest*)obj;
+  if (!o->h) return NULL;
+  const vd_sim_model* sm = vd_harvest_sim_model(o->h);
+  const vd_sim_data* sd = vd_harvest_sim_data(o->h);
+  vd_sim_to_plant(sm, sd, o->plant, o->pstate);
+  *plant = o->plant;
+  *col = sd->collider, *ncol = sd->ncollider;
+  return o->pstate;
+}
+
+int vdpy_harvest_busy(PyObject* obj, int set) {
+  vdpy_harvest* o = (vdpy_harvest*)obj;
+  int was = o->busy;
+  if (set >= 0) o->busy = set;
+  return was;
+}
+
+// a labelled cloud of the plant in its current state (Plant.cloud's keywords)
+static PyObject* harvest_cloud(vdpy_harvest* o, PyObject* args, PyObject* kw) {
+  if (PyTuple_GET_SIZE(args)) return PyErr_Format(PyExc_TypeError, "cloud() takes keyword arguments only");
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  const vd_model* m;
+  const vd_sim_collider* col;
+  int ncol;
+  const vd_data* d = vdpy_harvest_plant_state((PyObject*)o, &m, &col, &ncol);
+  o->busy = 1;
+  PyObject* r = vdpy_cloud_make(o->spec, m, d, o->plant_seed, kw);
+  o->busy = 0;
+  return r;
+}
+
+static PyObject* harvest_plant(vdpy_harvest* o, PyObject* unused) {
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  vd_plant_spec* spec = vd_plant_spec_copy(o->spec);
+  if (!spec) return PyErr_NoMemory();
+  vd_sim_to_spec(vd_harvest_sim_model(o->h), vd_harvest_sim_data(o->h), spec);
+  return vdpy_plant_new(spec, o->plant_seed, o->scene.plant_path, NULL);
+}
+
+static PyGetSetDef harvest_getset[] = {
+    {"done", (getter)harvest_done, NULL, "True when the episode is over", NULL},
+    {"info", (getter)harvest_info, NULL, "the episode's scene: files, control_dt (s), duration (s), nq, gripper, method, plant seed", NULL},
+    {"qpos", (getter)harvest_qpos, NULL, "the robot's MuJoCo joint positions (a copy)", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyMethodDef harvest_methods[] = {
+    {"reset", (PyCFunction)(void (*)(void))harvest_reset, METH_VARARGS | METH_KEYWORDS,
+     "reset(seed, episode=0, *, randomize=True): start episode `episode` of the scene's\n"
+     "randomisation under seed (plant seed, target, method parameters); the plant is regrown\n"
+     "when its seed changes. Without the GIL."},
+    {"step", (PyCFunction)(void (*)(void))harvest_step, METH_VARARGS | METH_KEYWORDS,
+     "step(lin_vel, ang_vel, gripper) -> bool: one control step under an end-effector velocity\n"
+     "(m/s, rad/s, world frame) and a gripper command in [0, 1] (0 open, 1 closed), without the\n"
+     "GIL; False when MuJoCo or the plant failed (the episode is then done)."},
+    {"run", (PyCFunction)harvest_run, METH_NOARGS,
+     "run() -> bool: the scene's scripted controller (approach, grasp, then pull, bend or twist)\n"
+     "to the end of the episode, without the GIL, as `verdant harvest` runs it; False when MuJoCo\n"
+     "or the plant failed. Only before the first step() of an episode."},
+    {"observe", (PyCFunction)harvest_observe, METH_NOARGS,
+     "observe() -> dict: time, phase, joint state q and qd, end-effector pose, target fruit, grasp\n"
+     "forces, detachment."},
+    {"events", (PyCFunction)(void (*)(void))harvest_events, METH_VARARGS | METH_KEYWORDS,
+     "events(since=0) -> list of dicts: phase, touch, grasp, slip, release, fracture, detach, hit,\n"
+     "drop and ik events from index since on."},
+    {"summary", (PyCFunction)harvest_summary, METH_NOARGS, "summary() -> dict: the outcome so far (summary.json)."},
+    {"cloud", (PyCFunction)(void (*)(void))harvest_cloud, METH_VARARGS | METH_KEYWORDS,
+     "cloud(**options) -> Cloud: the plant in its current state (Plant.cloud's keywords)."},
+    {"plant", (PyCFunction)harvest_plant, METH_NOARGS, "plant() -> Plant: the plant in its current state."},
+    {NULL, NULL, 0, NULL},
+};
+
+PyTypeObject vdpy_harvest_type = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "verdant._verdant.Harvest",
+    .tp_basicsize = sizeof(vdpy_harvest),
+    .tp_dealloc = (destructor)harvest_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
+    .tp_doc = "Harvest(scene): a harvest episode stepped from Python (see verdant.HarvestEnv).",
+    .tp_methods = harvest_methods,
+    .tp_getset = harvest_getset,
+    .tp_new = harvest_new,
+};
