@@ -36,6 +36,7 @@ typedef struct cli_plant_opts {
   double curve_connect;    // --curve-connect (m), < 0: the file's or the default
   double curve_distance;   // --curve-distance (m), < 0: the file's or the default
   int engine;              // --engine auto|native|python (vd_lsys_engine), VD_LSYS_AUTO by default
+  const char* lstring_out; // --lstring FILE: the derived L-string as JSON (.lpy files), NULL: none
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.

@@ -102,6 +102,51 @@ int cli_has_ext(const char* path, const char* ext) {
   return n >= e && strcasecmp(path + n - e, ext) == 0;
 }
 
+// the derived L-string as JSON (--lstring): module names and parameters (numbers or strings),
+// written to a temporary name and renamed when complete
+static vd_status write_lstring_json(const char* path, const vd_lsystem* ls, const vd_lstring* s, vd_error* err) {
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.tmp%d", path, (int)getpid());
+  FILE* f = fopen(tmp, "wb");
+  if (!f) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot write: %s", strerror(errno));
+  fprintf(f, "{\"format\": \"verdant-lstring\", \"version\": 1, \"modules\": [");
+  for (int64_t i = 0; i < s->n; i++) {
+    fputs(i ? ",\n[" : "\n[", f);
+    const char* name = vd_lsys_symbol_name(ls, s->sym[i]);
+    fputc('"', f);
+    for (const char* c = name; *c; c++) {
+      if (*c == '"' || *c == '\\') fputc('\\', f);
+      fputc(*c, f);
+    }
+    fputc('"', f);
+    for (int64_t k = s->par[i]; k < s->par[i + 1]; k++) {
+      double v = s->val[k];
+      const char* str = vd_lsys_value_str(ls, v);
+      if (str) {
+        fputs(", \"", f);
+        for (const char* c = str; *c; c++) {
+          if (*c == '"' || *c == '\\') fputc('\\', f);
+          if ((unsigned char)*c < 32) fprintf(f, "\\u%04x", (unsigned char)*c);
+          else fputc(*c, f);
+        }
+        fputc('"', f);
+      } else if (isfinite(v)) {
+        fprintf(f, ", %.17g", v);
+      } else {
+        fputs(", null", f);  // an object of the Python engine, or a non-finite number
+      }
+    }
+    fputc(']', f);
+  }
+  fputs("\n]}\n", f);
+  int bad = ferror(f);
+  if (fclose(f) != 0 || bad || rename(tmp, path) != 0) {
+    remove(tmp);
+    return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot write: %s", strerror(errno));
+  }
+  return VD_OK;
+}
+
 const char* cli_plant_help =
     "  -n, --steps N         derivation steps (default: the file's `derivation length`)\n"
     "      --seed S          random seed, as random.seed(S) before the axiom (default 0)\n"
@@ -111,6 +156,8 @@ const char* cli_plant_help =
     "      --max-ops N       interpreter work allowed: loop iterations + calls (default 1e9)\n"
     "      --engine E        who runs the file's Python: auto (default: native when the file\n"
     "                        stays in the native subset, else python), native, python\n"
+    "      --lstring FILE    .lpy files: also write the derived L-string (before interpretation)\n"
+    "                        as JSON: {\"modules\": [[\"A\", 1, 2], [\"[\"], ...]}\n"
     "      --curve-step M    curves files: dense sampling step (m; default 0.001)\n"
     "      --curve-connect M curves files: largest branch gap, sigma_connect (m; default 0.01)\n"
     "      --curve-distance M\n"
@@ -187,6 +234,11 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
       return -1;
     }
     o->max_modules = v;
+    return 1;
+  }
+  if (!strcmp(a, "--lstring")) {
+    CLI_TAKE();
+    o->lstring_out = val;
     return 1;
   }
   if (!strcmp(a, "--engine")) {
@@ -344,6 +396,7 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   double t0 = cli_now();
   if (!st) st = vd_lsys_derive(ls, &def, &derived, err);
   double t1 = cli_now();
+  if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
   if (!st) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
   if (!st) {
     vd_turtle_def td = vd_turtle_def_default();

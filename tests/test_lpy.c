@@ -7,11 +7,12 @@
 #include "test.h"
 #include "verdant/lsys.h"
 
-// parse (the native engine) and derive src (steps -1 = the file's), format the result into buf
-static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, vd_error* e) {
+// parse with an engine and derive src (steps -1 = the file's), format the result into buf
+static vd_status derive_engine(const char* src, vd_lsys_engine engine, int steps, char* buf, size_t cap,
+                               vd_error* e) {
   vd_lsystem* ls;
   buf[0] = 0;
-  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", VD_LSYS_NATIVE, &ls, e);
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", engine, &ls, e);
   if (st) return st;
   vd_lsys_def d = vd_lsys_def_default();
   d.steps = steps;
@@ -22,6 +23,11 @@ static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, 
   vd_lstring_free(&s);
   vd_lsys_destroy(ls);
   return st;
+}
+
+// the same with the native engine
+static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, vd_error* e) {
+  return derive_engine(src, VD_LSYS_NATIVE, steps, buf, cap, e);
 }
 
 #define DERIVES(src, steps, expected)                                                              \
@@ -255,4 +261,39 @@ TEST(lpy, nproduce_in_a_def) {
   DERIVES("def two(x):\n  nproduce B(x) B(x + 1)\ndef one():\n  produce C\n  nproduce D\n"
           "Axiom: A(1)\nproduction:\nA(x) :\n  two(x)\n  one()\n",
           1, "B(1)B(2)C");
+}
+
+TEST(lpy, absent_or_empty_axiom_and_spacing) {
+  // no Axiom: (a rule set) and an empty Axiom: give an empty string, as in L-Py
+  DERIVES("production:\nA --> B\n", 1, "");
+  DERIVES("Axiom:\nproduction:\nA --> B\n", 1, "");
+  // spaces between a module name and its parameters, in successors, patterns and declarations
+  DERIVES("module Leaf (a, b)\nAxiom: Leaf (1, 2) F (3)\nproduction:\nLeaf (a, b) --> Leaf (b, a)\n", 1,
+          "Leaf(2,1)F(3)");
+  // a non-ASCII character is one module; u'' strings are plain strings
+  DERIVES("Axiom: A(u'\xc3\xa9') \xc3\xa9\nproduction:\n\xc3\xa9 --> B\n", 1, "A('\xc3\xa9')B");
+}
+
+#define PY_DERIVES(src, steps, expected)                                                           \
+  do {                                                                                             \
+    char b_[4096];                                                                                 \
+    vd_error e_ = {0};                                                                             \
+    CHECK_STATUS(derive_engine(src, VD_LSYS_PYTHON, steps, b_, sizeof b_, &e_), VD_OK, e_);        \
+    CHECK_STR(b_, expected);                                                                       \
+  } while (0)
+
+TEST(lpy, argument_lists_in_patterns_python_engine) {
+  // *args, **kwds (the names of `module A(x, t)`, the last parameters) and x(...) variables
+  // bind lists and dicts, as L-Py's matching does; the native engine refuses them
+  PY_DERIVES("module A(x, t)\nAxiom: A(1, 2, 3) B\nproduction:\nA(*args, **kw) :\n"
+             "  assert args == [1] and kw == {'x': 2, 't': 3}\n  produce C(len(args))\n",
+             1, "C(1)B");
+  PY_DERIVES("module A(x, t)\nAxiom: A(1, 2)\nproduction:\n*(**kw) :\n  assert kw == {'name': 'A', 'x': 1, 't': 2}\n"
+             "  produce D\n",
+             1, "D");
+  PY_DERIVES("Axiom: A(5, 6)\nproduction:\n*(n, x, *rest) :\n  assert n == 'A' and x == 5 and rest == [6]\n"
+             "  produce E\n",
+             1, "E");
+  PY_DERIVES("Axiom: I(0) I(1) A\nproduction:\nx(I(t)) < A :\n  assert t == [0, 1]\n  produce B\n", 1, "I(0)I(1)B");
+  PY_DERIVES("Axiom: A I(0) I(1)\nproduction:\nA > x(I(t)) :\n  assert t == [0, 1]\n  produce B\n", 1, "BI(0)I(1)");
 }

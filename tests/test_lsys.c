@@ -350,7 +350,7 @@ typedef struct bad_case {
 
 static const bad_case bad_cases[] = {
     {"Axiom: A(\n", VD_ERR_SYNTAX, 1},                                   // unclosed bracket
-    {"production:\nA --> B\n", VD_ERR_SYNTAX, 2},                        // no axiom
+    {"# only a comment\n\n", VD_ERR_SYNTAX, 1},                          // nothing in the file
     {"Axiom: A\nproduction:\nA -> B\n", VD_ERR_SYNTAX, 3},               // wrong arrow
     {"Axiom: A\nproduction:\nA(x) :\nproduce B\n", VD_ERR_SYNTAX, 3},    // body not indented
     {"Axiom: A\nproduction:\nA :\n  if x\n    produce B\n", VD_ERR_SYNTAX, 4},  // missing ':'

@@ -49,7 +49,7 @@ static double delta_e(const double a[3], const double b[3]) {
 
 // smallest colour difference between two labels of a table in a palette
 static double palette_min_delta(const char* const* names, int n, vd_palette p) {
-  vd_label lab[16];
+  vd_label lab[16] = {{0}};
   float rgb[16][3];
   for (int i = 0; i < n; i++)
     vd_label_init(&lab[i], i + 1, names[i]);

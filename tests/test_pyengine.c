@@ -274,7 +274,7 @@ TEST(pyengine, errors_name_the_file_line) {
       {"import no_such_module_here\nAxiom: A\n", VD_ERR_UNSUPPORTED, 1},
       {"x = [1]\nAxiom: A\nproduction:\nA :\n    while True:\n        x.append(1)\n        x.pop()\n",
        VD_ERR_LIMIT, 0},
-      {"x = [1]\n", VD_ERR_SYNTAX, 1},
+      {"# nothing but a comment\n", VD_ERR_SYNTAX, 1},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     vd_lsystem* ls;

@@ -19,7 +19,9 @@ typedef enum vtype {
   V_BUILTIN,  // n = builtin id
   V_NS,       // n = namespace id (NS_MATH, NS_RANDOM)
   V_UNDEF,    // a global slot that has no value yet
-  V_OBJ       // n = a boxed Python object handle (the Python engine's object table)
+  V_OBJ,      // n = a boxed Python object handle (the Python engine's object table)
+  V_LIST,     // n = a list bound by the match of a rule (*args, x(...) variables): ls->mlist[n]
+  V_DICT      // n = a dict bound by the match (**kwds): ls->mlist[n], keys and values alternate
 } vtype;
 
 typedef struct value {
@@ -146,6 +148,8 @@ typedef struct pmod {
 
 // What a few pattern elements need beyond a module.
 typedef struct pext {
+  int args_slot;   // PK_MOD / PK_ANY: slot of a trailing `*args` (a list), -1 none
+  int kwds_slot;   // slot of a trailing `**kwds` (a dict of the declared parameter names), -1 none
   int has_name;    // PK_ANY: written with parameters, the first one is the module name
   int name_slot;   // PK_ANY: slot of the name, -1 when the name is a constant (name_val)
   value name_val;  // PK_ANY: constant name (a string)
@@ -284,6 +288,21 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int opt_module_matching;      // 0 simple, 1 with *args, 2 with value constraints (default)
   int opt_axiom_decomposition;  // 1: the axiom is decomposed before the first step
   int has_bases;                // a module declaration names base modules (inheritance)
+  // parameter names declared with `module A(x, t)` (**kwds patterns): symbol, names (string ids)
+  int npdecl, cappdecl;
+  struct pdecl {
+    int32_t sym;
+    int n;
+    int* name;  // string ids (arena)
+  }* pdecl;
+  // lists and dicts bound by one rule match (*args, **kwds, x(...) variables): valid while the
+  // rule runs; mlist[i] = the values mval[at .. at + n)
+  struct mlist {
+    int at, n;
+  }* mlist;
+  int nmlist, capmlist;
+  value* mval;
+  int nmval, capmval;
   // labels declared by the file
   int nlabel;
   int* label_id;
@@ -419,6 +438,9 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
                          int level, int* matched);
 // Free a run's scratch.
 void lsys_pass_free(lsys_pass* P);
+// A new list (or dict) of n values for the match being made: its id, -1 out of memory; its
+// values at ls->mval[ls->mlist[id].at] (to be filled).
+int lsys_mlist_new(vd_lsystem* ls, int n);
 // Run the turtle over s without keeping geometry, writing the turtle's position and frame into
 // the parameters of the query modules ?P ?H ?U ?L ?R of s.
 vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);

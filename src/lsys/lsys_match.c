@@ -136,14 +136,118 @@ static int bind_params(const pmod* p, const double* val, int np, value* frame) {
   return 1;
 }
 
+// a list of module parameters (prepended with a name when name >= 0); -1 out of memory
+static value param_list(vd_lsystem* ls, int name, const double* val, int n) {
+  int id = lsys_mlist_new(ls, n + (name >= 0));
+  if (id < 0) return (value){V_UNDEF, 0};
+  value* o = ls->mval + ls->mlist[id].at;
+  if (name >= 0) *o++ = (value){V_STR, name};
+  for (int k = 0; k < n; k++) o[k] = param_to_value(val[k]);
+  return (value){V_LIST, id};
+}
+
+// the declared parameter names of a symbol (module A(x, t)); count in *n
+static const int* declared_names(const vd_lsystem* ls, int32_t sym, int* n) {
+  for (int i = 0; i < ls->npdecl; i++)
+    if (ls->pdecl[i].sym == sym) {
+      *n = ls->pdecl[i].n;
+      return ls->pdecl[i].name;
+    }
+  *n = 0;
+  return NULL;
+}
+
+// L-Py's named parameters from index start: name i is the parameter max(0, np - nnamed) + i;
+// with name >= 0 the dict also holds 'name'
+static value named_dict(vd_lsystem* ls, int32_t sym, int name, const double* val, int np, int start) {
+  int nn;
+  const int* names = declared_names(ls, sym, &nn);
+  int first = np - nn > 0 ? np - nn : 0, count = 0;
+  for (int i = start; i < nn; i++) count += first + i < np;
+  int key_name = -1;
+  if (name >= 0 && (key_name = str_intern(ls, "name", 4)) < 0) return (value){V_UNDEF, 0};
+  int id = lsys_mlist_new(ls, 2 * (count + (name >= 0)));
+  if (id < 0) return (value){V_UNDEF, 0};
+  value* o = ls->mval + ls->mlist[id].at;
+  if (name >= 0) {
+    *o++ = (value){V_STR, key_name};
+    *o++ = (value){V_STR, name};
+  }
+  for (int i = start; i < nn; i++)
+    if (first + i < np) {
+      *o++ = (value){V_STR, names[i]};
+      *o++ = param_to_value(val[first + i]);
+    }
+  return (value){V_DICT, id};
+}
+
+// a pattern module with *args and/or **kwds (the Python engine): L-Py's module matching with
+// the any-module and argument lists (openalea/lpy matching.cpp, with value constraints)
+static int bind_lists(const mstate* S, const pmod* p, int32_t sym, int name, const double* val, int np) {
+  vd_lsystem* ls = S->ls;
+  const pext* x = p->x;
+  int hasA = x->args_slot >= 0, hasK = x->kwds_slot >= 0, star = p->kind == PK_ANY;
+  int hasN = star && x->has_name;
+  int P = hasN + p->nparam + hasA + hasK;
+  int nn;
+  declared_names(ls, sym, &nn);
+  value A = {V_UNDEF, 0}, K = {V_UNDEF, 0};
+  if (!star && np + 2 < P) return 0;
+  if (star && np + 3 < P) return 0;
+  if (P == 1) {
+    if (hasA) A = param_list(ls, star ? name : -1, val, np);
+    else if (nn != np) return 0;
+    else K = named_dict(ls, sym, star ? name : -1, val, np, 0);
+  } else if (P == 2 && hasA && hasK && !hasN) {
+    if (nn > np) return 0;
+    A = param_list(ls, -1, val, np - nn);
+    K = named_dict(ls, sym, star ? name : -1, val, np, 0);
+  } else {
+    int normal = p->nparam;
+    if (normal > np) return 0;
+    if (hasN) {
+      if (x->name_slot >= 0) S->frame[x->name_slot] = (value){V_STR, name};
+      else if ((int)x->name_val.n != name) return 0;
+    }
+    for (int k = 0; k < normal; k++) {
+      if (p->slot[k] >= 0) {
+        S->frame[p->slot[k]] = param_to_value(val[k]);
+      } else {
+        value c = p->cval[k];
+        if (c.t == V_STR ? lsys_unbox_str(val[k]) != (int)c.n : !(v_isnum(c) && val[k] == c.n)) return 0;
+      }
+    }
+    if (hasA) {
+      if (star && normal == 0 && !hasK) {
+        A = param_list(ls, -1, val, np);
+      } else {
+        int last = np;
+        if (hasK) last = normal > np - nn ? normal : np - nn;
+        A = param_list(ls, -1, val + normal, last > normal ? last - normal : 0);
+      }
+    }
+    if (hasK) {
+      if (!hasA && nn + normal < np) return 0;
+      int unnamed = np - nn > 0 ? np - nn : 0;
+      int start = normal - unnamed > 0 ? normal - unnamed : 0;
+      K = named_dict(ls, sym, -1, val, np, start);
+    }
+  }
+  if ((hasA && A.t == V_UNDEF) || (hasK && K.t == V_UNDEF)) return 0;  // out of memory: no match
+  if (hasA) S->frame[x->args_slot] = A;
+  if (hasK) S->frame[x->kwds_slot] = K;
+  return 1;
+}
+
 static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k) {
   int64_t j = at(v, k);
   const vd_lstring* s = v->s;
   int np = (int)(s->par[j + 1] - s->par[j]);
   const double* val = s->val + s->par[j];
+  int lists = p->x && (p->x->args_slot >= 0 || p->x->kwds_slot >= 0);
   if (p->kind == PK_MOD) {
     if (s->sym[j] != p->sym) return 0;
-    return bind_params(p, val, np, S->frame);
+    return lists ? bind_lists(S, p, s->sym[j], -1, val, np) : bind_params(p, val, np, S->frame);
   }
   if (p->kind != PK_ANY) return 0;
   if (!p->x) return 1;
@@ -151,6 +255,7 @@ static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k
   const char* name = vd_lsys_symbol_name(S->ls, s->sym[j]);
   int id = str_intern(S->ls, name, (int)strlen(name));
   if (id < 0) return 0;
+  if (lists) return bind_lists(S, p, s->sym[j], id, val, np);
   if (p->x->name_slot >= 0) S->frame[p->x->name_slot] = (value){V_STR, id};
   else if ((int)p->x->name_val.n != id) return 0;
   return bind_params(p, val, np, S->frame);
@@ -170,6 +275,54 @@ static void set_none(const pstr* p, value* frame) {
 
 static int is_re(const pmod* m) { return m->kind == PK_REP || m->kind == PK_OR; }
 
+// the variable slots of a pattern, in order (at most cap); their count
+static int pattern_vars(const pstr* p, int* slots, int n, int cap) {
+  for (int i = 0; i < p->n; i++) {
+    const pmod* m = &p->m[i];
+    if (m->x && m->x->has_name && m->x->name_slot >= 0 && n < cap) slots[n++] = m->x->name_slot;
+    for (int k = 0; k < m->nparam; k++)
+      if (m->slot && m->slot[k] >= 0 && n < cap) slots[n++] = m->slot[k];
+    if (m->x && m->x->args_slot >= 0 && n < cap) slots[n++] = m->x->args_slot;
+    if (m->x && m->x->kwds_slot >= 0 && n < cap) slots[n++] = m->x->kwds_slot;
+    for (int a = 0; m->x && a < m->x->nsub; a++) n = pattern_vars(&m->x->sub[a], slots, n, cap);
+  }
+  return n;
+}
+
+// what the variables of a repetition took at each iteration (L-Py binds each to a list)
+typedef struct rep_acc {
+  int slots[32];
+  int nv;           // variables
+  value* v;         // nv values per iteration (cap values)
+  int n, cap;       // values stored, capacity
+} rep_acc;
+
+static int rep_take(rep_acc* A, const value* frame) {
+  if (!A->nv) return 1;
+  if (!vd_grow((void**)&A->v, &A->cap, A->n + A->nv, sizeof(value))) return 0;
+  for (int k = 0; k < A->nv; k++) A->v[A->n++] = frame[A->slots[k]];
+  return 1;
+}
+
+// bind each variable to the list of its values (in string order: reversed when the
+// repetition walked to the left); frees the accumulator; 0 out of memory
+static int rep_bind(vd_lsystem* ls, rep_acc* A, value* frame, int reversed) {
+  int ok = 1;
+  int iters = A->nv ? A->n / A->nv : 0;
+  for (int k = 0; k < A->nv && ok; k++) {
+    int id = lsys_mlist_new(ls, iters);
+    if (id < 0) {
+      ok = 0;
+      break;
+    }
+    value* o = ls->mval + ls->mlist[id].at;
+    for (int it = 0; it < iters; it++) o[it] = A->v[(reversed ? iters - 1 - it : it) * A->nv + k];
+    frame[A->slots[k]] = (value){V_LIST, id};
+  }
+  vd_free(A->v, sizeof(value) * (size_t)A->cap);
+  return ok;
+}
+
 // ---------------------------------------------------------------------------------------------
 // left contexts: L-Py's TreeLeftMatcher (and its string form)
 
@@ -182,13 +335,16 @@ static int left_re(const mstate* S, const view* v, int64_t pos, const pmod* m, i
   int64_t it = pos;
   if (m->kind == PK_REP) {
     int num = 0;
+    rep_acc A = {{0}, 0, NULL, 0, 0};
+    A.nv = pattern_vars(&x->sub[0], A.slots, 0, 32);
     while (num < x->rmax) {
       int64_t e;
       if (!left_match(S, v, it, &x->sub[0], x->sub[0].n - 1, &e, string_mode)) break;
+      if (!rep_take(&A, S->frame)) break;
       it = e;
       num++;
     }
-    if (num < x->rmin) return 0;
+    if (!rep_bind(S->ls, &A, S->frame, 1) || num < x->rmin) return 0;
   } else {
     int matched = -1;
     for (int a = 0; a < x->nsub && matched < 0; a++) {
@@ -218,8 +374,16 @@ static int left_match(const mstate* S, const view* v, int64_t start, const pstr*
     it = it <= 0 ? NONE : it - 1;
     for (int i = from; i >= 0; i--) {
       const pmod* m = &p->m[i];
-      if (m->kind == PK_NONE) continue;
-      if (it == NONE) return 0;
+      if (it == NONE) {
+        // nothing left: only None and repetitions that may match nothing (L-Py)
+        if (m->kind == PK_NONE) continue;
+        if (is_re(m)) {
+          int64_t e;
+          if (!left_re(S, v, 0, m, &e, string_mode)) return 0;
+          continue;
+        }
+        return 0;
+      }
       if (is_re(m)) {
         int64_t e;
         if (!left_re(S, v, it + 1, m, &e, string_mode)) return 0;
@@ -275,15 +439,18 @@ static int right_re(const mstate* S, const view* v, int64_t pos, int64_t* last, 
   int64_t it = pos, lm = *last;
   if (m->kind == PK_REP) {
     int num = 0;
+    rep_acc A = {{0}, 0, NULL, 0, 0};
+    A.nv = pattern_vars(&x->sub[0], A.slots, 0, 32);
     while (num < x->rmax) {
       int64_t e, l2 = lm;
       if (!right_match(S, v, it, &l2, &x->sub[0], 0, x->sub[0].n, &e, string_mode)) break;
+      if (!rep_take(&A, S->frame)) break;
       // the sub-match ends on its last matched module: continue after it
       lm = e;
       it = e + 1;
       num++;
     }
-    if (num < x->rmin) return 0;
+    if (!rep_bind(S->ls, &A, S->frame, 0) || num < x->rmin) return 0;
   } else {
     int matched = -1;
     for (int a = 0; a < x->nsub && matched < 0; a++) {
@@ -336,7 +503,6 @@ static int right_match(const mstate* S, const view* v, int64_t start, int64_t* l
     for (; i < to; i++) {
       const pmod* m = &p->m[i];
       if (it >= v->n) return 0;
-      if (m->kind == PK_NONE) continue;
       if (is_re(m)) {
         int64_t e;
         if (!right_re(S, v, it, &lm, m, &e, string_mode)) return 0;
@@ -427,6 +593,7 @@ static int pred_backward(const mstate* S, const view* v, int64_t i, const pstr* 
 
 int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end) {
   mstate S = {M->ls, frame};
+  M->ls->nmlist = M->ls->nmval = 0;  // lists bound by an earlier attempt are no longer referenced
   const unsigned char* ign = M->ignored[r->filter + 1];
   view src = {M->src, M->src->n, 0, M->match, ign, M->nsym};
   int64_t b, e;

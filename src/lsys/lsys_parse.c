@@ -349,7 +349,11 @@ static vd_status lx_next(lexer* L) {
   if (isalpha((unsigned char)c) || c == '_') {
     int p = L->pos;
     while (p < L->len && (isalnum((unsigned char)s[p]) || s[p] == '_')) p++;
-    // string prefixes r'', b'', f'' are not supported
+    // string prefixes r'', b'', f'' are not supported (u'' is a plain string in Python 3)
+    if (p == L->pos + 1 && (c == 'u' || c == 'U') && p < L->len && (s[p] == '\'' || s[p] == '"')) {
+      L->pos = p;
+      return lx_next(L);
+    }
     if (p < L->len && (s[p] == '\'' || s[p] == '"') && p - L->pos <= 2)
       return perr(L->ls, VD_ERR_UNSUPPORTED, L->lineno, L->col0 + L->pos,
                   "unsupported: prefixed string literal");
@@ -918,13 +922,22 @@ static int read_module_name(vd_lsystem* ls, const char* s, int len, int* pos, in
     perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unexpected '%c' where a module name was expected", c);
     return -1;
   }
-  if ((unsigned char)c < 32 || (unsigned char)c >= 127) {
-    perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unexpected character (byte 0x%02x) in an L-string",
-         (unsigned char)c);
+  // a non-ASCII character (UTF-8, as Python 3 reads the file) is one module, like an ASCII one
+  int clen = 1;
+  unsigned char u = (unsigned char)c;
+  if (u >= 0xC2 && u <= 0xF4) {
+    clen = u >= 0xF0 ? 4 : u >= 0xE0 ? 3 : 2;
+    for (int k = 1; k < clen; k++)
+      if (p + k >= len || ((unsigned char)s[p + k] & 0xC0) != 0x80) clen = 0;
+  } else if (u < 32 || u >= 127) {
+    clen = 0;
+  }
+  if (!clen) {
+    perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unexpected character (byte 0x%02x) in an L-string", u);
     return -1;
   }
-  int id = sym_intern(ls, s + p, 1, 0);
-  *pos = p + 1;
+  int id = sym_intern(ls, s + p, clen, 0);
+  *pos = p + clen;
   if (id < 0) perr(ls, VD_ERR_NOMEM, lineno, col0 + p, "out of memory");
   return id;
 }
@@ -963,6 +976,12 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     m->line = lineno;
     m->col = mcol;
     if (sym == VD_SYM_CUT) t->has_cut = 1;
+    {
+      // L-Py allows spaces between a module's name and its parameters: `MyGC (a, b)`
+      int q = pos;
+      while (q < len && is_space(s[q])) q++;
+      if (q < len && s[q] == '(') pos = q;
+    }
     if (pos < len && s[pos] == '(' && ls->engine == VD_LSYS_PYTHON) {
       // the Python engine: parameters stay Python source for CPython
       expr* params[64];
@@ -1122,8 +1141,49 @@ static int parse_pattern_params(vd_lsystem* ls, scope* sc, const char* s, int p,
       return 0;
     }
     if (tok_is(&L, '*') || tok_is(&L, OP_POW)) {
-      perr(ls, VD_ERR_UNSUPPORTED, lineno, lx_col(&L), "unsupported: '%s' pattern parameter (binds a %s)",
-           tok_is(&L, '*') ? "*args" : "**kwds", tok_is(&L, '*') ? "list" : "dict");
+      int kw = tok_is(&L, OP_POW), scol = lx_col(&L);
+      if (ls->engine != VD_LSYS_PYTHON) {
+        perr(ls, VD_ERR_UNSUPPORTED, lineno, scol, "unsupported: '%s' pattern parameter (binds a %s)",
+             kw ? "**kwds" : "*args", kw ? "dict" : "list");
+        return 0;
+      }
+      // the Python engine: *args (a list) then **kwds (a dict), at the end
+      if (lx_next(&L)) return 0;
+      if (L.t != T_NAME) {
+        perr(ls, VD_ERR_SYNTAX, lineno, lx_col(&L), "expected a name after '%s'", kw ? "**" : "*");
+        return 0;
+      }
+      if (!m->x) {
+        if (!(m->x = aalloc(ls, sizeof(pext)))) {
+          perr(ls, VD_ERR_NOMEM, lineno, scol, "out of memory");
+          return 0;
+        }
+        m->x->args_slot = m->x->kwds_slot = -1;
+      }
+      if (m->x->kwds_slot >= 0 || (!kw && m->x->args_slot >= 0)) {
+        perr(ls, VD_ERR_SYNTAX, lineno, scol, "'*args' and '**kwds' come last, in this order");
+        return 0;
+      }
+      int sl = scope_add(ls, sc, L.s + L.start, L.tlen);
+      if (sl < 0) {
+        perr(ls, VD_ERR_NOMEM, lineno, scol, "out of memory");
+        return 0;
+      }
+      if (kw) m->x->kwds_slot = sl;
+      else m->x->args_slot = sl;
+      if (lx_next(&L)) return 0;
+      if (tok_is(&L, ',')) {
+        if (lx_next(&L)) return 0;
+      } else if (!tok_is(&L, ')')) {
+        char bb[64];
+        perr(ls, VD_ERR_SYNTAX, lineno, lx_col(&L), "expected ',' or ')' in a pattern, found %s",
+             tok_desc(&L, bb, sizeof bb));
+        return 0;
+      }
+      continue;
+    }
+    if (m->x && (m->x->args_slot >= 0 || m->x->kwds_slot >= 0)) {
+      perr(ls, VD_ERR_SYNTAX, lineno, lx_col(&L), "'*args' and '**kwds' come last, in this order");
       return 0;
     }
     if (L.t == T_NAME && !tok_name(&L, "True") && !tok_name(&L, "False") && !tok_name(&L, "None")) {
@@ -1186,6 +1246,7 @@ static int parse_pattern_re(vd_lsystem* ls, scope* sc, const char* s, int p, int
     perr(ls, VD_ERR_NOMEM, lineno, col0 + p, "out of memory");
     return 0;
   }
+  x->args_slot = x->kwds_slot = -1;
   int nargs = 0, starts[64] = {0}, ends[64] = {0};
   for (int q = p + 1; q <= close && nargs < 64;) {
     int c = next_comma(s, q, close);
@@ -1220,7 +1281,7 @@ static int parse_pattern_re(vd_lsystem* ls, scope* sc, const char* s, int p, int
       perr(ls, VD_ERR_SYNTAX, lineno, col0 + starts[k], "empty pattern in %s(...)", m->kind == PK_REP ? "x" : "or");
       return 0;
     }
-    if (m->kind == PK_REP && sc->n > before) {
+    if (m->kind == PK_REP && sc->n > before && ls->engine != VD_LSYS_PYTHON) {
       perr(ls, VD_ERR_UNSUPPORTED, lineno, col0 + starts[k],
            "unsupported: variables inside x(...) (they bind lists)");
       return 0;
@@ -1279,14 +1340,21 @@ static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, in
         // *(name, x, y): the name first, then the parameters
         int after;
         if (!parse_pattern_params(ls, sc, s, pos, b, lineno, col0, m, &after)) return 0;
+        if (m->x && m->nparam == 0) {
+          pos = after;  // *(*args), *(**kwds), *(*args, **kwds): the name goes in the list / dict
+          continue;
+        }
         if (m->nparam == 0) {
           perr(ls, VD_ERR_SYNTAX, lineno, m->col, "'*()' needs at least the module name");
           return 0;
         }
-        m->x = aalloc(ls, sizeof(pext));
         if (!m->x) {
-          perr(ls, VD_ERR_NOMEM, lineno, m->col, "out of memory");
-          return 0;
+          m->x = aalloc(ls, sizeof(pext));
+          if (!m->x) {
+            perr(ls, VD_ERR_NOMEM, lineno, m->col, "out of memory");
+            return 0;
+          }
+          m->x->args_slot = m->x->kwds_slot = -1;
         }
         m->x->has_name = 1;
         m->x->name_slot = m->slot[0];
@@ -1303,7 +1371,7 @@ static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, in
       continue;
     }
     if (s[pos] == 'N' && b - pos >= 4 && memcmp(s + pos, "None", 4) == 0 &&
-        (pos + 4 == b || !(isalnum((unsigned char)s[pos + 4]) || s[pos + 4] == '_')) && depth > 0) {
+        (pos + 4 == b || !(isalnum((unsigned char)s[pos + 4]) || s[pos + 4] == '_'))) {
       m->kind = PK_NONE;
       pos += 4;
       continue;
@@ -1331,6 +1399,11 @@ static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, in
     }
     m->kind = PK_MOD;
     m->sym = sym;
+    {
+      int q = pos;  // `A (x)`: spaces before the parameters, as in L-Py
+      while (q < b && is_space(s[q])) q++;
+      if (q < b && s[q] == '(') pos = q;
+    }
     if (pos < b && s[pos] == '(') {
       if (!parse_pattern_params(ls, sc, s, pos, b, lineno, col0, m, &par)) return 0;
       pos = par;
@@ -1890,8 +1963,13 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
     int a = p;
     while (p < ln->len && !is_space(s[p]) && s[p] != ',' && s[p] != '(' && s[p] != ':' && s[p] != '#') p++;
     if (p == a) return perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + p, "expected a module name");
-    if (sym_intern(ls, s + a, p - a, 1) < 0) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+    int sym = sym_intern(ls, s + a, p - a, 1);
+    if (sym < 0) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+    while (p < ln->len && is_space(s[p]) && p + 1 < ln->len && (is_space(s[p + 1]) || s[p + 1] == '(')) p++;
+    if (p < ln->len && is_space(s[p]) && p + 1 < ln->len && s[p + 1] == '(') p++;
     if (p < ln->len && s[p] == '(') {
+      // parameter names (for **kwds patterns): names separated by commas
+      int names[64], nn = 0, open = p;
       int depth = 0;
       while (p < ln->len) {
         if (s[p] == '(') depth++;
@@ -1899,6 +1977,26 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
         p++;
       }
       if (p >= ln->len) return perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + a, "unclosed '(' in module declaration");
+      for (int q = open + 1; q < p && nn < 64;) {
+        while (q < p && (is_space(s[q]) || s[q] == ',')) q++;
+        int n0 = q;
+        while (q < p && (isalnum((unsigned char)s[q]) || s[q] == '_')) q++;
+        if (q == n0) break;
+        int id = str_intern(ls, s + n0, q - n0);
+        if (id < 0) return str_intern_error(ls, id, ln->lineno, ln->col0 + n0);
+        names[nn++] = id;
+        while (q < p && s[q] != ',') q++;
+      }
+      if (nn) {
+        if (!vd_grow((void**)&ls->pdecl, &ls->cappdecl, ls->npdecl + 1, sizeof(struct pdecl)))
+          return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+        struct pdecl* d = &ls->pdecl[ls->npdecl++];
+        d->sym = sym;
+        d->n = nn;
+        d->name = aalloc(ls, sizeof(int) * (size_t)nn);
+        if (!d->name) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+        memcpy(d->name, names, sizeof(int) * (size_t)nn);
+      }
       p++;
     }
     while (p < ln->len && is_space(s[p])) p++;
@@ -2556,8 +2654,12 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
         int j = li + 1;
         while (j < P.nline && P.lines[j].blank) j++;
         if (j >= P.nline || P.lines[j].indent <= ln->indent) {
-          st = perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + a, "expected an axiom after 'Axiom:'");
-          goto done;
+          // an empty axiom (L-Py accepts it: the derivation has nothing to rewrite)
+          ls->axiom = lsys_parse_tmpl_text(ls, "", 0, ln->lineno, ln->col0 + a);
+          if (!ls->axiom) goto fail;
+          li++;
+          section = -1;
+          continue;
         }
         scope sc;
         memset(&sc, 0, sizeof sc);
@@ -2669,6 +2771,16 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
     }
     if ((st = parse_toplevel_stmt(&P, &li))) goto done;
   }
+  {
+    // a file with nothing in it is not an L-system (without an Axiom:, a file of rules or of
+    // Python code is: its string is empty, as in L-Py)
+    int content = 0;
+    for (int k = 0; k < P.nline && !content; k++) content = !P.lines[k].blank;
+    if (!content) {
+      st = perr(ls, VD_ERR_SYNTAX, 1, 1, "the file is empty (no Axiom:, no rules, no code)");
+      goto done;
+    }
+  }
   if (ls->engine == VD_LSYS_PYTHON) {
     // the trailer runs as Python; its L-system options (matching, early return) apply here too
     if (init_at < len) {
@@ -2680,8 +2792,9 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
     goto done;
   }
   if (!ls->axiom && !ls->axiom_body) {
-    st = perr(ls, VD_ERR_SYNTAX, P.nline ? P.lines[P.nline - 1].lineno : 1, 1, "the file has no 'Axiom:'");
-    goto done;
+    // no Axiom: an empty string (L-Py's default: a rule set for composition, or Python code alone)
+    ls->axiom = lsys_parse_tmpl_text(ls, "", 0, 1, 1);
+    if (!ls->axiom) goto fail;
   }
   if (init_at < len) {
     int line0 = 1;

@@ -441,6 +441,27 @@ static PyObject* value_object(vd_lsystem* ls, value v) {
       }
       return py_none();
     }
+    case V_LIST:
+    case V_DICT: {
+      // *args, **kwds and x(...) variables bound by the rule's match (lsys_match.c)
+      const struct mlist* l = &ls->mlist[(int)v.n];
+      PyObject* o = v.t == V_LIST ? PyList_New(l->n) : PyDict_New();
+      for (int k = 0; o && k < l->n; k += v.t == V_LIST ? 1 : 2) {
+        PyObject* a = value_object(ls, ls->mval[l->at + k]);
+        PyObject* b = v.t == V_DICT && a ? value_object(ls, ls->mval[l->at + k + 1]) : NULL;
+        if (!a || (v.t == V_DICT && (!b || PyDict_SetItem(o, a, b) < 0))) {
+          Py_XDECREF(a);
+          Py_XDECREF(b);
+          Py_CLEAR(o);
+        } else if (v.t == V_LIST) {
+          PyList_SET_ITEM(o, k, a);
+        } else {
+          Py_DECREF(a);
+          Py_DECREF(b);
+        }
+      }
+      return o;
+    }
     default: return py_none();
   }
 }
@@ -817,6 +838,37 @@ static PyObject* vd_stop(PyObject* self, PyObject* noarg) {
   return py_none();
 }
 
+// backward() / forward(): the direction of the next steps (the derivation loop reads it)
+static PyObject* vd_set_backward(PyObject* self, PyObject* arg) {
+  (void)self;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  int b = PyObject_IsTrue(arg);
+  if (b < 0) return NULL;
+  ls->backward = b;
+  return py_none();
+}
+
+static PyObject* vd_is_backward(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  return ls ? PyBool_FromLong(ls->backward) : NULL;
+}
+
+// isFrameDisplayed(): the step is the last one
+static PyObject* vd_frame_displayed(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  return ls ? PyBool_FromLong(ls->frame_displayed) : NULL;
+}
+
+// the 'Module matching' option (PatternModule.matchingMethod)
+static PyObject* vd_module_matching(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  return ls ? PyLong_FromLong(ls->opt_module_matching) : NULL;
+}
+
 static PyObject* vd_log_text(PyObject* self, PyObject* arg) {
   (void)self;
   const char* s = PyUnicode_AsUTF8(arg);
@@ -835,6 +887,10 @@ static PyMethodDef vd_methods[] = {
     {"iteration", vd_iteration, METH_NOARGS, "getIterationNb"},
     {"stop", vd_stop, METH_NOARGS, "Stop"},
     {"log", vd_log_text, METH_O, "a line to verdant's log"},
+    {"set_backward", vd_set_backward, METH_O, "backward() / forward()"},
+    {"is_backward", vd_is_backward, METH_NOARGS, "not isForward()"},
+    {"frame_displayed", vd_frame_displayed, METH_NOARGS, "isFrameDisplayed"},
+    {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef vd_module_def = {PyModuleDef_HEAD_INIT, "_verdant_lsys", "verdant's L-system engine", -1,

@@ -646,11 +646,8 @@ vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno) {
 
 vd_status lsys_py_parse_end(vd_lsystem* ls, size_t init_at) {
   lsys_py* py = ls->py;
-  if (!py->has_axiom) {
-    int last = py->nphys;
-    while (last > 1 && py->phys_at[last - 1] >= init_at) last--;
-    return vm_error(ls, VD_ERR_SYNTAX, last, 1, "the file has no 'Axiom:'");
-  }
+  // no Axiom: the string is empty (L-Py: a rule set, or Python code alone); the derivation then
+  // returns at once
   if (init_at < py->len) {
     // the trailer, from the marker line on
     int line = 1;

@@ -28,7 +28,7 @@ static int rule_is_simple(const rule* r) {
   for (int p = 0; p < 3; p++)
     for (int k = 0; k < parts[p]->n; k++) {
       const pmod* m = &parts[p]->m[k];
-      if (m->kind != PK_MOD || m->exact) return 0;
+      if (m->kind != PK_MOD || m->exact || m->x) return 0;
       if (p < 2 && (m->sym == VD_SYM_SB || m->sym == VD_SYM_EB)) return 0;
     }
   return 1;
@@ -437,6 +437,19 @@ static inline __attribute__((always_inline)) int apply_try(vd_lsystem* ls, const
     }
   }
   return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// lists bound by a match
+
+int lsys_mlist_new(vd_lsystem* ls, int n) {
+  if (!vd_grow((void**)&ls->mlist, &ls->capmlist, ls->nmlist + 1, sizeof(struct mlist)) ||
+      !vd_grow((void**)&ls->mval, &ls->capmval, ls->nmval + n, sizeof(value)))
+    return -1;
+  ls->mlist[ls->nmlist].at = ls->nmval;
+  ls->mlist[ls->nmlist].n = n;
+  ls->nmval += n;
+  return ls->nmlist++;
 }
 
 // ---------------------------------------------------------------------------------------------

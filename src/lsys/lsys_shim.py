@@ -433,23 +433,76 @@ def Stop():
     _vd.stop()
 
 
-_direction = {"forward": True}
-
-
 def forward():
-    _direction["forward"] = True
+    """Derive left to right from the next step on (the default)."""
+    _vd.set_backward(False)
 
 
 def backward():
-    _direction["forward"] = False
+    """Derive right to left from the next step on (new right contexts >> apply)."""
+    _vd.set_backward(True)
 
 
 def isForward():
-    return _direction["forward"]
+    return not _vd.is_backward()
 
 
 def frameDisplay(enabled=True):
     """Display only: nothing to do without a viewer."""
+
+
+def isFrameDisplayed():
+    """True during the last step (L-Py computes a scene for the hooks then)."""
+    return _vd.frame_displayed()
+
+
+def isAnimationEnabled():
+    """No animation runs in verdant."""
+    return False
+
+
+class _PatternModuleType(type):
+    @property
+    def matchingMethod(cls):
+        return _vd.module_matching()
+
+
+class PatternModule(metaclass=_PatternModuleType):
+    """The 'Module matching' option's values, and the one in force (matchingMethod)."""
+    eSimple, eWithStar, eWithStarNValueConstraint = 0, 1, 2
+    eDefaultModuleMatching = 2
+
+
+# L-Py's __lpyfuture__: DiscardNewString() drops the result of the step where it is called
+# (the string of the step before is kept); it acts through an EndEach wrapped by
+# enable_string_discard, or the module's own EndEach when the file defines none
+_future = {"discard": False, "last": None}
+
+
+def DiscardNewString():
+    _future["discard"] = True
+
+
+def enable_string_discard(endeach):
+    nargs = endeach.__code__.co_argcount
+
+    def step_end(lstring, *more):
+        res = None
+        if not _future["discard"]:
+            res = endeach(lstring, *more) if nargs else endeach()
+        if _future["discard"]:
+            _future["discard"] = False
+            return _future["last"]
+        _future["last"] = Lstring(lstring)
+        return res
+
+    if nargs >= 2:
+        return lambda lstring, lscene: step_end(lstring, lscene)
+    return lambda lstring: step_end(lstring)
+
+
+def _future_endeach():
+    pass
 
 
 def nsproduce(lstring):
@@ -1766,7 +1819,7 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
-        "nsproduce", "extern", "context"]
+        "nsproduce", "extern", "context", "isFrameDisplayed", "isAnimationEnabled", "PatternModule"]
 
 _pgl_math = _module("openalea.plantgl.math", _MATH)
 _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
@@ -1774,10 +1827,14 @@ _pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH)
 _pgl = _module("openalea.plantgl", [])
 _pgl.all, _pgl.math, _pgl.scenegraph = _pgl_all, _pgl_math, _pgl_sg
 _lpy = _module("openalea.lpy", _LPY)
+_lpyfuture = _module("openalea.lpy.__lpyfuture__", ["DiscardNewString", "enable_string_discard"])
+_lpyfuture.EndEach = enable_string_discard(_future_endeach)
+_lpy.__lpyfuture__ = _lpyfuture
 _openalea = _module("openalea", [])
 _openalea.plantgl, _openalea.lpy = _pgl, _lpy
 OPENALEA = {"openalea": _openalea, "openalea.plantgl": _pgl, "openalea.plantgl.all": _pgl_all,
-            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy}
+            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy,
+            "openalea.lpy.__lpyfuture__": _lpyfuture}
 
 _BUILTINS = dict(_builtins.__dict__)
 _BUILTINS["__import__"] = _vd_import
