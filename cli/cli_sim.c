@@ -25,6 +25,8 @@ static const char* sim_help =
     "      --duration T        simulated time (s); default 1, or 0 after --settle/--statics\n"
     "      --dt H              time step (s), default 0.001\n"
     "      --iterations N      Newton iterations (direct) or sweeps (gs) per step, default 1\n"
+    "      --threads N         threads for one plant's step (default 1): the direct solver's\n"
+    "                          subtrees; the same bytes for any N\n"
     "      --solver S          direct (exact tree solve, default) or gs (XPBD Gauss-Seidel)\n"
     "      --settle            first run damped dynamics until the plant is still\n"
     "      --statics           first solve the static equilibrium directly\n"
@@ -77,7 +79,10 @@ static const char* sim_help_output =
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
-    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n";
+    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n"
+    "      --profile           time each stage of the steps and the frame output; --stats then\n"
+    "                          has stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
+    "                          project, velocity, fracture, frames)\n";
 
 // a closed triangle mesh from a Wavefront OBJ file: "v x y z" and "f i j k ..." lines (1-based
 // or negative indices, "i/t/n" forms, polygons split in fans); other lines are skipped
@@ -234,7 +239,7 @@ typedef struct sim_opts {
   const char* out;
   double duration;
   int duration_set;
-  int settle, statics, stats;
+  int settle, statics, stats, profile;
   double ke_tol;
   const char* frames;
   double fps;
@@ -366,7 +371,7 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
 // the summary
 
 static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant, double wall, int64_t steps,
-                       int settled, int settle_steps) {
+                       int settled, int settle_steps, double frames_s) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return 0;
   int node;
@@ -410,6 +415,12 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON* wk = cJSON_AddObjectToObject(root, "warning_counts");
   for (int k = 0; k < VD_SIM_WARN_COUNT; k++)
     cJSON_AddNumberToObject(wk, vd_sim_warning_name((vd_sim_warning)k), (double)d->warning[k]);
+  if (d->profile) {
+    cJSON* sg = cJSON_AddObjectToObject(root, "stage_seconds");
+    for (int k = 0; k < VD_SIM_STAGE_COUNT; k++)
+      cJSON_AddNumberToObject(sg, vd_sim_stage_name((vd_sim_stage)k), d->stage_seconds[k]);
+    cJSON_AddNumberToObject(sg, "frames", frames_s);
+  }
   char* text = cJSON_Print(root);
   cJSON_Delete(root);
   if (!text) return 0;
@@ -461,6 +472,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->opt.dt, x_ > 0 && x_ <= 1, "a time step in (0, 1] (s)");
     } else if (!strcmp(a, "--iterations")) {
       NUM(o->opt.iterations, x_ >= 1 && x_ <= 10000 && x_ == floor(x_), "an integer in 1..10000");
+    } else if (!strcmp(a, "--threads")) {
+      NUM(o->opt.threads, x_ >= 1 && x_ <= 64 && x_ == floor(x_), "an integer in 1..64");
     } else if (!strcmp(a, "--solver")) {
       VAL();
       if (!strcmp(val, "direct")) o->opt.solver = VD_SIM_DIRECT;
@@ -582,6 +595,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      o->profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error(cmd, "unknown option '%s'", a);
     } else if (!o->po.path) {
@@ -685,7 +700,10 @@ int cli_sim(int argc, char** argv) {
     m->opt.wind_series = wind;
     m->opt.nwind = nwind;
     d = vd_sim_data_create(m);
-    if (!d) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    if (!d)
+      st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    else
+      d->profile = o.profile;
   }
   // organs to pull, colliders
   for (int k = 0; !st && k < o.npull; k++) {
@@ -768,6 +786,7 @@ int cli_sim(int argc, char** argv) {
     double start = d->time, total = o.duration, next_frame = start;
     double ramp = o.ramp_set ? o.ramp : total;
     int show = o.po.progress && total / m->opt.dt > 2000;
+    double frames_s = 0;
     if (out.frames_open) cli_frames_write(&out, m, d), next_frame += 1.0 / o.fps;
     for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
       double t = d->time - start, f = ramp > 0 ? fmin(1.0, t / ramp) : 1.0;
@@ -786,7 +805,9 @@ int cli_sim(int argc, char** argv) {
       }
       st = vd_sim_step(m, d);
       if (out.frames_open && d->time >= next_frame - 1e-12) {
+        double tf = o.profile ? cli_now() : 0;
         if (cli_frames_write(&out, m, d)) break;  // reported by the commit below
+        if (o.profile) frames_s += cli_now() - tf;
         next_frame += 1.0 / o.fps;
       }
       if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);
@@ -860,7 +881,7 @@ int cli_sim(int argc, char** argv) {
       code = EXIT_FAIL;
       goto done;
     }
-    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps)) code = EXIT_FAIL;
+    if (o.stats && !print_stats(m, d, plant, wall, d->nstep - steps0, settled, settle_steps, frames_s)) code = EXIT_FAIL;
   }
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);

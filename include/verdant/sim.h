@@ -55,6 +55,23 @@ typedef enum vd_sim_warning {
 // Lower-case name of a warning kind ("nonfinite", "solver", ...).
 const char* vd_sim_warning_name(vd_sim_warning w);
 
+// Stages of a step, timed into vd_sim_data::stage_seconds while vd_sim_data::profile is 1.
+typedef enum vd_sim_stage {
+  VD_SIM_STAGE_FORCES = 0,  // loads: gravity, the caller's forces, wind and air drag
+  VD_SIM_STAGE_PREDICT,     // prediction of positions and frames (and the step's bookkeeping)
+  VD_SIM_STAGE_CONTACTS,    // contact candidates near colliders, self-contact pairs
+  VD_SIM_STAGE_EVAL,        // constraint evaluation: values, Jacobians, body residuals
+  VD_SIM_STAGE_FACTOR,      // the direct solver's elimination from the tips (factorisation)
+  VD_SIM_STAGE_SOLVE,       // back substitution and the update of the state (GS: the sweeps)
+  VD_SIM_STAGE_PROJECT,     // contact projection and friction
+  VD_SIM_STAGE_VELOCITY,    // velocities from the motion, the step's checks (finite, stretch)
+  VD_SIM_STAGE_FRACTURE,    // fracture checks
+  VD_SIM_STAGE_COUNT
+} vd_sim_stage;
+
+// Lower-case name of a stage ("forces", "predict", ...).
+const char* vd_sim_stage_name(vd_sim_stage s);
+
 // Material classes: each rod segment takes its material from one of these.
 typedef enum vd_sim_class {
   VD_SIM_GREEN = 0,  // green (herbaceous) stem: organ stem, other
@@ -160,6 +177,9 @@ typedef struct vd_sim_opt {
   int fracture;               // 1: joints break at their thresholds
   int contacts;               // 1: colliders are projected
   double friction;            // Coulomb friction coefficient of contacts (-)
+  int threads;                // threads one state's step uses (the direct solver's subtrees, per-segment
+                              // loops); the bytes do not depend on it; changing it rebuilds the
+                              // solver's schedule at the next step (one allocation)
   int self_collision;         // 1: the plant's capsules and fruit spheres collide with each other
                               // (vd_collide_self; topological neighbours and pairs touching in
                               // the modelled shape excluded)
@@ -168,7 +188,8 @@ typedef struct vd_sim_opt {
 // Defaults: dt 1e-3 s, iterations 1, solver direct, gravity (0, 0, -9.81) m/s^2,
 // air_density 1.226 kg/m^3, wind 0 m/s, gust_amplitude 0, gust_period 2 s, no wind series,
 // drag 1, stokes_viscosity 0 Pa s, damping 0 s, mass_damping 0 1/s, fracture 1, contacts 1,
-// friction 0.5, self_collision 0 (off: it costs ~30 % on the tomato with a probe, docs/physics.md).
+// friction 0.5, threads 1, self_collision 0 (off: it costs ~30 % on the tomato with a probe,
+// docs/physics.md).
 vd_sim_opt vd_sim_opt_default(void);
 
 // rod segment flags
@@ -311,6 +332,8 @@ typedef struct vd_sim_data {
   double max_penetration;  // deepest penetration left after the last step (m)
   int64_t nwarning;        // numerical warnings of every kind (the sum of warning[])
   int64_t warning[VD_SIM_WARN_COUNT];  // numerical warnings by kind (vd_sim_warning)
+  int profile;             // 1: time each stage of every step into stage_seconds (0 by default)
+  double stage_seconds[VD_SIM_STAGE_COUNT];  // time spent per stage while profiling, wall clock (s)
   void* work;              // solver scratch (private)
   size_t work_bytes;       // size of work
   vd_arena arena;          // per-step scratch (contacts)

@@ -89,6 +89,7 @@ vd_sim_opt vd_sim_opt_default(void) {
   o.contacts = 1;
   o.friction = 0.5;
   o.self_collision = 0;
+  o.threads = 1;
   return o;
 }
 

@@ -165,12 +165,16 @@ static double seg_dist2(vd_vec3 a, vd_vec3 b, vd_vec3 p) {
 // its radius. (Node spheres of the segment radius reach r along the axis as well: they pushed
 // the first free node of the tree's upright trunk, r = 8.2 cm, from 3 cm above the ground to
 // 8.2 cm, stretching the 2 cm segment below it by 260 %.)
-static void plane_reach(const vd_sim_model* m, const vd_sim_data* d, vd_vec3 n, double* reach) {
+// Only segments with an end in near[] (a node whose height above the plane, less its largest
+// radius, is below the margin) are looked at: the others cannot make a candidate.
+static void plane_reach(const vd_sim_model* m, const vd_sim_data* d, vd_vec3 n, const unsigned char* near,
+                        double* reach) {
   for (int i = 0; i < m->nnode_all; i++)
     reach[i] = m->node_sphere[i] > 0 ? m->node_sphere[i] : -1;
   for (int t = 0; t < m->nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FRUITSEG) continue;
     int a = d->seg_start[t], b = m->seg_node[2 * t + 1];
+    if (!near[a] && !near[b]) continue;
     vd_vec3 e = vd_sub(d->node_pos[b], d->node_pos[a]);
     double l2 = vd_dot(e, e), en = vd_dot(e, n);
     double s2 = l2 > 0 ? 1 - en * en / l2 : 1;
@@ -186,7 +190,8 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
   size_t cap = (size_t)d->ncollider * (size_t)(m->nseg + m->nnode_all);
   sim_contact* c = vd_arena_alloc(&d->arena, cap * sizeof(sim_contact));
   double* reach = vd_arena_alloc(&d->arena, (size_t)m->nnode_all * sizeof(double));
-  if (!c || !reach) {
+  unsigned char* near = vd_arena_alloc(&d->arena, (size_t)m->nnode_all);
+  if (!c || !reach || !near) {
     sim_warn(d, VD_SIM_WARN_ARENA);
     return 0;
   }
@@ -194,22 +199,39 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
   for (int k = 0; k < d->ncollider; k++) {
     const vd_sim_collider* col = &d->collider[k];
     vd_vec3 nrm;
-    // nodes: every moving node against planes (with the rod's reach towards the plane), fruit
-    // spheres against the rest
-    if (col->shape == VD_SIM_PLANE) plane_reach(m, d, q_rotate(col->quat, vd_v3(0, 0, 1)), reach);
-    // a ball around the shape: elements beyond it (plus their radius) are skipped at once
+    if (col->shape == VD_SIM_PLANE) {
+      // every moving node with the rod's reach towards the plane; a node higher than its
+      // largest radius plus the margin cannot touch, and needs no reach
+      vd_vec3 pn = q_rotate(col->quat, vd_v3(0, 0, 1));
+      const sim_work* w = (const sim_work*)d->work;
+      int any = 0;
+      for (int i = 0; i < m->nnode_all; i++) {
+        // a spare node carries the segment that broke onto it
+        double rmax = i < m->nnode ? m->node_radius[i] : m->seg_radius[w->spare_of[i - m->nnode]];
+        near[i] = sim_node_moves(m, d, i) && i != d->collider_pass[k] &&
+                  vd_dot(pn, vd_sub(d->node_pos[i], col->pos)) - rmax < margin;
+        any |= near[i];
+      }
+      if (!any) continue;
+      plane_reach(m, d, pn, near, reach);
+      for (int i = 0; i < m->nnode_all; i++) {
+        if (!near[i] || reach[i] < 0) continue;
+        if (sim_collider_distance(col, d->node_pos[i], &nrm) - reach[i] < margin)
+          c[n++] = (sim_contact){i, -1, 0, reach[i], k, 0, -1, -1, 0, 0};
+      }
+      continue;
+    }
+    // fruit spheres, then segment capsules; a ball around the shape: elements beyond it (plus
+    // their radius) are skipped at once
     double far = collider_reach(col) + margin;
     for (int i = 0; i < m->nnode_all; i++) {
-      if (sim_node_w(m, d, i) <= 0 || i == d->collider_pass[k]) continue;
-      double r = col->shape == VD_SIM_PLANE ? reach[i] : m->node_sphere[i];
-      if (r < 0 || (r == 0 && col->shape != VD_SIM_PLANE)) continue;
+      double r = m->node_sphere[i];
+      if (!(r > 0) || !sim_node_moves(m, d, i) || i == d->collider_pass[k]) continue;
       vd_vec3 dp = vd_sub(d->node_pos[i], col->pos);
       if (vd_dot(dp, dp) > (far + r) * (far + r)) continue;
       if (sim_collider_distance(col, d->node_pos[i], &nrm) - r < margin)
         c[n++] = (sim_contact){i, -1, 0, r, k, 0, -1, -1, 0, 0};
     }
-    if (col->shape == VD_SIM_PLANE) continue;
-    // segment capsules
     for (int t = 0; t < m->nseg; t++) {
       if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
       int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];

@@ -12,27 +12,26 @@ static size_t take(size_t* top, size_t bytes) {
 }
 
 sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
-  size_t na = (size_t)m->nnode_all, ns = (size_t)m->nseg, nb = ns + (size_t)m->nspare;
+  size_t na = (size_t)m->nnode_all, ns = (size_t)m->nseg;
   size_t nsp = m->nspare ? (size_t)m->nspare : 1, ntl = (size_t)m->ntie + 16;
   size_t D = sizeof(double), top = 0;
   size_t o_w = take(&top, sizeof(sim_work));
   size_t o_np = take(&top, na * sizeof(vd_vec3)), o_sp = take(&top, ns * sizeof(vd_quat));
   size_t o_fe = take(&top, na * sizeof(vd_vec3)), o_te = take(&top, ns * sizeof(vd_vec3)), o_dr = take(&top, na * D);
+  size_t o_sdr = take(&top, ns * 5 * D);
   size_t o_cp = take(&top, ns * 6 * D), o_so = take(&top, nsp * sizeof(int)), o_ls = take(&top, ns * 6 * D);
-  size_t o_h = take(&top, nb * 36 * D), o_g = take(&top, nb * 6 * D), o_dy = take(&top, nb * 6 * D);
-  size_t o_s = take(&top, ns * 36 * D), o_r = take(&top, ns * 6 * D), o_x = take(&top, ns * 36 * D);
-  size_t o_dl = take(&top, ns * 6 * D), o_j = take(&top, ns * sizeof(sim_joint));
+
   char* blk = vd_calloc(1, top);
   if (!blk) return NULL;
   sim_work* w = (sim_work*)(blk + o_w);
   w->node_prev = (vd_vec3*)(blk + o_np), w->seg_prev = (vd_quat*)(blk + o_sp);
   w->node_fext = (vd_vec3*)(blk + o_fe), w->seg_text = (vd_vec3*)(blk + o_te), w->node_drag = (double*)(blk + o_dr);
+  w->seg_drag = (double*)(blk + o_sdr);
   w->c_prev = (double*)(blk + o_cp), w->spare_of = (int*)(blk + o_so), w->lambda_save = (double*)(blk + o_ls);
-  w->h = (double*)(blk + o_h), w->gb = (double*)(blk + o_g), w->dy = (double*)(blk + o_dy);
-  w->s = (double*)(blk + o_s), w->r = (double*)(blk + o_r), w->x = (double*)(blk + o_x);
-  w->dl = (double*)(blk + o_dl), w->joint = (sim_joint*)(blk + o_j);
+
   w->tie_lambda = vd_calloc(ntl, 3 * D);
-  if (!w->tie_lambda) {
+  if (!w->tie_lambda || sim_plan_build(m, 1, &w->plan)) {
+    vd_free(w->tie_lambda, ntl * 3 * D);
     vd_free(blk, top);
     return NULL;
   }
@@ -41,6 +40,7 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
   // self-collision primitives and their exclusion, from the modelled shape
   vd_error err;
   if (sim_self_init(m, &w->self, &err)) {
+    sim_plan_free(&w->plan);
     vd_free(w->tie_lambda, ntl * 3 * D);
     vd_free(blk, top);
     return NULL;
@@ -54,6 +54,7 @@ sim_work* sim_work_create(const vd_sim_model* m, size_t* bytes) {
 static void work_free(sim_work* w, size_t bytes) {
   if (!w) return;
   sim_self_free(&w->self);
+  sim_plan_free(&w->plan);
   vd_free(w->tie_lambda, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
   vd_free(w, bytes);
 }
@@ -112,6 +113,7 @@ void vd_sim_data_reset(const vd_sim_model* m, vd_sim_data* d) {
   d->max_penetration = 0;
   d->nwarning = 0;
   memset(d->warning, 0, sizeof d->warning);
+  memset(d->stage_seconds, 0, sizeof d->stage_seconds);
 }
 
 void vd_sim_data_destroy(vd_sim_data* d) {
@@ -221,7 +223,7 @@ int vd_sim_find_organ(const vd_sim_model* m, const vd_model* plant, const char* 
 double vd_sim_kinetic_energy(const vd_sim_model* m, const vd_sim_data* d) {
   double e = 0;
   for (int i = 0; i < m->nnode_all; i++)
-    if (sim_node_w(m, d, i) > 0) e += 0.5 * d->node_mass[i] * vd_dot(d->node_vel[i], d->node_vel[i]);
+    if (sim_node_moves(m, d, i)) e += 0.5 * d->node_mass[i] * vd_dot(d->node_vel[i], d->node_vel[i]);
   for (int t = 0; t < m->nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
     vd_vec3 w = q_rotate(q_conj(d->seg_quat[t]), d->seg_omega[t]);

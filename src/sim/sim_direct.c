@@ -6,365 +6,759 @@
 // vertices are bodies and joints (Baraff 1996; Deul et al. 2018): a body is one segment's end
 // node with its frame (6 dofs), a joint is that segment's stretch-shear and bend-twist rows
 // (6), which touch only the body and its parent. Eliminating bodies and joints from the tips
-// to the root (children first) leaves no fill-in: per segment one 6x6 Cholesky of the body and
-// one of the joint's Schur complement. Unlike plain XPBD we keep the primal residual g, so the
-// iteration converges to the implicit Euler step itself and static equilibria are exact.
+// to the root (children first) leaves no fill-in. Unlike plain XPBD we keep the primal residual
+// g, so the iteration converges to the implicit Euler step itself and static equilibria are
+// exact.
+//
+// How it is computed (issue 13):
+// * The stretch-shear rows are taken in world axes: rows premultiplied by T = l0 R, which
+//   leaves the solution unchanged (dl = T^T dl^) and turns their Jacobian into [I, [E]x] on the
+//   body and [-I, 0] on the parent (E = x_end - x_start), with compliance
+//   alpha^ = l0^2 R diag(alpha~) R^T: cross products instead of 3x3 products.
+// * Bodies are eliminated SIM_W (8) at a time (sim_plan.c): every quantity of a block is stored
+//   lane by lane (sim_blk), and the block arithmetic of a step runs as one loop over the lanes,
+//   which the compiler vectorises (each lane's arithmetic is the scalar one: same bytes with any
+//   vector width, no fused multiply-adds, -ffp-contract=off).
+// * A body sums its children's contributions J_p^T S^-1 J_p and their residual terms itself,
+//   in the fixed order of its children, so the bytes do not depend on the schedule or threads.
+// * Tips (a third of the tomato) have a diagonal body matrix: their inverse is written down.
+// * 6x6 inverses by 3x3 Schur blocks (two divisions each), used through products.
+#include <omp.h>
+#include <stddef.h>
+
 #include "sim_internal.h"
 
-// ---------------------------------------------------------------------------------------------
-// 6x6 helpers, kept here so the compiler can unroll them in the hot loops
+// a profiling build (-DVD_PROF_NOINLINE) keeps the stages apart for callgrind
+#ifdef VD_PROF_NOINLINE
+#define PROF_NOINLINE __attribute__((noinline))
+#define SIM_INLINE_PROF static
+#else
+#define PROF_NOINLINE
+#define SIM_INLINE_PROF static inline __attribute__((always_inline))
+#endif
 
-// inverse of a symmetric 3x3 matrix by cofactors (out may not alias a); 0 if singular
-static inline int inv3_sym(const double* a, double* o) {
-  double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[2] * a[7] - a[1] * a[8], c02 = a[1] * a[5] - a[2] * a[4];
-  double c11 = a[0] * a[8] - a[2] * a[6], c12 = a[2] * a[3] - a[0] * a[5], c22 = a[0] * a[4] - a[1] * a[3];
-  double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
-  if (!(det > 0)) return 0;
-  double id = 1.0 / det;
-  o[0] = c00 * id, o[1] = o[3] = c01 * id, o[2] = o[6] = c02 * id;
-  o[4] = c11 * id, o[5] = o[7] = c12 * id, o[8] = c22 * id;
-  return 1;
-}
-
-// inverse of a symmetric positive definite 6x6 matrix [[A, B], [B^T, D]] by its 3x3 blocks:
-// X = A^-1 B, T = D - B^T X (the Schur complement, positive definite), then
-// inv = [[A^-1 + X T^-1 X^T, -X T^-1], [-T^-1 X^T, T^-1]]; 0 if not positive definite
-static int inv_spd(const double* m, double* inv) {
-  double a[9], b[9], dd[9], ai[9], x[9], t[9], ti[9], y[9];
-  for (int i = 0; i < 3; i++)
-    for (int k = 0; k < 3; k++) {
-      a[3 * i + k] = m[6 * i + k];
-      b[3 * i + k] = m[6 * i + 3 + k];
-      dd[3 * i + k] = m[6 * (3 + i) + 3 + k];
-    }
-  if (!(a[0] > 0) || !inv3_sym(a, ai)) return 0;
-  for (int i = 0; i < 3; i++)
-    for (int k = 0; k < 3; k++) x[3 * i + k] = ai[3 * i] * b[k] + ai[3 * i + 1] * b[3 + k] + ai[3 * i + 2] * b[6 + k];
-  for (int i = 0; i < 3; i++)
-    for (int k = i; k < 3; k++) {
-      double v = dd[3 * i + k] - (b[i] * x[k] + b[3 + i] * x[3 + k] + b[6 + i] * x[6 + k]);
-      t[3 * i + k] = t[3 * k + i] = v;
-    }
-  if (!(t[0] > 0) || !inv3_sym(t, ti)) return 0;
-  for (int i = 0; i < 3; i++)
-    for (int k = 0; k < 3; k++) y[3 * i + k] = x[3 * i] * ti[k] + x[3 * i + 1] * ti[3 + k] + x[3 * i + 2] * ti[6 + k];
-  for (int i = 0; i < 3; i++)
-    for (int k = 0; k < 3; k++) {
-      inv[6 * (3 + i) + 3 + k] = ti[3 * i + k];
-      inv[6 * i + 3 + k] = inv[6 * (3 + k) + i] = -y[3 * i + k];
-    }
-  for (int i = 0; i < 3; i++)
-    for (int k = i; k < 3; k++) {
-      double v = ai[3 * i + k] + y[3 * i] * x[3 * k] + y[3 * i + 1] * x[3 * k + 1] + y[3 * i + 2] * x[3 * k + 2];
-      inv[6 * i + k] = inv[6 * k + i] = v;
-    }
-  return 1;
-}
-
-
-
+// Every kernel is inlined into the block loops, which are compiled three times (x86-64 with gcc
+// or clang; -DVD_SIM_PORTABLE for one baseline build): for AVX-512 (eight lanes in one
+// instruction), AVX2 (four) and the baseline (SSE2, two), picked at load time by the CPU. All
+// give the same bytes: each lane's arithmetic is the scalar IEEE arithmetic in the same order,
+// with no fused multiply-adds (-ffp-contract=off); the tomato's frames were compared byte for
+// byte between the three and between blocks of four and eight lanes.
+#define SIM_INLINE static inline __attribute__((always_inline))
+#if defined(__x86_64__) && defined(__has_attribute) && !defined(VD_PROF_NOINLINE) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(VD_SIM_PORTABLE)
+#if __has_attribute(target_clones)
+#define SIM_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+#endif
+#ifndef SIM_CLONES
+#define SIM_CLONES
+#endif
 
 #define SIM_MAX_TURN 1.0   // largest frame rotation of one Newton update (rad)
 #define SIM_MAX_MOVE 10.0  // largest node move of one Newton update (rest lengths of its segment)
 
-// body numbering: segment t is body t; spare node k (k = node - nnode) is body nseg + k
-static int node_body(const vd_sim_model* m, const vd_sim_data* d, int n) {
-  if (n >= m->nnode) return d->node_mass[n] > 0 ? m->nseg + (n - m->nnode) : -1;
+// packed upper 3x3: 00 01 02 11 12 22
+#define S00 0
+#define S01 1
+#define S02 2
+#define S11 3
+#define S12 4
+#define S22 5
+
+// ---------------------------------------------------------------------------------------------
+// lane kernels: every statement is a loop over the SIM_W lanes of contiguous arrays, which the
+// compiler turns into vector instructions (each lane's arithmetic is the scalar one)
+
+typedef double lane[SIM_W];
+#define L _Pragma("omp simd") for (int l = 0; l < SIM_W; l++)
+
+// index of element (i, j) of a packed symmetric 3x3
+static const int SYM[3][3] = {{S00, S01, S02}, {S01, S11, S12}, {S02, S12, S22}};
+
+// inverse of symmetric 3x3 matrices (packed) by cofactors; ok *= 1 where positive definite
+SIM_INLINE void inv3s(lane* restrict a, lane* restrict o, lane ok) {
+  lane c00, c01, c02, c11, c12, c22, id;
+  L c00[l] = a[S11][l] * a[S22][l] - a[S12][l] * a[S12][l];
+  L c01[l] = a[S02][l] * a[S12][l] - a[S01][l] * a[S22][l];
+  L c02[l] = a[S01][l] * a[S12][l] - a[S02][l] * a[S11][l];
+  L c11[l] = a[S00][l] * a[S22][l] - a[S02][l] * a[S02][l];
+  L c12[l] = a[S02][l] * a[S01][l] - a[S00][l] * a[S12][l];
+  L c22[l] = a[S00][l] * a[S11][l] - a[S01][l] * a[S01][l];
+  L {
+    double det = a[S00][l] * c00[l] + a[S01][l] * c01[l] + a[S02][l] * c02[l];
+    id[l] = 1.0 / det;
+    ok[l] = a[S00][l] > 0 && det > 0 ? ok[l] : 0.0;
+  }
+  L o[S00][l] = c00[l] * id[l];
+  L o[S01][l] = c01[l] * id[l];
+  L o[S02][l] = c02[l] * id[l];
+  L o[S11][l] = c11[l] * id[l];
+  L o[S12][l] = c12[l] * id[l];
+  L o[S22][l] = c22[l] * id[l];
+}
+
+// inverse of symmetric positive definite 6x6 matrices [A | B | D] by their 3x3 blocks:
+// X = A^-1 B, T = D - B^T X (the Schur complement), inverse [[A^-1 + X T^-1 X^T, -X T^-1],
+// [., T^-1]]; ok *= 1 where both pivots were positive definite
+SIM_INLINE void inv6s(lane* restrict m, lane* restrict o, lane ok) {
+  lane *a = m, *b = m + 6, *dd = m + 15;
+  lane ai[6], x[9], t[6], y[9];
+  inv3s(a, ai, ok);
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++)
+      L x[3 * i + k][l] = ai[SYM[i][0]][l] * b[k][l] + ai[SYM[i][1]][l] * b[3 + k][l] + ai[SYM[i][2]][l] * b[6 + k][l];
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++)
+      L t[SYM[i][k]][l] = dd[SYM[i][k]][l] - (b[i][l] * x[k][l] + b[3 + i][l] * x[3 + k][l] + b[6 + i][l] * x[6 + k][l]);
+  inv3s(t, o + 15, ok);
+  lane* ti = o + 15;
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++)
+      L y[3 * i + k][l] = x[3 * i][l] * ti[SYM[0][k]][l] + x[3 * i + 1][l] * ti[SYM[1][k]][l] + x[3 * i + 2][l] * ti[SYM[2][k]][l];
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++)
+      L o[SYM[i][k]][l] = ai[SYM[i][k]][l] + y[3 * i][l] * x[3 * k][l] + y[3 * i + 1][l] * x[3 * k + 1][l] +
+                          y[3 * i + 2][l] * x[3 * k + 2][l];
+  for (int k = 0; k < 9; k++) L o[6 + k][l] = -y[k][l];
+}
+
+// y = M v for symmetric 6x6 matrices [A | B | D] and 6-vectors
+SIM_INLINE void mul6s(lane* restrict m, lane* restrict v, lane* restrict y) {
+  lane *a = m, *b = m + 6, *dd = m + 15;
+  for (int i = 0; i < 3; i++) {
+    L y[i][l] = a[SYM[i][0]][l] * v[0][l] + a[SYM[i][1]][l] * v[1][l] + a[SYM[i][2]][l] * v[2][l] + b[3 * i][l] * v[3][l] +
+                b[3 * i + 1][l] * v[4][l] + b[3 * i + 2][l] * v[5][l];
+    L y[3 + i][l] = b[i][l] * v[0][l] + b[3 + i][l] * v[1][l] + b[6 + i][l] * v[2][l] + dd[SYM[i][0]][l] * v[3][l] +
+                    dd[SYM[i][1]][l] * v[4][l] + dd[SYM[i][2]][l] * v[5][l];
+  }
+}
+
+// c = e x u for 3-vectors
+#define CROSS(c, e, u)                                         \
+  do {                                                         \
+    L(c)[0][l] = (e)[1][l] * (u)[2][l] - (e)[2][l] * (u)[1][l]; \
+    L(c)[1][l] = (e)[2][l] * (u)[0][l] - (e)[0][l] * (u)[2][l]; \
+    L(c)[2][l] = (e)[0][l] * (u)[1][l] - (e)[1][l] * (u)[0][l]; \
+  } while (0)
+
+// ---------------------------------------------------------------------------------------------
+// body numbering
+
+// slot of the body that owns node n for a tie: its segment's slot, nslot + k for spare k, -1
+static int tie_slot(const vd_sim_model* m, const vd_sim_data* d, const sim_plan* p, int n) {
+  if (n >= m->nnode) return d->node_mass[n] > 0 ? p->nslot + (n - m->nnode) : -1;
   if (m->node_fixed[n]) return -1;
   int o = m->node_owner[n];
-  return o >= 0 && !(m->seg_flags[o] & VD_SIM_FIXED) ? o : -1;
+  return o >= 0 ? p->seg_slot[o] : -1;
 }
 
+// ---------------------------------------------------------------------------------------------
+// quaternion maps on lanes
 
-
-// y = J x (6x6 times 6)
-static void mv6(const double* jm, const double* x, double* y) {
-  for (int i = 0; i < 6; i++) {
-    double s = 0;
-    for (int k = 0; k < 6; k++) s += jm[6 * i + k] * x[k];
-    y[i] = s;
+// rotation matrices of unit quaternions (w, x, y, z)
+SIM_INLINE void rot_lanes(lane* restrict q, lane* restrict r) {
+  L {
+    double w = q[0][l], x = q[1][l], y = q[2][l], z = q[3][l];
+    r[0][l] = 1 - 2 * (y * y + z * z), r[1][l] = 2 * (x * y - w * z), r[2][l] = 2 * (x * z + w * y);
+    r[3][l] = 2 * (x * y + w * z), r[4][l] = 1 - 2 * (x * x + z * z), r[5][l] = 2 * (y * z - w * x);
+    r[6][l] = 2 * (x * z - w * y), r[7][l] = 2 * (y * z + w * x), r[8][l] = 1 - 2 * (x * x + y * y);
   }
 }
 
-
-// mass matrix and inertial residual of every body; returns 0 if a body has no mass
-static void init_bodies(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h) {
-  double h2 = h * h;
-  for (int t = 0; t < m->nseg; t++) {
-    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    double* hb = w->h + 36 * t;
-    double* g = w->gb + 6 * t;
-    memset(hb, 0, 36 * sizeof(double));
-    int n = m->seg_node[2 * t + 1];
-    // the node's mass plus h times its air drag damping (drag linearised at v_n, implicit)
-    double mass = d->node_mass[n] + h * w->node_drag[n];
-    hb[0] = hb[7] = hb[14] = mass;
-    // rotational inertia in world axes
-    double r[9], iw[9];
-    m3_from_quat(r, d->seg_quat[t]);
-    double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
-    double a = ib, c = it - ib, d3[3] = {r[2], r[5], r[8]};
-    for (int i = 0; i < 3; i++)
-      for (int k = 0; k < 3; k++) iw[3 * i + k] = (i == k ? a : 0.0) + c * d3[i] * d3[k];
-    for (int i = 0; i < 3; i++)
-      for (int k = 0; k < 3; k++) hb[6 * (3 + i) + 3 + k] = iw[3 * i + k];
-    // g = M (y - y_n - h v_n) - h^2 f
-    vd_vec3 dx = vd_sub(vd_sub(d->node_pos[n], w->node_prev[n]), vd_scale(d->node_vel[n], h));
-    vd_vec3 f = w->node_fext[n];
-    g[0] = mass * dx.x - h2 * f.x, g[1] = mass * dx.y - h2 * f.y, g[2] = mass * dx.z - h2 * f.z;
-    vd_vec3 om = d->seg_omega[t];
-    vd_vec3 dth = vd_sub(quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t]))),
-                         vd_scale(om, h));
-    vd_vec3 io = m3_mul_v(iw, om);
-    vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(om, io));
-    vd_vec3 idth = m3_mul_v(iw, dth);
-    g[3] = idth.x - h2 * tq.x, g[4] = idth.y - h2 * tq.y, g[5] = idth.z - h2 * tq.z;
+// c = a b (sa, sb = +1 or -1 conjugate a or b)
+SIM_INLINE void qmul_lanes(lane* restrict a, lane* restrict b, lane* restrict c, double sa, double sb) {
+  L {
+    double aw = a[0][l], ax = sa * a[1][l], ay = sa * a[2][l], az = sa * a[3][l];
+    double bw = b[0][l], bx = sb * b[1][l], by = sb * b[2][l], bz = sb * b[3][l];
+    c[0][l] = aw * bw - ax * bx - ay * by - az * bz;
+    c[1][l] = aw * bx + ax * bw + ay * bz - az * by;
+    c[2][l] = aw * by - ax * bz + ay * bw + az * bx;
+    c[3][l] = aw * bz + ax * by - ay * bx + az * bw;
   }
-  for (int k = 0; k < m->nspare; k++) {
-    int n = m->nnode + k, b = m->nseg + k;
-    double* hb = w->h + 36 * b;
-    double* g = w->gb + 6 * b;
-    memset(hb, 0, 36 * sizeof(double));
-    memset(g, 0, 6 * sizeof(double));
-    if (d->node_mass[n] <= 0) continue;
-    double mass = d->node_mass[n] + h * w->node_drag[n];
-    hb[0] = hb[7] = hb[14] = mass;
-    hb[21] = hb[28] = hb[35] = 1.0;  // the spare has no frame: a decoupled unit block
-    vd_vec3 dx = vd_sub(vd_sub(d->node_pos[n], w->node_prev[n]), vd_scale(d->node_vel[n], h));
-    vd_vec3 f = w->node_fext[n];
-    g[0] = mass * dx.x - h2 * f.x, g[1] = mass * dx.y - h2 * f.y, g[2] = mass * dx.z - h2 * f.z;
+}
+
+// rotation vector of q (the shorter way: q and -q alike) as quat_log does it where
+// t = |Im q| / Re q <= 0.1 (its series); elsewhere need[l] = 1 and the caller calls quat_log
+SIM_INLINE void qlog_lanes(lane* restrict q, lane* restrict v, lane need) {
+  L {
+    double sg = q[0][l] < 0 ? -1.0 : 1.0;
+    double w = sg * q[0][l], x = sg * q[1][l], y = sg * q[2][l], z = sg * q[3][l];
+    double s2 = x * x + y * y + z * z, w2 = w * w;
+    int ok = w > 0 && s2 <= 0.01 * w2;
+    double k = 2 * sim_atan_ratio(ok ? s2 / w2 : 0.0) / (ok ? w : 1.0);
+    v[0][l] = k * x, v[1][l] = k * y, v[2][l] = k * z;
+    need[l] = ok ? 0.0 : 1.0;
+  }
+}
+
+// q = exp(v) q, normalised, as quat_rotate_by does it where |v| <= 0.1 rad (its series);
+// elsewhere need[l] = 1 and the caller calls quat_rotate_by
+SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
+  L {
+    double a2 = v[0][l] * v[0][l] + v[1][l] * v[1][l] + v[2][l] * v[2][l], c, k;
+    sim_exp_series(a2 <= 0.01 ? a2 : 0.0, &c, &k);
+    double ex = v[0][l] * k, ey = v[1][l] * k, ez = v[2][l] * k;
+    double aw = c, bw = q[0][l], bx = q[1][l], by = q[2][l], bz = q[3][l];
+    double rw = aw * bw - ex * bx - ey * by - ez * bz;
+    double rx = aw * bx + ex * bw + ey * bz - ez * by;
+    double ry = aw * by - ex * bz + ey * bw + ez * bx;
+    double rz = aw * bz + ex * by - ey * bx + ez * bw;
+    double n = sqrt(rw * rw + rx * rx + ry * ry + rz * rz), in = 1.0 / n;
+    q[0][l] = rw * in, q[1][l] = rx * in, q[2][l] = ry * in, q[3][l] = rz * in;
+    need[l] = a2 <= 0.01 ? 0.0 : 1.0;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// linearisation of the bodies and joints of a block
+
+// a block's inputs, gathered lane by lane (the model's part is in the plan's sim_stat)
+typedef struct sim_in {
+  lane qt[4], qp[4], qv[4];   // frame, parent frame (identity: no bend rows), frame at the step's start
+  lane e[3];                  // x_end - x_start (m)
+  lane dx[3];                 // x_end - x_start_of_step - h v (m)
+  lane fe[3], om[3], te[3];   // external force (N), angular velocity (rad/s), external torque (N m)
+  lane lam[6], cp[6];         // multipliers, constraint values at the step's start (0 without damping)
+  lane mass, tieh, tieg[3];   // mass with drag (kg), ties on the node
+  lane bend;                  // 1 when the bend rows are active
+  sim_stat* st;               // the block's model data
+} sim_in;
+
+// gather lane l of a block from slot s (padding: a unit body and joint)
+PROF_NOINLINE static void gather_in(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
+                                    sim_in* in, int l, int s) {
+  const sim_plan* p = &w->plan;
+  int t = p->slot_seg[s];
+  double h = ctx->h;
+  if (t < 0) {
+    double* f = &in->qt[0][0];
+    for (size_t k = 0; k < offsetof(sim_in, st) / sizeof(lane); k++) f[SIM_W * k + l] = 0;
+    in->qt[0][l] = in->qp[0][l] = in->qv[0][l] = 1;
+    in->mass[l] = 1;
+    return;
+  }
+  int nb = m->seg_node[2 * t + 1], na = d->seg_start[t], par = m->seg_parent[t];
+  int bend = !d->seg_broken[t] && par >= 0;
+  vd_quat q = d->seg_quat[t], qp = bend ? d->seg_quat[par] : vd_quat_identity(), qv = w->seg_prev[t];
+  in->qt[0][l] = q.w, in->qt[1][l] = q.x, in->qt[2][l] = q.y, in->qt[3][l] = q.z;
+  in->qp[0][l] = qp.w, in->qp[1][l] = qp.x, in->qp[2][l] = qp.y, in->qp[3][l] = qp.z;
+  in->qv[0][l] = qv.w, in->qv[1][l] = qv.x, in->qv[2][l] = qv.y, in->qv[3][l] = qv.z;
+  vd_vec3 xb = d->node_pos[nb], xa = d->node_pos[na], xv = w->node_prev[nb], v = d->node_vel[nb];
+  vd_vec3 fe = w->node_fext[nb], om = d->seg_omega[t], te = w->seg_text[t];
+  in->e[0][l] = xb.x - xa.x, in->e[1][l] = xb.y - xa.y, in->e[2][l] = xb.z - xa.z;
+  in->dx[0][l] = xb.x - xv.x - v.x * h, in->dx[1][l] = xb.y - xv.y - v.y * h, in->dx[2][l] = xb.z - xv.z - v.z * h;
+  in->fe[0][l] = fe.x, in->fe[1][l] = fe.y, in->fe[2][l] = fe.z;
+  in->om[0][l] = om.x, in->om[1][l] = om.y, in->om[2][l] = om.z;
+  in->te[0][l] = te.x, in->te[1][l] = te.y, in->te[2][l] = te.z;
+  const double* lam = d->seg_lambda + 6 * t;
+  for (int k = 0; k < 6; k++) in->lam[k][l] = lam[k];
+  const double* cp = w->c_prev + 6 * t;
+  if (ctx->gamma > 0)
+    for (int k = 0; k < 6; k++) in->cp[k][l] = cp[k];
+  else
+    for (int k = 0; k < 6; k++) in->cp[k][l] = 0;
+  for (int k = 0; k < 3; k++) in->tieg[k][l] = p->tie_g[3 * s + k];
+  in->mass[l] = d->node_mass[nb] + h * w->node_drag[nb];
+  in->tieh[l] = p->tie_h[s];
+  in->bend[l] = bend;
+}
+
+// bend-twist strain and its Jacobian dC/dpsi of the lanes (sim_bend_strain, lane-parallel);
+// lanes whose log needs libm are recomputed by sim_bend_strain itself
+SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane* restrict dc) {
+  lane qr[4];
+  qmul_lanes(in->qp, in->qt, qr, -1, 1);
+  // the sign that puts q_rel on the rest rotation's side
+  L {
+    double dot = qr[0][l] * in->st->q0[0][l] + qr[1][l] * in->st->q0[1][l] + qr[2][l] * in->st->q0[2][l] + qr[3][l] * in->st->q0[3][l];
+    double sg = dot < 0 ? -1.0 : 1.0;
+    for (int k = 0; k < 4; k++) qr[k][l] *= sg;
+  }
+  if (kind == VD_SIM_BEND_QUAT) {
+    L {
+      double f = 1.0 / in->st->lbar[l], k2 = 2.0 * f;
+      cb[0][l] = k2 * (qr[1][l] - in->st->q0[1][l]);
+      cb[1][l] = k2 * (qr[2][l] - in->st->q0[2][l]);
+      cb[2][l] = k2 * (qr[3][l] - in->st->q0[3][l]);
+      dc[0][l] = f * qr[0][l], dc[1][l] = f * qr[3][l], dc[2][l] = -f * qr[2][l];
+      dc[3][l] = -f * qr[3][l], dc[4][l] = f * qr[0][l], dc[5][l] = f * qr[1][l];
+      dc[6][l] = f * qr[2][l], dc[7][l] = -f * qr[1][l], dc[8][l] = f * qr[0][l];
+    }
+    return;
+  }
+  // log measure: the turn qd = conj(q0) q (w >= 0), ph = log(qd), C = ph / l-bar,
+  // dC/dpsi = J_l^-1(ph) R0^T / l-bar, J_l^-1 = I - [ph]x / 2 + beta [ph]x^2
+  lane qd[4], ph[3], need, r0[9], beta, f, dd, jl[9];
+  qmul_lanes(in->st->q0, qr, qd, -1, 1);
+  qlog_lanes(qd, ph, need);
+  for (int l = 0; l < SIM_W; l++)
+    if (need[l] > 0) {
+      vd_vec3 v = quat_log((vd_quat){qd[0][l], qd[1][l], qd[2][l], qd[3][l]});
+      ph[0][l] = v.x, ph[1][l] = v.y, ph[2][l] = v.z;
+    }
+  // beta = (1 - (a / 2) cot(a / 2)) / a^2, cot(a / 2) = w / s; its series below a = 0.1 (to 1e-17)
+  L {
+    double a2 = ph[0][l] * ph[0][l] + ph[1][l] * ph[1][l] + ph[2][l] * ph[2][l];
+    double s = sqrt(qd[1][l] * qd[1][l] + qd[2][l] * qd[2][l] + qd[3][l] * qd[3][l]);
+    double ser = 1.0 / 12 + a2 * (1.0 / 720 + a2 * (1.0 / 30240 + a2 * (1.0 / 1209600 + a2 * (1.0 / 47900160))));
+    double a = sqrt(a2);
+    int big = a2 > 0.01;
+    double frm = (1 - 0.5 * a * qd[0][l] / (big ? s : 1.0)) / (big ? a2 : 1.0);
+    beta[l] = big ? frm : ser;
+    dd[l] = 1 - beta[l] * a2;
+    f[l] = 1.0 / in->st->lbar[l];
+  }
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) L jl[3 * i + k][l] = beta[l] * ph[i][l] * ph[k][l] + (i == k ? dd[l] : 0.0);
+  L jl[1][l] += 0.5 * ph[2][l], jl[2][l] -= 0.5 * ph[1][l], jl[5][l] += 0.5 * ph[0][l];
+  L jl[3][l] -= 0.5 * ph[2][l], jl[6][l] += 0.5 * ph[1][l], jl[7][l] -= 0.5 * ph[0][l];
+  rot_lanes(in->st->q0, r0);
+  for (int k = 0; k < 3; k++) L cb[k][l] = f[l] * ph[k][l];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++)
+      L dc[3 * i + k][l] = f[l] * (jl[3 * i][l] * r0[3 * k][l] + jl[3 * i + 1][l] * r0[3 * k + 1][l] + jl[3 * i + 2][l] * r0[3 * k + 2][l]);
+}
+
+// linearise a block from its gathered inputs: body matrix (mass + ties) I and the inertia, the
+// residual g with -J^T lambda, the joint's values, compliances and Jacobians (world stretch rows)
+PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, double h, double gam, vd_sim_bend kind) {
+  double h2 = h * h, ig = 1.0 / (1 + gam);
+  lane *rt = b->rt, rp[9], dq[4], dth[3], need, cb[3], dc[9];
+  rot_lanes(in->qt, rt);
+  for (int k = 0; k < 4; k++) L b->qt[k][l] = in->qt[k][l];
+  L b->l0[l] = in->st->l0[l];
+  rot_lanes(in->qp, rp);
+  // the frame's turn since the step's start
+  qmul_lanes(in->qt, in->qv, dq, 1, -1);
+  qlog_lanes(dq, dth, need);
+  for (int l = 0; l < SIM_W; l++)
+    if (need[l] > 0) {
+      vd_vec3 v = quat_log((vd_quat){dq[0][l], dq[1][l], dq[2][l], dq[3][l]});
+      dth[0][l] = v.x, dth[1][l] = v.y, dth[2][l] = v.z;
+    }
+  bend_lanes(kind, in, cb, dc);
+  // compliances / h^2 (inactive bend rows: unit compliance)
+  lane acs[3], acb[3];
+  for (int k = 0; k < 3; k++) {
+    L acs[k][l] = in->st->cs[k][l] / h2;
+    L acb[k][l] = in->bend[l] > 0 ? in->st->cb[k][l] / h2 : 1.0 / h2;
+  }
+  // body: world inertia ib I + (it - ib) d3 d3^T; g_t = I (dth - h om) - h^2 (tau - om x I om)
+  lane* d3 = b->d3;
+  lane ci, iw[6], dt[3], io[3], tq[3], il0;
+  L ci[l] = in->st->it[l] - in->st->ib[l], il0[l] = 1.0 / in->st->l0[l];
+  L d3[0][l] = rt[2][l], d3[1][l] = rt[5][l], d3[2][l] = rt[8][l];
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->st->ib[l] : 0.0) + ci[l] * d3[i][l] * d3[k][l];
+  for (int k = 0; k < 3; k++) L dt[k][l] = dth[k][l] - h * in->om[k][l];
+  for (int i = 0; i < 3; i++) {
+    L io[i][l] = iw[SYM[i][0]][l] * in->om[0][l] + iw[SYM[i][1]][l] * in->om[1][l] + iw[SYM[i][2]][l] * in->om[2][l];
+    L b->g[3 + i][l] = iw[SYM[i][0]][l] * dt[0][l] + iw[SYM[i][1]][l] * dt[1][l] + iw[SYM[i][2]][l] * dt[2][l];
+  }
+  lane oxi[3];
+  CROSS(oxi, in->om, io);
+  for (int k = 0; k < 3; k++) L tq[k][l] = in->te[k][l] - oxi[k][l];
+  // stretch-shear: C_s = R^T E / l0 - e3, damped value v (material); the world rows take
+  // f = R lambda_s / l0, c^ = l0 R v and alpha^ = l0^2 R diag(alpha~) R^T / (1 + gamma)
+  lane v[3];
+  for (int k = 0; k < 3; k++)
+    L {
+      double cs = (rt[k][l] * in->e[0][l] + rt[3 + k][l] * in->e[1][l] + rt[6 + k][l] * in->e[2][l]) * il0[l] - (k == 2 ? 1.0 : 0.0);
+      v[k][l] = (cs + acs[k][l] * in->lam[k][l] + gam * (cs - in->cp[k][l])) * ig;
+    }
+  for (int i = 0; i < 3; i++) {
+    L b->lf[i][l] = (rt[3 * i][l] * in->lam[0][l] + rt[3 * i + 1][l] * in->lam[1][l] + rt[3 * i + 2][l] * in->lam[2][l]) * il0[l];
+    L b->c[i][l] = in->st->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
+  }
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++)
+      L b->al[SYM[i][k]][l] = in->st->l0[l] * in->st->l0[l] * ig *
+                              (rt[3 * i][l] * acs[0][l] * rt[3 * k][l] + rt[3 * i + 1][l] * acs[1][l] * rt[3 * k + 1][l] +
+                               rt[3 * i + 2][l] * acs[2][l] * rt[3 * k + 2][l]);
+  // bend-twist: G = dC/dpsi R_p^T (zero when inactive)
+  lane* gm = b->gm;
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++)
+      L gm[3 * i + k][l] = in->bend[l] * (dc[3 * i][l] * rp[3 * k][l] + dc[3 * i + 1][l] * rp[3 * k + 1][l] + dc[3 * i + 2][l] * rp[3 * k + 2][l]);
+  for (int k = 0; k < 3; k++)
+    L {
+      double c = in->bend[l] * cb[k][l];
+      b->c[3 + k][l] = (c + acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
+      b->al[6 + k][l] = acb[k][l] * ig;
+      b->lf[3 + k][l] = in->lam[3 + k][l];
+    }
+  // g = M (y - y_n - h v_n) - h^2 f - J^T lambda, J^T lambda = [f; f x E + G^T lambda_b]
+  lane fxe[3];
+  CROSS(fxe, b->lf, in->e);
+  for (int k = 0; k < 3; k++) {
+    L b->g[k][l] = in->mass[l] * in->dx[k][l] - h2 * in->fe[k][l] - b->lf[k][l] + in->tieg[k][l];
+    L b->g[3 + k][l] = b->g[3 + k][l] - h2 * tq[k][l] - fxe[k][l] -
+                       (gm[k][l] * in->lam[3][l] + gm[3 + k][l] * in->lam[4][l] + gm[6 + k][l] * in->lam[5][l]);
+    L b->e[k][l] = in->e[k][l];
+  }
+  // body matrix: (mass + ties) I and the inertia
+  for (int k = 0; k < 15; k++) L b->h[k][l] = 0;
+  L {
+    double mt = in->mass[l] + in->tieh[l];
+    b->h[S00][l] = mt, b->h[S11][l] = mt, b->h[S22][l] = mt;
+    b->mi[0][l] = 1.0 / mt, b->mi[1][l] = 1.0 / in->st->ib[l], b->mi[2][l] = 1.0 / in->st->it[l] - 1.0 / in->st->ib[l];
+  }
+  for (int k = 0; k < 6; k++) L b->h[15 + k][l] = iw[k][l];
+}
+
+// add the children's contributions to slot s's body (lane l of block b), in their fixed order
+PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, sim_blk* b, int l, int s) {
+  for (int k = p->kid_start[s]; k < p->kid_start[s + 1]; k++) {
+    int c = p->kid_slot[k];
+    if (d->seg_broken[p->slot_seg[c]]) continue;  // it hangs from its spare now
+    const sim_blk* cb = &p->blk[c / SIM_W];
+    int cl = c % SIM_W;
+    for (int i = 0; i < 21; i++) b->h[i][l] += cb->dh[i][cl];
+    for (int i = 0; i < 6; i++) b->g[i][l] += cb->dg[i][cl];
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// the block kernels (lane-parallel)
+
+// forward elimination of a block: H^-1, S = J H^-1 J^T + alpha^, r, S^-1 and the contribution
+// to the parent; tip: the body matrix is (mass) I and the inertia, its inverse written down
+SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
+  lane hi[21], sm[21], ok;
+  L ok[l] = 1.0;
+  if (tip) {
+    // (m I)^-1 and R diag(1/ib, 1/ib, 1/it) R^T = (1/ib) I + (1/it - 1/ib) d3 d3^T
+    for (int k = 0; k < 15; k++) L hi[k][l] = 0;
+    L hi[S00][l] = b->mi[0][l];
+    L hi[S11][l] = b->mi[0][l];
+    L hi[S22][l] = b->mi[0][l];
+    for (int i = 0; i < 3; i++)
+      for (int k = i; k < 3; k++)
+        L hi[15 + SYM[i][k]][l] = (i == k ? b->mi[1][l] : 0.0) + b->mi[2][l] * b->d3[i][l] * b->d3[k][l];
+  } else {
+    inv6s(b->h, hi, ok);
+  }
+  lane *ha = hi, *hb = hi + 6, *hd = hi + 15, *e = b->e, *g = b->gm;
+  // Q = [E]x Hb^T (column j: E x row j of Hb), Z = [E]x Hd (column j: E x column j of Hd)
+  lane q[9], z[9], zx[9], u[3], w[3];
+  for (int j = 0; j < 3; j++) {
+    L u[0][l] = hb[3 * j][l], u[1][l] = hb[3 * j + 1][l], u[2][l] = hb[3 * j + 2][l];
+    L w[0][l] = hd[SYM[0][j]][l], w[1][l] = hd[SYM[1][j]][l], w[2][l] = hd[SYM[2][j]][l];
+    L {
+      q[j][l] = e[1][l] * u[2][l] - e[2][l] * u[1][l];
+      q[3 + j][l] = e[2][l] * u[0][l] - e[0][l] * u[2][l];
+      q[6 + j][l] = e[0][l] * u[1][l] - e[1][l] * u[0][l];
+      z[j][l] = e[1][l] * w[2][l] - e[2][l] * w[1][l];
+      z[3 + j][l] = e[2][l] * w[0][l] - e[0][l] * w[2][l];
+      z[6 + j][l] = e[0][l] * w[1][l] - e[1][l] * w[0][l];
+    }
+  }
+  // Z [E]x^T: row i is E x row i of Z
+  for (int i = 0; i < 3; i++)
+    L {
+      zx[3 * i][l] = e[1][l] * z[3 * i + 2][l] - e[2][l] * z[3 * i + 1][l];
+      zx[3 * i + 1][l] = e[2][l] * z[3 * i][l] - e[0][l] * z[3 * i + 2][l];
+      zx[3 * i + 2][l] = e[0][l] * z[3 * i + 1][l] - e[1][l] * z[3 * i][l];
+    }
+  // S_ss = Ha + Q + Q^T + Z [E]x^T + alpha^_s; S_sb = (Hb + Z) G^T; S_bb = G Hd G^T + alpha^_b
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++)
+      L sm[SYM[i][k]][l] = ha[SYM[i][k]][l] + q[3 * i + k][l] + q[3 * k + i][l] + zx[3 * i + k][l] + b->al[SYM[i][k]][l];
+  lane bz[9], vg[9];
+  for (int k = 0; k < 9; k++) L bz[k][l] = hb[k][l] + z[k][l];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) {
+      L sm[6 + 3 * i + k][l] = bz[3 * i][l] * g[3 * k][l] + bz[3 * i + 1][l] * g[3 * k + 1][l] + bz[3 * i + 2][l] * g[3 * k + 2][l];
+      L vg[3 * i + k][l] = g[3 * i][l] * hd[SYM[0][k]][l] + g[3 * i + 1][l] * hd[SYM[1][k]][l] + g[3 * i + 2][l] * hd[SYM[2][k]][l];
+    }
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++)
+      L sm[15 + SYM[i][k]][l] = vg[3 * i][l] * g[3 * k][l] + vg[3 * i + 1][l] * g[3 * k + 1][l] + vg[3 * i + 2][l] * g[3 * k + 2][l];
+  L sm[15 + S00][l] += b->al[6][l];
+  L sm[15 + S11][l] += b->al[7][l];
+  L sm[15 + S22][l] += b->al[8][l];
+  // r = -c' + J H^-1 g: hg = H^-1 g = (u, w); r_s = -c_s + u + E x w, r_b = -c_b + G w
+  lane hg[6], ew[3], r[6];
+  mul6s(hi, b->g, hg);
+  CROSS(ew, e, hg + 3);
+  for (int i = 0; i < 3; i++) {
+    L r[i][l] = -b->c[i][l] + hg[i][l] + ew[i][l];
+    L r[3 + i][l] = -b->c[3 + i][l] + g[3 * i][l] * hg[3][l] + g[3 * i + 1][l] * hg[4][l] + g[3 * i + 2][l] * hg[5][l];
+  }
+  lane si[21];
+  inv6s(sm, si, ok);
+  // contribution J_p^T S^-1 J_p = [[S^-1_A, S^-1_B G], [., G^T S^-1_D G]] and to g_p:
+  // [(S^-1 r)_s + f; G^T ((S^-1 r)_b + lambda_b)]
+  lane *sa = si, *sb = si + 6, *sd = si + 15;
+  lane ug[9], sr[6], pb[3];
+  for (int k = 0; k < 6; k++) L b->dh[k][l] = sa[k][l];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) {
+      L b->dh[6 + 3 * i + k][l] = sb[3 * i][l] * g[k][l] + sb[3 * i + 1][l] * g[3 + k][l] + sb[3 * i + 2][l] * g[6 + k][l];
+      L ug[3 * i + k][l] = sd[SYM[i][0]][l] * g[k][l] + sd[SYM[i][1]][l] * g[3 + k][l] + sd[SYM[i][2]][l] * g[6 + k][l];
+    }
+  for (int i = 0; i < 3; i++)
+    for (int k = i; k < 3; k++)
+      L b->dh[15 + SYM[i][k]][l] = g[i][l] * ug[k][l] + g[3 + i][l] * ug[3 + k][l] + g[6 + i][l] * ug[6 + k][l];
+  mul6s(si, r, sr);
+  for (int k = 0; k < 3; k++) {
+    L b->dg[k][l] = sr[k][l] + b->lf[k][l];
+    L pb[k][l] = sr[3 + k][l] + b->lf[3 + k][l];
+  }
+  for (int k = 0; k < 3; k++) L b->dg[3 + k][l] = g[k][l] * pb[0][l] + g[3 + k][l] * pb[1][l] + g[6 + k][l] * pb[2][l];
+  for (int k = 0; k < 21; k++) L b->h[k][l] = hi[k][l];
+  for (int k = 0; k < 21; k++) L b->s[k][l] = si[k][l];
+  for (int k = 0; k < 6; k++) L b->r[k][l] = r[k][l];
+  L b->ok[l] = ok[l];
+}
+
+// back substitution of a block, the parents' updates in dyp: dl = S^-1 (r + [dx_p; G dth_p]),
+// dy = H^-1 (-g + [dl_s; dl_s x E + G^T dl_b])
+PROF_NOINLINE SIM_INLINE_PROF void back_kernel(sim_blk* restrict b, lane* restrict dyp) {
+  lane *g = b->gm, *e = b->e;
+  lane v[6], tv[6], lxe[3];
+  for (int i = 0; i < 3; i++) {
+    L v[i][l] = b->r[i][l] + dyp[i][l];
+    L v[3 + i][l] = b->r[3 + i][l] + g[3 * i][l] * dyp[3][l] + g[3 * i + 1][l] * dyp[4][l] + g[3 * i + 2][l] * dyp[5][l];
+  }
+  mul6s(b->s, v, b->dl);
+  lane* dl = b->dl;
+  L {
+    lxe[0][l] = dl[1][l] * e[2][l] - dl[2][l] * e[1][l];
+    lxe[1][l] = dl[2][l] * e[0][l] - dl[0][l] * e[2][l];
+    lxe[2][l] = dl[0][l] * e[1][l] - dl[1][l] * e[0][l];
+  }
+  for (int k = 0; k < 3; k++) {
+    L tv[k][l] = -b->g[k][l] + dl[k][l];
+    L tv[3 + k][l] = -b->g[3 + k][l] + lxe[k][l] + g[k][l] * dl[3][l] + g[3 + k][l] * dl[4][l] + g[6 + k][l] * dl[5][l];
+  }
+  mul6s(b->h, tv, b->dy);
+}
+
+// ---------------------------------------------------------------------------------------------
+// one Newton iteration
+
+// a spare node hangs only from the joint that broke onto it (lane l of block b): solve it now,
+// H = (m + ties) I + S^-1_A, dx = -H^-1 g; 0 when singular
+static int solve_spare(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
+                       const sim_blk* b, int l, int t) {
+  const sim_plan* p = &w->plan;
+  int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;
+  double h = ctx->h, h2 = h * h;
+  double mass = d->node_mass[n] + h * w->node_drag[n] + p->tie_h[p->nslot + k];
+  double a[9] = {b->dh[S00][l] + mass, b->dh[S01][l],        b->dh[S02][l],
+                 b->dh[S01][l],        b->dh[S11][l] + mass, b->dh[S12][l],
+                 b->dh[S02][l],        b->dh[S12][l],        b->dh[S22][l] + mass};
+  double ms = d->node_mass[n] + h * w->node_drag[n];
+  vd_vec3 dx = vd_sub(vd_sub(d->node_pos[n], w->node_prev[n]), vd_scale(d->node_vel[n], h));
+  vd_vec3 f = w->node_fext[n];
+  const double* tg = p->tie_g + 3 * (p->nslot + k);
+  vd_vec3 g = vd_v3(ms * dx.x - h2 * f.x + tg[0] + b->dg[0][l], ms * dx.y - h2 * f.y + tg[1] + b->dg[1][l],
+                    ms * dx.z - h2 * f.z + tg[2] + b->dg[2][l]);
+  vd_vec3 x;
+  if (!m3_solve_spd(a, vd_scale(g, -1), &x)) return 0;
+  double* o = p->spare_dy + 3 * k;
+  o[0] = x.x, o[1] = x.y, o[2] = x.z;
+  return 1;
+}
+
+// forward elimination of blocks [b0, b1); 0 when a factorisation failed
+SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim_step_ctx* ctx, int b0, int b1) {
+  sim_plan* p = &w->plan;
+  for (int bi = b0; bi < b1; bi++) {
+    sim_blk* b = &p->blk[bi];
+    sim_in in;
+    in.st = &p->stat[bi];
+    for (int l = 0; l < SIM_W; l++) gather_in(m, d, w, ctx, &in, l, bi * SIM_W + l);
+    eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
+    for (int l = 0; l < SIM_W; l++) {
+      int s = bi * SIM_W + l;
+      if (p->slot_seg[s] >= 0) gather_lane(d, p, b, l, s);
+    }
+    if (p->tip_block[bi])
+      forward_kernel(b, 1);
+    else
+      forward_kernel(b, 0);
+    for (int l = 0; l < SIM_W; l++) {
+      int t = p->slot_seg[bi * SIM_W + l];
+      if (t < 0) continue;
+      if (!(b->ok[l] > 0)) return 0;
+      if (d->seg_broken[t] && !solve_spare(m, d, w, ctx, b, l, t)) return 0;
+    }
+  }
+  return 1;
+}
+
+// back substitution of blocks [b0, b1) in reverse
+SIM_CLONES static void back_range(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, int b0, int b1) {
+  sim_plan* p = &w->plan;
+  lane dyp[6];
+  for (int bi = b1 - 1; bi >= b0; bi--) {
+    sim_blk* b = &p->blk[bi];
+    for (int l = 0; l < SIM_W; l++) {
+      int s = bi * SIM_W + l, t = p->slot_seg[s], ps = p->par_slot[s];
+      for (int k = 0; k < 6; k++) dyp[k][l] = 0;
+      if (t < 0) continue;
+      if (d->seg_broken[t]) {
+        const double* o = p->spare_dy + 3 * (m->seg_spare[t] - m->nnode);
+        dyp[0][l] = o[0], dyp[1][l] = o[1], dyp[2][l] = o[2];
+      } else if (ps >= 0) {
+        const sim_blk* pb = &p->blk[ps / SIM_W];
+        for (int k = 0; k < 6; k++) dyp[k][l] = pb->dy[k][ps % SIM_W];
+      }
+    }
+    back_kernel(b, dyp);
+  }
+}
+
+// trust region: a Newton update that turns a frame by more than SIM_MAX_TURN or moves a
+// node by more than SIM_MAX_MOVE rest lengths of its segment is scaled down as a whole (the
+// linearisation means nothing that far out; from there a full update diverges). Corrections
+// of a light node's prediction reach a few rest lengths in normal runs; these do not.
+SIM_CLONES static double trust_scale(const sim_plan* p) {
+  double turn2 = 0, move2 = 0;  // largest squared turn and squared move in rest lengths
+  for (int bi = 0; bi < p->nblock; bi++) {
+    const sim_blk* b = &p->blk[bi];
+    lane tu, mo;
+    L tu[l] = b->dy[3][l] * b->dy[3][l] + b->dy[4][l] * b->dy[4][l] + b->dy[5][l] * b->dy[5][l];
+    L mo[l] = (b->dy[0][l] * b->dy[0][l] + b->dy[1][l] * b->dy[1][l] + b->dy[2][l] * b->dy[2][l]) / (b->l0[l] * b->l0[l]);
+    for (int l = 0; l < SIM_W; l++) {
+      if (p->slot_seg[bi * SIM_W + l] < 0) continue;
+      if (tu[l] > turn2) turn2 = tu[l];
+      if (mo[l] > move2) move2 = mo[l];
+    }
+  }
+  double scale = 1, turn = sqrt(turn2), move = sqrt(move2);
+  if (turn > SIM_MAX_TURN) scale = SIM_MAX_TURN / turn;
+  if (move * scale > SIM_MAX_MOVE) scale = SIM_MAX_MOVE / move;
+  return scale;
+}
+
+// apply the update scaled by scale: positions, frames, multipliers (stretch rows back to the
+// material frame: dlambda_s = l0 R^T dl^)
+SIM_CLONES static void apply_blocks(const vd_sim_model* m, vd_sim_data* d, sim_plan* p, double scale, int b0, int b1) {
+  for (int bi = b0; bi < b1; bi++) {
+    sim_blk* b = &p->blk[bi];
+    lane v[3], need, ls[3];
+    for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
+    qrot_lanes(b->qt, v, need);
+    for (int k = 0; k < 3; k++)
+      L ls[k][l] = scale * (b->l0[l] * (b->rt[k][l] * b->dl[0][l] + b->rt[3 + k][l] * b->dl[1][l] + b->rt[6 + k][l] * b->dl[2][l]));
+    for (int l = 0; l < SIM_W; l++) {
+      int t = p->slot_seg[bi * SIM_W + l];
+      if (t < 0) continue;
+      int n = m->seg_node[2 * t + 1];
+      vd_vec3* x = &d->node_pos[n];
+      x->x += scale * b->dy[0][l], x->y += scale * b->dy[1][l], x->z += scale * b->dy[2][l];
+      d->seg_quat[t] = need[l] > 0 ? quat_rotate_by(d->seg_quat[t], vd_v3(v[0][l], v[1][l], v[2][l]))
+                                   : (vd_quat){b->qt[0][l], b->qt[1][l], b->qt[2][l], b->qt[3][l]};
+      double* lam = d->seg_lambda + 6 * t;
+      for (int k = 0; k < 3; k++) lam[k] += ls[k][l];
+      if (!d->seg_broken[t] && m->seg_parent[t] >= 0)
+        for (int k = 0; k < 3; k++) lam[3 + k] += scale * b->dl[3 + k][l];
+      else
+        lam[3] = lam[4] = lam[5] = 0;
+    }
   }
 }
 
 // one Newton iteration; returns 0 when a factorisation failed (state left unchanged)
 static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim_step_ctx* ctx) {
-  double h = ctx->h, h2 = h * h, gam = ctx->gamma;
+  sim_plan* p = &w->plan;
+  double h2 = ctx->h * ctx->h;
   int nseg = m->nseg;
-  // linearise every joint at the current state
-  for (int t = 0; t < nseg; t++)
-    if (!(m->seg_flags[t] & VD_SIM_FIXED)) sim_joint_eval(m, d, t, &w->joint[t]);
-  init_bodies(m, d, w, h);
-  // g -= J^T lambda for every joint, on its own body and its parent body
-  for (int t = 0; t < nseg; t++) {
-    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    const sim_joint* j = &w->joint[t];
-    const double* lam = d->seg_lambda + 6 * t;
-    vd_vec3 ls = vd_v3(lam[0], lam[1], lam[2]), lb = vd_v3(lam[3], lam[4], lam[5]);
-    vd_vec3 ta = m3_tmul_v(j->a, ls), tb = vd_add(m3_tmul_v(j->b, ls), m3_tmul_v(j->g, lb));
-    double* g = w->gb + 6 * t;
-    g[0] -= ta.x, g[1] -= ta.y, g[2] -= ta.z, g[3] -= tb.x, g[4] -= tb.y, g[5] -= tb.z;
-    if (j->parent_body >= 0) {
-      double* gp = w->gb + 6 * j->parent_body;
-      vd_vec3 tg = m3_tmul_v(j->g, lb);
-      gp[0] += ta.x, gp[1] += ta.y, gp[2] += ta.z;
-      if (j->parent_body < nseg) gp[3] += tg.x, gp[4] += tg.y, gp[5] += tg.z;
-    }
-  }
-  // ties are leaf joints of the body that owns their node: H += I / alpha~, g += (c + alpha~ l) / alpha~ - l
+  // ties are leaf joints of the body that owns their node: H += I / alpha~, g += c / alpha~
+  int nts = p->nslot + m->nspare;
+  memset(p->tie_h, 0, (size_t)nts * sizeof(double));
+  memset(p->tie_g, 0, (size_t)nts * 3 * sizeof(double));
   int ntie = sim_tie_count(m, d);
   for (int k = 0; k < ntie; k++) {
     int n;
     vd_vec3 target;
     double comp;
     sim_tie_get(m, d, k, &n, &target, &comp);
-    int b = node_body(m, d, n);
-    if (b < 0) continue;
+    int s = tie_slot(m, d, p, n);
+    if (s < 0) continue;
     double at = comp / h2;
-    double* lam = w->tie_lambda + 3 * k;
     vd_vec3 cc = vd_sub(d->node_pos[n], target);
-    double* hb = w->h + 36 * b;
-    double* g = w->gb + 6 * b;
-    hb[0] += 1 / at, hb[7] += 1 / at, hb[14] += 1 / at;
-    // g_body -= lambda (J = I), then g' = g + (c + alpha~ lambda) / alpha~ = g + c / alpha~ + lambda
-    g[0] += cc.x / at, g[1] += cc.y / at, g[2] += cc.z / at;
-    (void)lam;
+    p->tie_h[s] += 1 / at;
+    p->tie_g[3 * s] += cc.x / at, p->tie_g[3 * s + 1] += cc.y / at, p->tie_g[3 * s + 2] += cc.z / at;
   }
-  // forward elimination: children before parents; h and s end up holding inverses. The
-  // Jacobians are used block by block: J_c = [[a, b], [0, g]], J_p = [[-a, 0], [0, -g]].
-  for (int oi = 0; oi < nseg; oi++) {
-    int t = m->seg_order[oi];
-    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    const sim_joint* j = &w->joint[t];
-    const double *ja = j->a, *jb = j->b, *jg = j->g;
-    double* hb = w->h + 36 * t;
-    double* g = w->gb + 6 * t;
-    double hi[36];
-    if (!inv_spd(hb, hi)) return 0;
-    memcpy(hb, hi, sizeof hi);
-    // P = J_c H^-1, then S = P J_c^T
-    double pm[36], sm[36];
-    for (int i = 0; i < 3; i++)
-      for (int c = 0; c < 6; c++) {
-        double u0 = 0, u1 = 0;
-        for (int k = 0; k < 3; k++) {
-          u0 += ja[3 * i + k] * hi[6 * k + c] + jb[3 * i + k] * hi[6 * (3 + k) + c];
-          u1 += jg[3 * i + k] * hi[6 * (3 + k) + c];
-        }
-        pm[6 * i + c] = u0;
-        pm[6 * (3 + i) + c] = u1;
-      }
-    for (int i = 0; i < 6; i++) {
-      const double* pr = pm + 6 * i;
-      for (int c = 0; c < 3; c++) {
-        sm[6 * i + c] = pr[0] * ja[3 * c] + pr[1] * ja[3 * c + 1] + pr[2] * ja[3 * c + 2] + pr[3] * jb[3 * c] +
-                        pr[4] * jb[3 * c + 1] + pr[5] * jb[3 * c + 2];
-        sm[6 * i + 3 + c] = pr[3] * jg[3 * c] + pr[4] * jg[3 * c + 1] + pr[5] * jg[3 * c + 2];
-      }
-    }
-    // r = -c' + J_c H^-1 g = -c' + P g, with c' and alpha~' divided by 1 + gamma (damping)
-    const double* lam = d->seg_lambda + 6 * t;
-    const double* cp = w->c_prev + 6 * t;
-    double* r = w->r + 6 * t;
-    for (int i = 0; i < 6; i++) {
-      double at = j->alpha[i] / h2;
-      double cv = j->c[i] + at * lam[i] + gam * (j->c[i] - cp[i]);
-      double pg = 0;
-      for (int k = 0; k < 6; k++) pg += pm[6 * i + k] * g[k];
-      sm[6 * i + i] += at / (1 + gam);
-      r[i] = -cv / (1 + gam) + pg;
-    }
-    double* s = w->s + 36 * t;
-    if (!inv_spd(sm, s)) return 0;
-    // parent body: H_p += J_p^T S^-1 J_p, g_p -= J_p^T S^-1 r
-    int pb = j->parent_body;
-    if (pb < 0) continue;
-    int spare = pb >= nseg;
-    double* hp = w->h + 36 * pb;
-    double* gp = w->gb + 6 * pb;
-    double sa[9], blk[9];
-    // block (0,0): a^T S00 a
-    for (int i = 0; i < 3; i++)
-      for (int c = 0; c < 3; c++)
-        sa[3 * i + c] = s[6 * i] * ja[c] + s[6 * i + 1] * ja[3 + c] + s[6 * i + 2] * ja[6 + c];
-    for (int i = 0; i < 3; i++)
-      for (int c = 0; c < 3; c++) {
-        blk[3 * i + c] = ja[i] * sa[c] + ja[3 + i] * sa[3 + c] + ja[6 + i] * sa[6 + c];
-        hp[6 * i + c] += blk[3 * i + c];
-      }
-    double sr[6];
-    for (int i = 0; i < 6; i++) {
-      double v = 0;
-      for (int k = 0; k < 6; k++) v += s[6 * i + k] * r[k];
-      sr[i] = v;
-    }
-    for (int i = 0; i < 3; i++) gp[i] += ja[i] * sr[0] + ja[3 + i] * sr[1] + ja[6 + i] * sr[2];
-    if (!spare) {
-      // blocks (0,1) = a^T S01 g and (1,1) = g^T S11 g
-      double sg[9];
-      for (int i = 0; i < 3; i++)
-        for (int c = 0; c < 3; c++)
-          sg[3 * i + c] = s[6 * i + 3] * jg[c] + s[6 * i + 4] * jg[3 + c] + s[6 * i + 5] * jg[6 + c];
-      for (int i = 0; i < 3; i++)
-        for (int c = 0; c < 3; c++) {
-          double v = ja[i] * sg[c] + ja[3 + i] * sg[3 + c] + ja[6 + i] * sg[6 + c];
-          hp[6 * i + 3 + c] += v;
-          hp[6 * (3 + c) + i] += v;
-        }
-      for (int i = 0; i < 3; i++)
-        for (int c = 0; c < 3; c++)
-          sg[3 * i + c] = s[6 * (3 + i) + 3] * jg[c] + s[6 * (3 + i) + 4] * jg[3 + c] + s[6 * (3 + i) + 5] * jg[6 + c];
-      for (int i = 0; i < 3; i++)
-        for (int c = 0; c < 3; c++)
-          hp[6 * (3 + i) + 3 + c] += jg[i] * sg[c] + jg[3 + i] * sg[3 + c] + jg[6 + i] * sg[6 + c];
-      for (int i = 0; i < 3; i++) gp[3 + i] += jg[i] * sr[3] + jg[3 + i] * sr[4] + jg[6 + i] * sr[5];
-    } else {
-      // a spare body hangs only from this joint: solve it now as a root
-      double hs[36];
-      if (!inv_spd(hp, hs)) return 0;
-      memcpy(hp, hs, sizeof hs);
-      double ng[6];
-      for (int i = 0; i < 6; i++) ng[i] = -gp[i];
-      mv6(hs, ng, w->dy + 6 * pb);
-    }
-  }
-  // back substitution: parents before children
-  for (int oi = nseg - 1; oi >= 0; oi--) {
-    int t = m->seg_order[oi];
-    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    const sim_joint* j = &w->joint[t];
-    const double *ja = j->a, *jb = j->b, *jg = j->g;
-    double* dl = w->dl + 6 * t;
-    double* dy = w->dy + 6 * t;
-    double rr[6];
-    memcpy(rr, w->r + 6 * t, sizeof rr);
-    int pb = j->parent_body;
-    if (pb >= 0) {
-      // rr = r - J_p dy_p = r + [a dy_p0; g dy_p1]
-      const double* dp = w->dy + 6 * pb;
-      for (int i = 0; i < 3; i++) {
-        rr[i] += ja[3 * i] * dp[0] + ja[3 * i + 1] * dp[1] + ja[3 * i + 2] * dp[2];
-        if (pb < nseg) rr[3 + i] += jg[3 * i] * dp[3] + jg[3 * i + 1] * dp[4] + jg[3 * i + 2] * dp[5];
-      }
-    }
-    mv6(w->s + 36 * t, rr, dl);
-    // dy = H^-1 (-g + J_c^T dl), J_c^T dl = [a^T dl0; b^T dl0 + g^T dl1]
-    const double* g = w->gb + 6 * t;
-    double v[6];
-    for (int i = 0; i < 3; i++) {
-      v[i] = -g[i] + ja[i] * dl[0] + ja[3 + i] * dl[1] + ja[6 + i] * dl[2];
-      v[3 + i] = -g[3 + i] + jb[i] * dl[0] + jb[3 + i] * dl[1] + jb[6 + i] * dl[2] + jg[i] * dl[3] +
-                 jg[3 + i] * dl[4] + jg[6 + i] * dl[5];
-    }
-    mv6(w->h + 36 * t, v, dy);
-  }
-  // trust region: a Newton update that turns a frame by more than SIM_MAX_TURN or moves a
-  // node by more than SIM_MAX_MOVE rest lengths of its segment is scaled down as a whole (the
-  // linearisation means nothing that far out; from there a full update diverges). Corrections
-  // of a light node's prediction reach a few rest lengths in normal runs; these do not.
+  sim_stage(d, VD_SIM_STAGE_EVAL, ctx->tstage);
+  // forward elimination (with each block's linearisation), then back substitution
   double scale = 1;
+  if (p->nthread <= 1) {
+    if (!forward_range(m, d, w, ctx, 0, p->nblock)) return 0;
+    sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
+    back_range(m, d, w, 0, p->nblock);
+    scale = trust_scale(p);
+    apply_blocks(m, d, p, scale, 0, p->nblock);
+  } else {
+    // each thread its subtrees, then one thread the top part; back substitution the other way
+    // round; the update by blocks
+    int nt = p->nthread, ok = 1;
+#pragma omp parallel num_threads(nt)
+    {
+      int team = omp_get_num_threads(), me = omp_get_thread_num(), mine = 1;
+      for (int k = me; k < nt; k += team) mine &= forward_range(m, d, w, ctx, p->part[k], p->part[k + 1]);
+      if (!mine) {
+#pragma omp atomic write
+        ok = 0;
+      }
+#pragma omp barrier
+#pragma omp single
+      {
+        if (ok && !forward_range(m, d, w, ctx, p->part[nt], p->nblock)) ok = 0;
+        if (ok) back_range(m, d, w, p->part[nt], p->nblock);
+      }
+      if (ok) {
+        for (int k = me; k < nt; k += team) back_range(m, d, w, p->part[k], p->part[k + 1]);
+#pragma omp barrier
+#pragma omp single
+        scale = trust_scale(p);
+        int per = (p->nblock + team - 1) / team, b0 = me * per, b1 = b0 + per < p->nblock ? b0 + per : p->nblock;
+        if (b0 < b1) apply_blocks(m, d, p, scale, b0, b1);
+      }
+    }
+    if (!ok) return 0;
+    sim_stage(d, VD_SIM_STAGE_FACTOR, ctx->tstage);
+  }
   for (int t = 0; t < nseg; t++) {
-    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    const double* dy = w->dy + 6 * t;
-    double turn = sqrt(dy[3] * dy[3] + dy[4] * dy[4] + dy[5] * dy[5]);
-    double move = sqrt(dy[0] * dy[0] + dy[1] * dy[1] + dy[2] * dy[2]) / m->seg_len0[t];
-    if (turn * scale > SIM_MAX_TURN) scale = SIM_MAX_TURN / turn;
-    if (move * scale > SIM_MAX_MOVE) scale = SIM_MAX_MOVE / move;
+    if (!d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;
+    int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;
+    const double* o = p->spare_dy + 3 * k;
+    d->node_pos[n] = vd_add(d->node_pos[n], vd_v3(scale * o[0], scale * o[1], scale * o[2]));
   }
-  if (scale < 1) {
-    for (int k = 0; k < 6 * (nseg + m->nspare); k++) w->dy[k] *= scale;
-    for (int k = 0; k < 6 * nseg; k++) w->dl[k] *= scale;
-  }
-  // apply: positions, frames, multipliers
-  for (int t = 0; t < nseg; t++) {
-    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    const double* dy = w->dy + 6 * t;
-    int n = m->seg_node[2 * t + 1];
-    d->node_pos[n] = vd_add(d->node_pos[n], vd_v3(dy[0], dy[1], dy[2]));
-    d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_v3(dy[3], dy[4], dy[5]));
-    double* lam = d->seg_lambda + 6 * t;
-    const double* dl = w->dl + 6 * t;
-    for (int i = 0; i < 6; i++) lam[i] += dl[i];
-    if (!w->joint[t].bend) lam[3] = lam[4] = lam[5] = 0;
-  }
-  for (int k = 0; k < m->nspare; k++) {
-    int n = m->nnode + k;
-    if (d->node_mass[n] <= 0) continue;
-    const double* dy = w->dy + 6 * (m->nseg + k);
-    d->node_pos[n] = vd_add(d->node_pos[n], vd_v3(dy[0], dy[1], dy[2]));
-  }
-  // tie multipliers: dl = -(c + alpha~ l + dx) / alpha~
+  // tie multipliers: the node has moved already, the new constraint value is c + dx
   for (int k = 0; k < ntie; k++) {
     int n;
     vd_vec3 target;
     double comp;
     sim_tie_get(m, d, k, &n, &target, &comp);
-    int b = node_body(m, d, n);
-    if (b < 0) continue;
-    // the node has moved already: the new constraint value is c + dx
+    if (tie_slot(m, d, p, n) < 0) continue;
     vd_vec3 cc = vd_sub(d->node_pos[n], target);
     double at = comp / h2;
     double* lam = w->tie_lambda + 3 * k;
     lam[0] = -cc.x / at, lam[1] = -cc.y / at, lam[2] = -cc.z / at;
   }
+  sim_stage(d, VD_SIM_STAGE_SOLVE, ctx->tstage);
   return 1;
 }
 
 int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c) {
   sim_work* w = (sim_work*)d->work;
+  // the schedule is cut for opt.threads (rebuilt when that changes)
+  int nt = m->opt.threads < 1 ? 1 : m->opt.threads > SIM_MAX_THREADS ? SIM_MAX_THREADS : m->opt.threads;
+  if (w->plan.nthread != nt && sim_plan_build(m, nt, &w->plan)) {
+    sim_warn(d, VD_SIM_WARN_ARENA);
+    sim_plan_build(m, 1, &w->plan);  // fall back to one thread
+    if (!w->plan.mem) return 0;
+  }
   int iters = c->statics && m->opt.iterations < 4 ? 4 : m->opt.iterations;
   for (int it = 0; it < iters; it++) {
     if (!iterate(m, d, w, c)) return 0;
     if (c->contacts && c->ncontact) sim_contacts_project(m, d, c->contacts, c->ncontact, c->h);
+    sim_stage(d, VD_SIM_STAGE_PROJECT, c->tstage);
   }
   return 1;
 }

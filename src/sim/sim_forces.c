@@ -18,67 +18,102 @@ vd_vec3 sim_wind_at(const vd_sim_opt* o, double t) {
 
 // velocity of a node (zero when kinematic)
 static vd_vec3 node_v(const vd_sim_model* m, const vd_sim_data* d, int n) {
-  return sim_node_w(m, d, n) > 0 ? d->node_vel[n] : vd_v3(0, 0, 0);
+  return sim_node_moves(m, d, n) ? d->node_vel[n] : vd_v3(0, 0, 0);
 }
 
-void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
+typedef struct forces_ctx {
+  const vd_sim_model* m;
+  vd_sim_data* d;
+  sim_work* w;
+  vd_vec3 wind;
+  double q;  // rho_air / 2
+} forces_ctx;
+
+// gravity and the caller's loads on nodes; spheres' drag on their centre node
+static void node_loads(void* p, int k, int i0, int i1) {
+  const forces_ctx* c = p;
+  const vd_sim_model* m = c->m;
   const vd_sim_opt* o = &m->opt;
-  int nn = m->nnode_all;
-  // gravity and the caller's loads
-  for (int n = 0; n < nn; n++) {
-    double mass = d->node_mass[n];
-    w->node_fext[n] = sim_node_w(m, d, n) > 0 ? vd_add(vd_scale(o->gravity, mass), d->node_force[n])
-                                              : vd_v3(0, 0, 0);
+  vd_sim_data* d = c->d;
+  sim_work* w = c->w;
+  (void)k;
+  for (int n = i0; n < i1; n++) {
+    int moves = sim_node_moves(m, d, n);
+    w->node_fext[n] = moves ? vd_add(vd_scale(o->gravity, d->node_mass[n]), d->node_force[n]) : vd_v3(0, 0, 0);
+    w->node_drag[n] = 0;
+    if (!moves) continue;
+    // Stokes drag (numerical damping only)
+    if (o->stokes_viscosity > 0) {
+      double sc = 6 * VD_PI * o->stokes_viscosity * m->node_radius[n];
+      w->node_fext[n] = vd_madd(w->node_fext[n], d->node_vel[n], -sc);
+      w->node_drag[n] += sc;
+    }
+    if (!o->drag || m->node_sphere[n] <= 0) continue;
+    vd_vec3 u = vd_sub(c->wind, d->node_vel[n]);
+    int o2 = m->node_owner[n];
+    double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
+    double kq = c->q * cd * VD_PI * r * r * v_norm(u);
+    w->node_fext[n] = vd_madd(w->node_fext[n], u, kq);
+    w->node_drag[n] += 2 * kq;
   }
-  for (int t = 0; t < m->nseg; t++) w->seg_text[t] = d->seg_torque[t];
-  memset(w->node_drag, 0, (size_t)nn * sizeof(double));
-  // Stokes drag (numerical damping only)
-  if (o->stokes_viscosity > 0)
-    for (int n = 0; n < nn; n++)
-      if (sim_node_w(m, d, n) > 0) {
-        double c = 6 * VD_PI * o->stokes_viscosity * m->node_radius[n];
-        w->node_fext[n] = vd_madd(w->node_fext[n], d->node_vel[n], -c);
-        w->node_drag[n] += c;
-      }
-  if (!o->drag) return;
-  vd_vec3 wind = sim_wind_at(o, d->time);
-  double q = 0.5 * o->air_density;
-  // segments: cylinders in cross flow, leaf laminae as plates
-  for (int t = 0; t < m->nseg; t++) {
+}
+
+// each segment's drag force, damping and its start node's share into seg_drag: cylinders in
+// cross flow, leaf laminae as plates
+static void seg_drag(void* p, int k, int t0, int t1) {
+  const forces_ctx* c = p;
+  const vd_sim_model* m = c->m;
+  const vd_sim_data* d = c->d;
+  sim_work* w = c->w;
+  double q = c->q;
+  (void)k;
+  for (int t = t0; t < t1; t++) {
+    double* sd = w->seg_drag + 5 * t;
+    sd[4] = -1;  // no drag
     if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
     int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
-    double wa = sim_node_w(m, d, na), wb = sim_node_w(m, d, nb);
-    if (wa <= 0 && wb <= 0) continue;
-    vd_vec3 u = vd_sub(wind, vd_scale(vd_add(node_v(m, d, na), node_v(m, d, nb)), 0.5));
+    int ma = sim_node_moves(m, d, na), mb = sim_node_moves(m, d, nb);
+    if (!ma && !mb) continue;
+    vd_vec3 u = vd_sub(c->wind, vd_scale(vd_add(node_v(m, d, na), node_v(m, d, nb)), 0.5));
     vd_quat qt = d->seg_quat[t];
     vd_vec3 d3 = quat_d3(qt);
     vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
     double area = 2 * m->seg_radius[t] * m->seg_len0[t];
-    vd_vec3 f = vd_scale(up, q * m->seg_cd[t] * area * v_norm(up));
+    double kq = q * m->seg_cd[t] * area * v_norm(up);
+    vd_vec3 f = vd_scale(up, kq);
     // damping of F = k |u| u: dF/du has eigenvalues k |u| and 2 k |u|; the larger is taken
-    double c = 2 * q * m->seg_cd[t] * area * v_norm(up);
+    double cc = 2 * kq;
     const double* ln = m->seg_leaf_normal + 3 * t;
     if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
       vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
       double a = v_norm(nw);
       double un = vd_dot(u, nw) / a;
       f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
-      c += 2 * q * m->leaf_cd * a * fabs(un);
+      cc += 2 * q * m->leaf_cd * a * fabs(un);
     }
     // half to each end that moves (all of it when the other end is held)
-    double sa = wa > 0 ? (wb > 0 ? 0.5 : 1.0) : 0.0;
+    sd[0] = f.x, sd[1] = f.y, sd[2] = f.z, sd[3] = cc, sd[4] = ma ? (mb ? 0.5 : 1.0) : 0.0;
+  }
+}
+
+void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {
+  const vd_sim_opt* o = &m->opt;
+  int nt = sim_threads(m);
+  forces_ctx c = {m, d, w, sim_wind_at(o, d->time), 0.5 * o->air_density};
+  for (int t = 0; t < m->nseg; t++) w->seg_text[t] = d->seg_torque[t];
+  sim_parallel(nt, m->nnode_all, node_loads, &c);
+  if (!o->drag) return;
+  // the segments' drag in parallel, added to their nodes in order
+  sim_parallel(nt, m->nseg, seg_drag, &c);
+  for (int t = 0; t < m->nseg; t++) {
+    const double* sd = w->seg_drag + 5 * t;
+    double sa = sd[4], cc = sd[3];
+    if (sa < 0) continue;
+    int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
+    vd_vec3 f = vd_v3(sd[0], sd[1], sd[2]);
     w->node_fext[na] = vd_madd(w->node_fext[na], f, sa);
     w->node_fext[nb] = vd_madd(w->node_fext[nb], f, 1.0 - sa);
-    w->node_drag[na] += sa * c;
-    w->node_drag[nb] += (1.0 - sa) * c;
-  }
-  // spheres (fruits, buds) on their centre node
-  for (int n = 0; n < nn; n++) {
-    if (m->node_sphere[n] <= 0 || sim_node_w(m, d, n) <= 0) continue;
-    vd_vec3 u = vd_sub(wind, d->node_vel[n]);
-    int o2 = m->node_owner[n];
-    double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
-    w->node_fext[n] = vd_madd(w->node_fext[n], u, q * cd * VD_PI * r * r * v_norm(u));
-    w->node_drag[n] += 2 * q * cd * VD_PI * r * r * v_norm(u);
+    w->node_drag[na] += sa * cc;
+    w->node_drag[nb] += (1.0 - sa) * cc;
   }
 }

@@ -90,12 +90,43 @@ static inline vd_vec3 q_rotate(vd_quat q, vd_vec3 v) {
 }
 static inline double v_norm(vd_vec3 a) { return sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
 
+// Series of the maps for small angles, shared by the scalar maps below and the direct solver's
+// lane code (same operations, same bytes). For a rotation vector of squared angle a2 <= 0.01:
+// cos(a / 2) and sin(a / 2) / a (to 1e-20).
+static inline void sim_exp_series(double a2, double* c, double* k) {
+  double x2 = 0.25 * a2;
+  *c = 1 - x2 * (1.0 / 2 - x2 * (1.0 / 24 - x2 * (1.0 / 720 - x2 * (1.0 / 40320 - x2 * (1.0 / 3628800)))));
+  *k = 0.5 * (1 - x2 * (1.0 / 6 - x2 * (1.0 / 120 - x2 * (1.0 / 5040 - x2 * (1.0 / 362880 - x2 * (1.0 / 39916800))))));
+}
+// atan(t) / t for t2 = t^2 <= 0.01 (to 1e-19)
+static inline double sim_atan_ratio(double t2) {
+  double p = 1.0 / 17;
+  p = 1.0 / 15 - t2 * p, p = 1.0 / 13 - t2 * p, p = 1.0 / 11 - t2 * p, p = 1.0 / 9 - t2 * p;
+  p = 1.0 / 7 - t2 * p, p = 1.0 / 5 - t2 * p, p = 1.0 / 3 - t2 * p;
+  return 1.0 - t2 * p;
+}
+
 // rotation by the rotation vector v (exponential map)
-vd_quat quat_exp(vd_vec3 v);
+vd_quat quat_exp_big(vd_vec3 v);
+static inline vd_quat quat_exp(vd_vec3 v) {
+  double a2 = v.x * v.x + v.y * v.y + v.z * v.z, c, k;
+  if (!(a2 <= 0.01)) return quat_exp_big(v);
+  sim_exp_series(a2, &c, &k);  // below 0.1 rad (the steps' turns): no libm call
+  vd_quat q = {c, v.x * k, v.y * k, v.z * k};
+  return q;
+}
 // rotation vector of q (logarithm map), shortest (|angle| <= pi)
-vd_vec3 quat_log(vd_quat q);
+vd_vec3 quat_log_big(vd_quat q);
+static inline vd_vec3 quat_log(vd_quat q) {
+  if (q.w < 0) q.w = -q.w, q.x = -q.x, q.y = -q.y, q.z = -q.z;
+  double s2 = q.x * q.x + q.y * q.y + q.z * q.z, w2 = q.w * q.w;
+  if (!(q.w > 0 && s2 <= 0.01 * w2)) return quat_log_big(q);
+  // 2 atan2(s, w) / s = (2 / w) atan(t) / t, t = s / w <= 0.1
+  double k = 2 * sim_atan_ratio(s2 / w2) / q.w;
+  return vd_v3(q.x * k, q.y * k, q.z * k);
+}
 // q rotated by the world rotation vector v: exp(v) q, normalised
-vd_quat quat_rotate_by(vd_quat q, vd_vec3 v);
+static inline vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) { return q_normalize(q_mul(quat_exp(v), q)); }
 static inline double quat_dot(vd_quat a, vd_quat b) { return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline vd_vec3 quat_im(vd_quat q) { return vd_v3(q.x, q.y, q.z); }
 // d3 (z axis) of a frame
@@ -170,6 +201,81 @@ typedef struct sim_self {
 } sim_self;
 
 // ---------------------------------------------------------------------------------------------
+// the direct solver's schedule and blocks (sim_plan.c, sim_direct.c)
+
+#define SIM_W 8             // bodies eliminated side by side in one block (lanes: one AVX-512 vector)
+#define SIM_MAX_THREADS 64  // most threads one state's step may use
+
+// One block of SIM_W bodies, each field an array over the lanes (structure of arrays), so
+// the elimination's 6x6 and 3x3 block arithmetic runs lane-parallel (vectorised). A body is
+// one free segment: its end node and its frame (6 dofs); its joint is the segment's
+// stretch-shear rows (in world axes here) and its bend-twist rows with the parent. Symmetric
+// 6x6 matrices are stored as [A (3x3 upper: 00 01 02 11 12 22) | B (3x3 row-major) | D (upper)].
+typedef struct sim_blk {
+  double h[21][SIM_W];   // body matrix H, then its inverse
+  double s[21][SIM_W];   // joint Schur matrix S = J H^-1 J^T + alpha~', then its inverse
+  double g[6][SIM_W];    // body residual (position rows N s^2, rotation rows N m s^2)
+  double r[6][SIM_W];    // joint right-hand side
+  double e[3][SIM_W];    // segment vector x_end - x_start (m)
+  double gm[9][SIM_W];   // bend-twist Jacobian G (1/m, row-major)
+  double c[6][SIM_W];    // damped constraint values c': stretch rows in world axes (m), bend (1/m)
+  double al[9][SIM_W];   // damped compliances alpha~': stretch (upper 3x3, world), bend (diagonal)
+  double lf[6][SIM_W];   // the joint's multipliers: stretch as R lambda_s / l0 (world), bend
+  double mi[3][SIM_W];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib
+  double d3[3][SIM_W];   // the frame's d3
+  double dh[21][SIM_W];  // contribution J_p^T S^-1 J_p to the parent's H
+  double dg[6][SIM_W];   // contribution to the parent's g
+  double dy[6][SIM_W];   // body update (m, rad)
+  double dl[6][SIM_W];   // multiplier update (world stretch rows, bend rows)
+  double ok[SIM_W];      // 1 while both factorisations of the lane held
+  double qt[4][SIM_W];   // the frame at the linearisation
+  double rt[9][SIM_W];   // its rotation matrix
+  double l0[SIM_W];      // rest length (m)
+} sim_blk;
+
+// What a block's bodies and joints keep from the model (lane by lane), so that a step gathers
+// only the state. Padding lanes hold a unit body and joint.
+typedef struct sim_stat {
+  double q0[4][SIM_W];   // rest relative rotation of the bend-twist constraint
+  double cs[3][SIM_W];   // stretch-shear compliances
+  double cb[3][SIM_W];   // bend-twist compliances
+  double l0[SIM_W];      // rest length (m)
+  double lbar[SIM_W];    // Darboux length (m)
+  double ib[SIM_W];      // rotary inertia about d1, d2 (kg m^2)
+  double it[SIM_W];      // ... about d3
+} sim_stat;
+
+// The elimination schedule of a model for nthread threads: blocks in an order where every
+// body's children come in earlier blocks; thread k eliminates its subtrees' blocks
+// [part[k], part[k+1]), then one thread the top part [part[nthread], nblock). Each body sums
+// its children's contributions in the fixed order of kid_slot, so any schedule and any thread
+// count give the same bytes.
+typedef struct sim_plan {
+  int nbody, nblock, nslot;  // free segments, blocks, nblock * SIM_W
+  int nthread;               // threads the blocks are cut for
+  int part[SIM_MAX_THREADS + 2];
+  int* slot_seg;             // segment of each slot, -1 for padding (nslot)
+  int* seg_slot;             // slot of each segment, -1 when fixed (nseg)
+  int* par_slot;             // slot of the parent body, -1 when kinematic or padding (nslot)
+  int* kid_start;            // children of slot s: kid_slot[kid_start[s] .. kid_start[s + 1]) (nslot + 1)
+  int* kid_slot;             // (nbody)
+  unsigned char* tip_block;  // 1 when block b holds tips (no children) only (nblock)
+  double* tie_h;             // ties on each slot's node, then on each spare: sum of h^2 / compliance (nslot + nspare)
+  double* tie_g;             // ... and their residual sum c h^2 / compliance ((nslot + nspare) x 3)
+  double* spare_dy;          // update of each spare node this iteration (nspare x 3)
+  sim_blk* blk;              // the blocks (nblock, 64-byte aligned inside mem)
+  sim_stat* stat;            // their model data (nblock, 64-byte aligned)
+  void* mem;                 // one allocation for all of the above
+  size_t nbytes;             // its size
+} sim_plan;
+
+// Build the schedule of model m for nthread threads (1..SIM_MAX_THREADS) into p (freed and
+// replaced); VD_ERR_NOMEM when out of memory (p then empty).
+vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p);
+// Free a plan (an empty one is fine).
+void sim_plan_free(sim_plan* p);
+
+// ---------------------------------------------------------------------------------------------
 // solver scratch kept in vd_sim_data::work
 
 typedef struct sim_work {
@@ -178,18 +284,13 @@ typedef struct sim_work {
   vd_vec3* node_fext;   // total external force this step (N) (nnode_all)
   vd_vec3* seg_text;    // total external torque this step (N m) (nseg)
   double* node_drag;    // air drag damping -dF/dv of each node, taken implicitly (kg/s) (nnode_all)
+  double* seg_drag;     // each segment's drag force (N), damping (kg/s) and start node's share (nseg x 5)
   double* c_prev;       // constraint values at the start of the step (nseg x 6)
   double* lambda_save;  // multipliers before a statics step, to undo it (nseg x 6)
   int* spare_of;        // spare index -> segment (nspare)
-  // direct solver (bodies: nseg segments then nspare spares)
-  double* h;            // body matrices, then their inverses (nbody x 36)
-  double* gb;           // body right-hand sides (nbody x 6)
-  double* dy;           // body updates (nbody x 6)
-  double* s;            // inverses of the joint Schur matrices (nseg x 36)
-  double* r;            // joint right-hand sides (nseg x 6)
-  double* x;            // H_child^-1 J_child^T (nseg x 36)
-  double* dl;           // joint multiplier updates (nseg x 6)
-  sim_joint* joint;     // joints linearised this iteration (nseg)
+  // direct solver
+  sim_plan plan;        // its schedule and blocks
+
   double* tie_lambda;   // multipliers of model and user ties (ntie_all x 3)
   int cap_tie_lambda;   // capacity of tie_lambda (rows)
   int model_ties;       // stake ties of the model (the first rows)
@@ -214,7 +315,32 @@ typedef struct sim_step_ctx {
   struct sim_contact* contacts;  // contact candidates of this step
   int ncontact;                  // their count
   int last;                      // 1: the smallest substep, an overstretched state is kept
+  double* tstage;                // running timestamp of the stage profile (sim_stage)
 } sim_step_ctx;
+
+// Monotonic clock (s) for the stage profile.
+double sim_clock(void);
+// While d->profile is on: add the time since *t to stage s and set *t to now.
+static inline void sim_stage(vd_sim_data* d, vd_sim_stage s, double* t) {
+  if (!d->profile) return;
+  double now = sim_clock();
+  d->stage_seconds[s] += now - *t;
+  *t = now;
+}
+// The start of a timed span (0 when not profiling).
+static inline double sim_stage_start(const vd_sim_data* d) { return d->profile ? sim_clock() : 0.0; }
+
+// Threads of a state's step (opt.threads, at least 1), and a parallel loop over independent
+// elements with them: each element's arithmetic is the same on any thread, so the bytes do not
+// depend on the count (reductions are max or logical, which do not depend on the order).
+static inline int sim_threads(const vd_sim_model* m) {
+  return m->opt.threads < 1 ? 1 : m->opt.threads > SIM_MAX_THREADS ? SIM_MAX_THREADS : m->opt.threads;
+}
+// fn(ctx, chunk, i0, i1) over [0, n) cut into nchunk = min(nt, n / 256, SIM_MAX_THREADS)
+// contiguous chunks run by nt threads (at least one chunk; one chunk runs on the caller without
+// OpenMP); returns nchunk. Per-chunk results go to arrays indexed by chunk.
+typedef void (*sim_range_fn)(void* ctx, int chunk, int i0, int i1);
+int sim_parallel(int nt, int n, sim_range_fn fn, void* ctx);
 
 // Count one numerical warning of kind k (vd_sim_warning) in d->warning and d->nwarning.
 static inline void sim_warn(vd_sim_data* d, int k) {
@@ -227,6 +353,10 @@ static inline void sim_warn(vd_sim_data* d, int k) {
 int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
+// 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division
+static inline int sim_node_moves(const vd_sim_model* m, const vd_sim_data* d, int n) {
+  return !m->node_fixed[n] && d->node_mass[n] > 0;
+}
 // inverse mass of a node (0 when kinematic)
 static inline double sim_node_w(const vd_sim_model* m, const vd_sim_data* d, int n) {
   return m->node_fixed[n] || d->node_mass[n] <= 0 ? 0.0 : 1.0 / d->node_mass[n];

@@ -1,6 +1,22 @@
 // SPDX-License-Identifier: MIT
-// Small dense linear algebra (3x3, 6x6 Cholesky) and quaternion maps for the rod solvers.
+// Small dense linear algebra (3x3, 6x6 Cholesky) and quaternion maps for the rod solvers, and
+// the clock of the stage profile.
+#define _POSIX_C_SOURCE 199309L
+#include <time.h>
+
 #include "sim_internal.h"
+
+double sim_clock(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+const char* vd_sim_stage_name(vd_sim_stage s) {
+  static const char* names[VD_SIM_STAGE_COUNT] = {"forces", "predict", "contacts", "eval",    "factor",
+                                                  "solve",  "project", "velocity", "fracture"};
+  return s >= 0 && s < VD_SIM_STAGE_COUNT ? names[s] : "?";
+}
 
 int m3_solve_spd(const double* a, vd_vec3 b, vd_vec3* x) {
   // Cholesky of the 3x3 matrix, then two triangular solves
@@ -61,32 +77,18 @@ void m6_chol_solve(const double* l, double* b) {
   }
 }
 
-vd_quat quat_exp(vd_vec3 v) {
-  double a = v_norm(v);
-  vd_quat q;
-  if (a < 1e-8) {
-    // second-order series keeps the map smooth near zero
-    q.w = 1 - a * a / 8;
-    q.x = 0.5 * v.x, q.y = 0.5 * v.y, q.z = 0.5 * v.z;
-    return q_normalize(q);
-  }
-  double s = sin(0.5 * a) / a;
-  q.w = cos(0.5 * a);
-  q.x = v.x * s, q.y = v.y * s, q.z = v.z * s;
+vd_quat quat_exp_big(vd_vec3 v) {
+  double a = v_norm(v), k = sin(0.5 * a) / a;
+  vd_quat q = {cos(0.5 * a), v.x * k, v.y * k, v.z * k};
   return q;
 }
 
-vd_vec3 quat_log(vd_quat q) {
+vd_vec3 quat_log_big(vd_quat q) {
   if (q.w < 0) q.w = -q.w, q.x = -q.x, q.y = -q.y, q.z = -q.z;
   double s = sqrt(q.x * q.x + q.y * q.y + q.z * q.z);
   if (s < 1e-12) return vd_v3(2 * q.x, 2 * q.y, 2 * q.z);
-  double a = 2 * atan2(s, q.w);
-  double k = a / s;
+  double k = 2 * atan2(s, q.w) / s;
   return vd_v3(q.x * k, q.y * k, q.z * k);
-}
-
-vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) {
-  return q_normalize(q_mul(quat_exp(v), q));
 }
 
 vd_quat quat_between(vd_vec3 a, vd_vec3 b) {

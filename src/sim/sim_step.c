@@ -10,29 +10,142 @@ const char* vd_sim_warning_name(vd_sim_warning w) {
   return w >= 0 && w < VD_SIM_WARN_COUNT ? names[w] : "?";
 }
 
-// largest stretch strain |x_end - x_start| / l0 - 1 of the free segments (-)
-static double max_stretch(const vd_sim_model* m, const vd_sim_data* d) {
+// the per-element loops of a step, over ranges (sim_parallel runs them on opt.threads threads)
+typedef struct loop_ctx {
+  const vd_sim_model* m;
+  vd_sim_data* d;
+  sim_work* w;
+  double h, fl, damp;
+  int statics;
+  double r[SIM_MAX_THREADS];  // per-chunk results (largest squared stretch, move, or 1 if not finite)
+} loop_ctx;
+
+// largest squared stretch |x_end - x_start|^2 / l0^2 of the free segments
+static void stretch_range(void* p, int k, int t0, int t1) {
+  loop_ctx* c = p;
+  const vd_sim_model* m = c->m;
+  const vd_sim_data* d = c->d;
   double r2 = 0;
-  for (int t = 0; t < m->nseg; t++) {
+  for (int t = t0; t < t1; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
     vd_vec3 e = vd_sub(d->node_pos[m->seg_node[2 * t + 1]], d->node_pos[d->seg_start[t]]);
     double q = vd_dot(e, e) / (m->seg_len0[t] * m->seg_len0[t]);
     if (q > r2) r2 = q;
   }
-  return sqrt(r2) - 1;
+  c->r[k] = r2;
+}
+
+// largest of the chunks' results
+static double chunk_max(const loop_ctx* c, int nc) {
+  double r = 0;
+  for (int k = 0; k < nc; k++)
+    if (c->r[k] > r) r = c->r[k];
+  return r;
+}
+
+// largest stretch strain |x_end - x_start| / l0 - 1 of the free segments (-)
+static double max_stretch(const vd_sim_model* m, vd_sim_data* d) {
+  loop_ctx c = {m, d, (sim_work*)d->work, 0, 0, 0, 0, {0}};
+  return sqrt(chunk_max(&c, sim_parallel(sim_threads(m), m->nseg, stretch_range, &c))) - 1;
+}
+
+// 1 in r[k] when a position or a frame in the range is not finite (nodes and segments both by t)
+static void finite_range(void* p, int k, int i0, int i1) {
+  loop_ctx* c = p;
+  const vd_sim_model* m = c->m;
+  const vd_sim_data* d = c->d;
+  int bad = 0;
+  for (int i = i0; i < i1; i++) {
+    if (i < m->nnode_all) {
+      vd_vec3 x = d->node_pos[i];
+      bad |= !isfinite(x.x + x.y + x.z);
+    }
+    if (i < m->nseg) {
+      vd_quat q = d->seg_quat[i];
+      bad |= !isfinite(q.w + q.x + q.y + q.z);
+    }
+  }
+  c->r[k] = bad;
 }
 
 // does the state hold only finite numbers?
-static int finite_state(const vd_sim_model* m, const vd_sim_data* d) {
-  for (int i = 0; i < m->nnode_all; i++) {
-    vd_vec3 p = d->node_pos[i];
-    if (!isfinite(p.x + p.y + p.z)) return 0;
+static int finite_state(const vd_sim_model* m, vd_sim_data* d) {
+  loop_ctx c = {m, d, (sim_work*)d->work, 0, 0, 0, 0, {0}};
+  int n = m->nnode_all > m->nseg ? m->nnode_all : m->nseg;
+  return chunk_max(&c, sim_parallel(sim_threads(m), n, finite_range, &c)) == 0;
+}
+
+// the step's start for nodes: keep the positions, predict them (x += h v), and the largest move
+static void predict_nodes(void* p, int k, int i0, int i1) {
+  loop_ctx* c = p;
+  const vd_sim_model* m = c->m;
+  vd_sim_data* d = c->d;
+  sim_work* w = c->w;
+  double h = c->h, fl = c->fl, mv = 0;
+  for (int i = i0; i < i1; i++) {
+    w->node_prev[i] = d->node_pos[i];
+    if (c->statics) {
+      d->node_vel[i] = vd_v3(0, 0, 0);
+      continue;
+    }
+    if (!sim_node_moves(m, d, i)) continue;
+    vd_vec3 v = d->node_vel[i];
+    if (fl != 0) v = vd_madd(v, w->node_fext[i], fl / (d->node_mass[i] + h * w->node_drag[i]));
+    vd_vec3 x = vd_madd(d->node_pos[i], v, h);
+    vd_vec3 dx = vd_sub(x, w->node_prev[i]);
+    double s = vd_dot(dx, dx);
+    if (s > mv) mv = s;
+    d->node_pos[i] = x;
   }
-  for (int t = 0; t < m->nseg; t++) {
-    vd_quat q = d->seg_quat[t];
-    if (!isfinite(q.w + q.x + q.y + q.z)) return 0;
+  c->r[k] = mv;
+}
+
+// ... for frames: keep them, predict them (q = exp(h omega) q)
+static void predict_segs(void* p, int k, int t0, int t1) {
+  loop_ctx* c = p;
+  const vd_sim_model* m = c->m;
+  vd_sim_data* d = c->d;
+  sim_work* w = c->w;
+  double h = c->h, fl = c->fl;
+  (void)k;
+  for (int t = t0; t < t1; t++) {
+    w->seg_prev[t] = d->seg_quat[t];
+    if (c->statics) {
+      d->seg_omega[t] = vd_v3(0, 0, 0);
+      continue;
+    }
+    if (m->seg_flags[t] & VD_SIM_FIXED) continue;
+    vd_vec3 op = d->seg_omega[t];
+    if (fl != 0) {
+      // omega + h I^-1 (tau - omega x I omega), I = ib + (it - ib) d3 d3^T in world axes
+      vd_vec3 d3 = quat_d3(d->seg_quat[t]);
+      double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
+      vd_vec3 io = vd_madd(vd_scale(op, ib), d3, (it - ib) * vd_dot(d3, op));
+      vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(op, io));
+      vd_vec3 it_tq = vd_madd(vd_scale(tq, 1.0 / ib), d3, (1.0 / it - 1.0 / ib) * vd_dot(d3, tq));
+      op = vd_madd(op, it_tq, fl);
+    }
+    d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_scale(op, h));
   }
-  return 1;
+}
+
+// velocities from the step's motion (nodes and segments both by index)
+static void velocity_range(void* p, int k, int i0, int i1) {
+  loop_ctx* c = p;
+  const vd_sim_model* m = c->m;
+  vd_sim_data* d = c->d;
+  const sim_work* w = c->w;
+  double s = c->damp / c->h;
+  (void)k;
+  for (int i = i0; i < i1; i++) {
+    if (i < m->nnode_all)
+      d->node_vel[i] = !sim_node_moves(m, d, i) || c->statics ? vd_v3(0, 0, 0)
+                                                              : vd_scale(vd_sub(d->node_pos[i], w->node_prev[i]), s);
+    if (i < m->nseg)
+      d->seg_omega[i] = (m->seg_flags[i] & VD_SIM_FIXED) || c->statics
+                            ? vd_v3(0, 0, 0)
+                            : vd_scale(quat_log(q_mul(d->seg_quat[i], q_conj(w->seg_prev[i]))), s);
+  }
 }
 
 void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t) {
@@ -42,7 +155,7 @@ void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t) {
   if (d->node_mass[a] > 2 * share) d->node_mass[a] -= share;
   d->node_mass[k] = share;
   d->node_pos[k] = d->node_pos[a];
-  d->node_vel[k] = sim_node_w(m, d, a) > 0 ? d->node_vel[a] : vd_v3(0, 0, 0);
+  d->node_vel[k] = sim_node_moves(m, d, a) ? d->node_vel[a] : vd_v3(0, 0, 0);
   d->node_force[k] = vd_v3(0, 0, 0);
   d->seg_start[t] = k;
   d->seg_broken[t] = 1;
@@ -109,12 +222,12 @@ static double potential_energy(const vd_sim_model* m, const vd_sim_data* d, cons
     vd_vec3 target;
     double comp;
     sim_tie_get(m, d, k, &n, &target, &comp);
-    if (sim_node_w(m, d, n) <= 0) continue;
+    if (!sim_node_moves(m, d, n)) continue;
     vd_vec3 cc = vd_sub(d->node_pos[n], target);
     e += 0.5 * vd_dot(cc, cc) / comp;
   }
   for (int i = 0; i < m->nnode_all; i++)
-    if (sim_node_w(m, d, i) > 0) e -= vd_dot(w->node_fext[i], d->node_pos[i]);
+    if (sim_node_moves(m, d, i)) e -= vd_dot(w->node_fext[i], d->node_pos[i]);
   return e;
 }
 
@@ -133,24 +246,23 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   sim_work* w = (sim_work*)d->work;
   sim_step_ctx c = *cin;
   double h = c.h;
-  int na = m->nnode_all, ns = m->nseg;
+  int na = m->nnode_all, ns = m->nseg, nt = sim_threads(m);
+  double tp = sim_stage_start(d);
+  c.tstage = &tp;
   vd_arena_reset(&d->arena);
   memset(w->col_imp, 0, sizeof w->col_imp);
   memset(w->col_ang, 0, sizeof w->col_ang);
   // the stretch at the start: a step may not double it beyond VD_SIM_MAX_STRAIN (a stretch the
   // state already had, e.g. from a contact holding a node, is not a new failure)
   double strain0 = c.statics ? 0 : max_stretch(m, d);
+  sim_stage(d, VD_SIM_STAGE_VELOCITY, &tp);
   // loads at the start of the step
   sim_forces(m, d, w);
-  memcpy(w->node_prev, d->node_pos, (size_t)na * sizeof(vd_vec3));
-  memcpy(w->seg_prev, d->seg_quat, (size_t)ns * sizeof(vd_quat));
+  sim_stage(d, VD_SIM_STAGE_FORCES, &tp);
   if (c.gamma > 0)
     for (int t = 0; t < ns; t++)
       if (!(m->seg_flags[t] & VD_SIM_FIXED)) sim_joint_values(m, d, t, w->c_prev + 6 * t);
-  if (c.statics) {
-    for (int i = 0; i < na; i++) d->node_vel[i] = vd_v3(0, 0, 0);
-    for (int t = 0; t < ns; t++) d->seg_omega[t] = vd_v3(0, 0, 0);
-  } else {
+  if (!c.statics) {
     // prediction: semi-implicit Euler on velocities, then positions and frames; air drag is
     // linearly implicit, m (v - v_n) = h (f_n - c (v - v_n)) with c = -dF/dv (w->node_drag):
     // explicit drag diverges once h c / m > 2, which light organs in wind reach at 1 ms.
@@ -160,48 +272,30 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     // linearises its segment's rotation far from the solution
     memset(d->seg_lambda, 0, (size_t)ns * 6 * sizeof(double));
     memset(w->tie_lambda, 0, (size_t)w->cap_tie_lambda * 3 * sizeof(double));
-    double fl = m->opt.solver == VD_SIM_GS ? h : 0.0;
-    for (int i = 0; i < na; i++) {
-      if (sim_node_w(m, d, i) <= 0) continue;
-      vd_vec3 v = vd_madd(d->node_vel[i], w->node_fext[i], fl / (d->node_mass[i] + h * w->node_drag[i]));
-      d->node_pos[i] = vd_madd(d->node_pos[i], v, h);
-    }
-    for (int t = 0; t < ns; t++) {
-      if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-      double r[9], iinv[9];
-      m3_from_quat(r, d->seg_quat[t]);
-      double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
-      m3_inv_inertia(iinv, r, ib, it);
-      vd_vec3 om = d->seg_omega[t];
-      // I omega in world axes: ib omega + (it - ib) (d3 . omega) d3
-      vd_vec3 d3 = vd_v3(r[2], r[5], r[8]);
-      vd_vec3 io = vd_madd(vd_scale(om, ib), d3, (it - ib) * vd_dot(d3, om));
-      vd_vec3 tq = vd_sub(w->seg_text[t], vd_cross(om, io));
-      vd_vec3 op = vd_madd(om, m3_mul_v(iinv, tq), fl);
-      d->seg_quat[t] = quat_rotate_by(d->seg_quat[t], vd_scale(op, h));
-    }
   }
+  // keep the state and predict it (statics: velocities zeroed)
+  loop_ctx lc = {m, d, w, h, m->opt.solver == VD_SIM_GS ? h : 0.0, 0, c.statics, {0}};
+  double vmax = sqrt(chunk_max(&lc, sim_parallel(nt, na, predict_nodes, &lc)));
+  sim_parallel(nt, ns, predict_segs, &lc);
+  sim_stage(d, VD_SIM_STAGE_PREDICT, &tp);
   // contact candidates near the predicted state
   c.contacts = NULL;
   c.ncontact = 0;
   if (m->opt.contacts && (d->ncollider || m->opt.self_collision)) {
-    double vmax = 0;
-    for (int i = 0; i < na; i++)
-      if (sim_node_w(m, d, i) > 0) {
-        double s = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
-        if (s > vmax) vmax = s;
-      }
     if (d->ncollider) c.ncontact = sim_contacts_find(m, d, 2 * vmax + 0.005, &c.contacts);
     // self-contacts: each primitive reaches twice its own nodes' displacement (sim_self.c)
     if (m->opt.self_collision) c.ncontact = sim_self_find(m, d, 0.002, c.contacts, c.ncontact, &c.contacts);
   }
+  sim_stage(d, VD_SIM_STAGE_CONTACTS, &tp);
   // constraints
   // statics needs the primal residual that only the direct solver keeps
   int solved = 1;
-  if (m->opt.solver == VD_SIM_GS && !c.statics)
+  if (m->opt.solver == VD_SIM_GS && !c.statics) {
     sim_solve_gs(m, d, &c);
-  else
+    sim_stage(d, VD_SIM_STAGE_SOLVE, &tp);
+  } else {
     solved = sim_solve_direct(m, d, &c);
+  }
   // contacts have the last word (no penetration), then friction
   d->ncontact = c.ncontact;
   d->max_penetration = 0;
@@ -213,6 +307,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
       if (-s > d->max_penetration) d->max_penetration = -s;
     }
   }
+  sim_stage(d, VD_SIM_STAGE_PROJECT, &tp);
   // a failed step: put the previous state back and say why; at the smallest substep a state
   // stretched up to VD_SIM_BLOWUP_STRAIN is kept (counted), beyond it the step fails
   int fail = !finite_state(m, d) ? VD_SIM_WARN_NONFINITE : !solved ? VD_SIM_WARN_SOLVER : -1;
@@ -228,28 +323,16 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
     return fail;
   }
   // velocities from the step's motion
-  double damp = 1.0 / (1.0 + (m->opt.mass_damping + c.extra_damping) * h);
-  for (int i = 0; i < na; i++) {
-    if (sim_node_w(m, d, i) <= 0 || c.statics) {
-      d->node_vel[i] = vd_v3(0, 0, 0);
-      continue;
-    }
-    d->node_vel[i] = vd_scale(vd_sub(d->node_pos[i], w->node_prev[i]), damp / h);
-  }
-  for (int t = 0; t < ns; t++) {
-    if ((m->seg_flags[t] & VD_SIM_FIXED) || c.statics) {
-      d->seg_omega[t] = vd_v3(0, 0, 0);
-      continue;
-    }
-    vd_vec3 dq = quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])));
-    d->seg_omega[t] = vd_scale(dq, damp / h);
-  }
+  lc.damp = 1.0 / (1.0 + (m->opt.mass_damping + c.extra_damping) * h);
+  sim_parallel(nt, na > ns ? na : ns, velocity_range, &lc);
+  sim_stage(d, VD_SIM_STAGE_VELOCITY, &tp);
   if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
   // the step's reactions on the colliders (impulses; vd_sim_step makes them forces)
   for (int k = 0; k < d->ncollider; k++) {
     d->collider_force[k] = vd_add(d->collider_force[k], w->col_imp[k]);
     d->collider_torque[k] = vd_add(d->collider_torque[k], w->col_ang[k]);
   }
+  sim_stage(d, VD_SIM_STAGE_FRACTURE, &tp);
   for (int k = 0; k < d->ncollider; k++) d->collider[k].vel = vd_v3(0, 0, 0);
   d->time += c.statics ? 0.0 : h;
   return -1;
