@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // verdant benchmarks: derivation (modules/s) and turtle (segments/s) on derivations of 10^5 to
 // 10^7 modules, each printed beside memcpy of the same bytes in the same run (the peer: the
-// fastest any string rewriter can move its output). Results go to bench/results/<host>.csv.
+// fastest any string rewriter can move its output). The same rules run again through the Python
+// engine (embedded CPython) up to 10^6 modules, so the cost of the Python path is measured on the
+// same work. Results go to bench/results/<host>.csv.
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,14 +91,21 @@ int main(int argc, char** argv) {
     return 1;
   }
   fprintf(csv, "bench,case,modules_final,modules_total,seconds,modules_per_s,memcpy_seconds,ratio_vs_memcpy,"
-               "segments,turtle_seconds,segments_per_s\n");
-  printf("%-24s %12s %12s %9s %14s %10s %9s %12s\n", "case", "final", "written", "derive_s", "modules/s",
-         "memcpy_s", "x memcpy", "segments/s");
+               "segments,turtle_seconds,segments_per_s,engine\n");
+  printf("%-24s %-7s %12s %12s %9s %14s %10s %9s %12s\n", "case", "engine", "final", "written", "derive_s",
+         "modules/s", "memcpy_s", "x memcpy", "segments/s");
+  char why[256];
+  int python = vd_lsys_python_available(why, sizeof why);
+  if (!python) printf("(no Python engine here: %s)\n", why);
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
-    for (int k = 0; k < max_size; k++) {
+    for (int run = 0; run < 2 * max_size; run++) {
+      // native at every size, then the Python engine on the same rules up to ~1e6 modules
+      int k = run % max_size;
+      vd_lsys_engine eng = run < max_size ? VD_LSYS_NATIVE : VD_LSYS_PYTHON;
+      if (eng == VD_LSYS_PYTHON && (!python || k > 1)) continue;
       vd_lsystem* ls;
       vd_error err = {0};
-      if (vd_lsys_parse(cases[c].src, strlen(cases[c].src), cases[c].name, &ls, &err)) {
+      if (vd_lsys_parse_engine(cases[c].src, strlen(cases[c].src), cases[c].name, eng, &ls, &err)) {
         fprintf(stderr, "%s: %s\n", cases[c].name, err.msg);
         return 1;
       }
@@ -127,10 +136,11 @@ int main(int argc, char** argv) {
       double tt = bench_wall() - t1;
       int nseg = plant ? plant->nseg : 0;
       double mps = (double)a.total / td;
-      printf("%-24s %12lld %12lld %9.4f %14.0f %10.4f %9.2f %12.0f\n", cases[c].name, (long long)s.n,
+      const char* en = vd_lsys_engine_name(eng);
+      printf("%-24s %-7s %12lld %12lld %9.4f %14.0f %10.4f %9.2f %12.0f\n", cases[c].name, en, (long long)s.n,
              (long long)a.total, td, mps, tm, td / tm, tt > 0 ? nseg / tt : 0);
-      fprintf(csv, "derive,%s,%lld,%lld,%.6f,%.0f,%.6f,%.3f,%d,%.6f,%.0f\n", cases[c].name, (long long)s.n,
-              (long long)a.total, td, mps, tm, td / tm, nseg, tt, tt > 0 ? nseg / tt : 0);
+      fprintf(csv, "derive,%s,%lld,%lld,%.6f,%.0f,%.6f,%.3f,%d,%.6f,%.0f,%s\n", cases[c].name, (long long)s.n,
+              (long long)a.total, td, mps, tm, td / tm, nseg, tt, tt > 0 ? nseg / tt : 0, en);
       fflush(stdout);
       vd_plant_spec_destroy(plant);
       vd_lstring_free(&s);

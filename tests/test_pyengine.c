@@ -348,3 +348,129 @@ TEST(pyengine, objects_are_released_after_each_step) {
   vd_lstring_free(&g);
   vd_lsys_destroy(ls);
 }
+
+// ---------------------------------------------------------------------------------------------
+// the turtle fed by PlantGL objects
+
+static vd_plant_spec* grow_py(const char* src, vd_error* e) {
+  vd_lsystem* ls;
+  if (vd_lsys_parse_engine(src, strlen(src), "turtle.lpy", VD_LSYS_PYTHON, &ls, e)) return NULL;
+  vd_plant_spec* p = vd_plant_spec_create();
+  vd_lsys_def d = vd_lsys_def_default();
+  if (vd_lsys_grow(ls, &d, NULL, p, e)) {
+    vd_plant_spec_destroy(p);
+    p = NULL;
+  }
+  vd_lsys_destroy(ls);
+  return p;
+}
+
+TEST(pyengine, guide_turns_the_turtle_along_the_curve) {
+  if (!python_here()) return;
+  // an L-shaped guide of length 2 drawn by two F(1): the first goes straight, the second turns
+  // 90 degrees toward U (the curve's y), and the path ends at H0 + U0 = (1, 0, 1)
+  vd_error e = {0};
+  vd_plant_spec* p = grow_py("g = Polyline2D([(0, 0), (1, 0), (1, 1)])\nAxiom: SetGuide(g, 2) F(1) F(1)\n", &e);
+  if (!p) {
+    char b[600];
+    vdt_fail(__FILE__, __LINE__, "%s", vd_error_format(&e, b, sizeof b));
+    return;
+  }
+  REQUIRE(p->nseg == 2);
+  vd_vec3 end = p->node[p->seg[1].node1], mid = p->node[p->seg[0].node1];
+  CHECK_NEAR(mid.x, 0, 1e-3);
+  CHECK_NEAR(mid.z, 1, 1e-3);
+  CHECK_NEAR(end.x, 1, 1e-3);
+  CHECK_NEAR(end.y, 0, 1e-3);
+  CHECK_NEAR(end.z, 1, 1e-3);
+  vd_plant_spec_destroy(p);
+  // a guide twice as long as its curve stretches the moves; after the guide the turtle goes on
+  // straight; EndGuide stops following
+  p = grow_py("g = Polyline2D([(0, 0), (0.5, 0)])\nAxiom: SetGuide(g, 1) F(0.5) F(0.5) F(1) EndGuide F(1)\n", &e);
+  REQUIRE(p && p->nseg == 4);
+  CHECK_NEAR(p->node[p->seg[3].node1].z, 3, 1e-9);
+  vd_plant_spec_destroy(p);
+}
+
+TEST(pyengine, contour_sweeps_and_tubes) {
+  if (!python_here()) return;
+  vd_error e = {0};
+  // a square contour: F draws a swept mesh (8 vertices, 8 triangles, open), not a segment
+  const char* sq = "sq = Polyline2D([(1, 1), (-1, 1), (-1, -1), (1, -1), (1, 1)])\n";
+  char src[512];
+  snprintf(src, sizeof src, "%sAxiom: _(0.5) SetContour(sq, True) F(2)\n", sq);
+  vd_plant_spec* p = grow_py(src, &e);
+  REQUIRE(p);
+  CHECK_INT(p->nseg, 0);
+  REQUIRE(p->nmesh == 1);
+  CHECK_INT(p->mesh[0].nvert, 8);
+  CHECK_INT(p->mesh[0].ntri, 8);
+  CHECK_INT(p->mesh[0].closed, 0);
+  vd_plant_stats ps;
+  vd_plant_spec_stats(p, &ps);
+  CHECK_NEAR(ps.bbox_max.z, 2, 1e-12);
+  CHECK_NEAR(ps.bbox_max.x, 0.5, 1e-12);  // x of the contour along L (= -Y), y along U (= X)
+  CHECK_NEAR(ps.bbox_max.y, 0.5, 1e-12);
+  vd_plant_spec_destroy(p);
+  // a tube with the contour: one mesh through its path, a branch is its own tube
+  snprintf(src, sizeof src, "%sAxiom: SetContour(sq) @Gc F(1) [ +(30) F(1) ] F(1) F(1) @Ge F(1)\n", sq);
+  p = grow_py(src, &e);
+  REQUIRE(p);
+  CHECK_INT(p->nmesh, 3);  // the tube, its branch, the F after @Ge (a small sweep)
+  REQUIRE(p->nmesh == 3);
+  CHECK_INT(p->mesh[0].nvert, 2 * 4);  // the branch: its start and end rings
+  CHECK_INT(p->mesh[1].nvert, 4 * 4);  // the main tube: 4 rings
+  vd_plant_spec_destroy(p);
+}
+
+TEST(pyengine, sweep_and_radius_law) {
+  if (!python_here()) return;
+  vd_error e = {0};
+  // Sweep(path, section, length, dl, radius, law): 10 swept steps along the path, radius from
+  // the law (a line from 1 to 0: the last ring has radius 0)
+  vd_plant_spec* p = grow_py("path = Polyline2D([(0, 0), (1, 0)])\n"
+                             "sec = Polyline2D.Circle(1, 6)\n"
+                             "law = QuantisedFunction(Polyline2D([(0, 1), (1, 0)]))\n"
+                             "Axiom: Sweep(path, sec, 1, 0.1, 0.2, law)\n",
+                             &e);
+  REQUIRE(p);
+  CHECK_INT(p->nmesh, 10);
+  vd_plant_stats ps;
+  vd_plant_spec_stats(p, &ps);
+  CHECK_NEAR(ps.bbox_max.z, 1, 1e-9);
+  CHECK_NEAR(ps.bbox_max.y, 0.2, 1e-9);  // the hexagon's x = -1 corner along L = -Y
+  vd_plant_spec_destroy(p);
+  // nF with a law and a default section: segments, radius following the law
+  p = grow_py("law = QuantisedFunction(Polyline2D([(0, 1), (1, 0.5)]))\nAxiom: nF(1, 0.5, 0.1, law)\n", &e);
+  REQUIRE(p && p->nseg == 2);
+  CHECK_NEAR(p->seg[0].r0, 0.1, 1e-9);
+  CHECK_NEAR(p->seg[0].r1, 0.075, 1e-9);
+  CHECK_NEAR(p->seg[1].r1, 0.05, 1e-9);
+  vd_plant_spec_destroy(p);
+}
+
+TEST(pyengine, pglshape_places_the_geometry) {
+  if (!python_here()) return;
+  vd_error e = {0};
+  // a box of half-size (1, 2, 3) after a move: z along H, x along U, y along -L; scale 0.5
+  vd_plant_spec* p = grow_py("Axiom: f(10) @g(Box(Vector3(1, 2, 3)), 0.5) @g(Material('m')) @g(NurbsPatch([[(0,0,0,1),(1,0,0,1)],[(0,1,0,1),(1,1,0,1)]], udegree=1, vdegree=1))\n", &e);
+  if (!p) {
+    char b[600];
+    vdt_fail(__FILE__, __LINE__, "%s", vd_error_format(&e, b, sizeof b));
+    return;
+  }
+  REQUIRE(p->nmesh == 2);
+  CHECK_INT(p->mesh[0].closed, 1);
+  CHECK_INT(p->mesh[0].nvert, 8);
+  CHECK_INT(p->mesh[1].closed, 0);  // the patch: a thin surface
+  double zmin = 1e9, zmax = -1e9, xmax = -1e9, ymax = -1e9;
+  for (int i = 0; i < p->mesh[0].nvert; i++) {
+    vd_vec3 v = p->vert[p->mesh[0].vert_start + i];
+    zmin = fmin(zmin, v.z), zmax = fmax(zmax, v.z), xmax = fmax(xmax, v.x), ymax = fmax(ymax, v.y);
+  }
+  CHECK_NEAR(zmin, 10 - 1.5, 1e-12);
+  CHECK_NEAR(zmax, 10 + 1.5, 1e-12);
+  CHECK_NEAR(xmax, 0.5, 1e-12);
+  CHECK_NEAR(ymax, 1.0, 1e-12);
+  vd_plant_spec_destroy(p);
+}

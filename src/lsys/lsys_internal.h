@@ -513,6 +513,21 @@ void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 void lsys_py_reset_objects(vd_lsystem* ls);
 vd_status lsys_py_set_global(vd_lsystem* ls, const char* name, const char* text);
 vd_status lsys_py_get_global(vd_lsystem* ls, const char* name, double* out);
+// What the turtle reads from object parameters (the Python engine's curves, functions and
+// geometry). Arrays are vd_malloc'd, the caller frees them (sizes from the counts). Each returns
+// VD_ERR_TYPE with a message in why (cap bytes) when v is not such an object (or no object at all).
+// A curve as points at equal steps of its parameter (its stride): n points of dim (2 or 3) coordinates.
+vd_status lsys_obj_points(const vd_lsystem* ls, double v, double** p, int* n, int* dim, char* why, size_t cap);
+// A guide: the curve's length, m + 1 points, unit tangents and unit normals at equal steps of
+// normalised arc length, and the dimension.
+vd_status lsys_obj_guide(const vd_lsystem* ls, double v, int m, double* length, double** p, double** tan,
+                         double** nrm, int* dim, char* why, size_t cap);
+// A function of x: its range and its n samples at equal steps (QuantisedFunction).
+vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* lx, double** val, int* n, char* why,
+                            size_t cap);
+// A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
+vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
+                        char* why, size_t cap);
 // repr() of an object parameter into buf (cap bytes); "None" for a stale handle
 void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 

@@ -1347,3 +1347,189 @@ void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap) {
   }
   lsys_py_leave(mls);
 }
+
+// ---------------------------------------------------------------------------------------------
+// objects for the turtle
+
+// the object behind v and the shim's answer fn(obj, extra...) (new reference), or NULL with why
+static PyObject* obj_query(vd_lsystem* ls, double v, const char* fn, PyObject* extra, char* why, size_t cap) {
+  uint32_t id;
+  unsigned ep;
+  if (!ls || !ls->py || g_state != 1 || !lsys_unbox_obj(v, &id, &ep)) {
+    snprintf(why, cap, "%s", vd_lsys_value_is_str(v) ? "a string" : "a number");
+    return NULL;
+  }
+  PyObject* o = param_object(ls, v);
+  PyObject* f = o ? PyDict_GetItemString(g_shim, fn) : NULL;  // borrowed
+  PyObject* r = f ? (extra ? PyObject_CallFunctionObjArgs(f, o, extra, NULL) : PyObject_CallOneArg(f, o)) : NULL;
+  if (!r) {
+    PyObject *t, *e, *tb;
+    PyErr_Fetch(&t, &e, &tb);
+    PyObject* s = e ? PyObject_Str(e) : NULL;
+    const char* m = s ? PyUnicode_AsUTF8(s) : NULL;
+    snprintf(why, cap, "%s: %s", t ? ((PyTypeObject*)t)->tp_name : "error", m ? m : "");
+    Py_XDECREF(s);
+    Py_XDECREF(t);
+    Py_XDECREF(e);
+    Py_XDECREF(tb);
+    PyErr_Clear();
+  } else if (r == Py_None) {
+    PyObject* tr = PyObject_Repr(o);
+    const char* m = tr ? PyUnicode_AsUTF8(tr) : NULL;
+    snprintf(why, cap, "%.200s", m ? m : "an object");
+    Py_XDECREF(tr);
+    PyErr_Clear();
+    Py_CLEAR(r);
+  }
+  Py_XDECREF(o);
+  return r;
+}
+
+// a Python sequence of numbers into a new array of n doubles (n from the sequence), or NULL
+static double* doubles(PyObject* seq, int* n) {
+  PyObject* f = PySequence_Fast(seq, "numbers expected");
+  if (!f) return NULL;
+  Py_ssize_t k = PySequence_Fast_GET_SIZE(f);
+  double* a = vd_malloc(sizeof(double) * (size_t)(k ? k : 1));
+  for (Py_ssize_t i = 0; a && i < k; i++) {
+    a[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(f, i));
+    if (PyErr_Occurred() || !isfinite(a[i])) {
+      vd_free(a, sizeof(double) * (size_t)(k ? k : 1));
+      a = NULL;
+    }
+  }
+  Py_DECREF(f);
+  PyErr_Clear();
+  if (a) *n = (int)k;
+  return a;
+}
+
+static void free_doubles(double* a, int n) { vd_free(a, sizeof(double) * (size_t)(n ? n : 1)); }
+
+vd_status lsys_obj_points(const vd_lsystem* ls, double v, double** p, int* n, int* dim, char* why, size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  *p = NULL;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* zero = PyLong_FromLong(0);
+  PyObject* r = zero ? obj_query(mls, v, "_vd_curve", zero, why, cap) : NULL;
+  Py_XDECREF(zero);
+  int k = 0;
+  if (r && PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 2) {
+    *dim = (int)PyLong_AsLong(PyTuple_GET_ITEM(r, 1));
+    *p = doubles(PyTuple_GET_ITEM(r, 0), &k);
+    if (*p && (*dim == 2 || *dim == 3) && k % *dim == 0 && k >= 2 * *dim) {
+      *n = k / *dim;
+      st = VD_OK;
+    } else if (*p) {
+      free_doubles(*p, k);
+      *p = NULL;
+      snprintf(why, cap, "a curve with too few points");
+    }
+  }
+  Py_XDECREF(r);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+  return st;
+}
+
+vd_status lsys_obj_guide(const vd_lsystem* ls, double v, int m, double* length, double** p, double** tan,
+                         double** nrm, int* dim, char* why, size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  *p = *tan = *nrm = NULL;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* pm = PyLong_FromLong(m);
+  PyObject* r = pm ? obj_query(mls, v, "_vd_guide", pm, why, cap) : NULL;
+  Py_XDECREF(pm);
+  if (r && PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 5) {
+    int a = 0, b = 0, c = 0;
+    *length = PyFloat_AsDouble(PyTuple_GET_ITEM(r, 0));
+    *dim = (int)PyLong_AsLong(PyTuple_GET_ITEM(r, 4));
+    *p = doubles(PyTuple_GET_ITEM(r, 1), &a);
+    *tan = doubles(PyTuple_GET_ITEM(r, 2), &b);
+    *nrm = doubles(PyTuple_GET_ITEM(r, 3), &c);
+    int want = (m + 1) * *dim;
+    if (*p && *tan && *nrm && (*dim == 2 || *dim == 3) && a == want && b == want && c == want && isfinite(*length) &&
+        *length > 0) {
+      st = VD_OK;
+    } else {
+      if (*p) free_doubles(*p, a);
+      if (*tan) free_doubles(*tan, b);
+      if (*nrm) free_doubles(*nrm, c);
+      *p = *tan = *nrm = NULL;
+      snprintf(why, cap, "a curve without length");
+    }
+  }
+  Py_XDECREF(r);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+  return st;
+}
+
+vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* lx, double** val, int* n, char* why,
+                            size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  *val = NULL;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* r = obj_query(mls, v, "_vd_function", NULL, why, cap);
+  if (r && PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 3) {
+    *fx = PyFloat_AsDouble(PyTuple_GET_ITEM(r, 0));
+    *lx = PyFloat_AsDouble(PyTuple_GET_ITEM(r, 1));
+    *val = doubles(PyTuple_GET_ITEM(r, 2), n);
+    if (*val && *n >= 2 && isfinite(*fx) && isfinite(*lx) && *lx > *fx) {
+      st = VD_OK;
+    } else {
+      if (*val) free_doubles(*val, *n);
+      *val = NULL;
+      snprintf(why, cap, "a function without a range");
+    }
+  }
+  Py_XDECREF(r);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+  return st;
+}
+
+vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
+                        char* why, size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  *xyz = NULL;
+  *tri = NULL;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* r = obj_query(mls, v, "_vd_mesh", NULL, why, cap);
+  if (r && PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 3) {
+    int a = 0, b = 0;
+    double* p = doubles(PyTuple_GET_ITEM(r, 0), &a);
+    double* t = doubles(PyTuple_GET_ITEM(r, 1), &b);
+    *closed = PyObject_IsTrue(PyTuple_GET_ITEM(r, 2)) == 1;
+    int ok = p && t && a % 3 == 0 && b % 3 == 0 && a > 0 && b > 0;
+    int* ti = ok ? vd_malloc(sizeof(int) * (size_t)b) : NULL;
+    double nvert = (double)(a - a % 3) / 3.0;  // vertices (a is a multiple of 3 here)
+    for (int i = 0; ti && i < b; i++) {
+      if (!(t[i] >= 0 && t[i] < nvert)) {
+        vd_free(ti, sizeof(int) * (size_t)b);
+        ti = NULL;
+        break;
+      }
+      ti[i] = (int)t[i];
+    }
+    if (t) free_doubles(t, b);
+    if (ti) {
+      *xyz = p;
+      *nv = a / 3;
+      *tri = ti;
+      *nt = b / 3;
+      st = VD_OK;
+    } else {
+      if (p) free_doubles(p, a);
+      snprintf(why, cap, "a geometry whose mesh is not valid");
+    }
+  }
+  Py_XDECREF(r);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+  return st;
+}

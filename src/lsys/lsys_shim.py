@@ -91,6 +91,12 @@ _local_modules = {}
 
 
 def _vd_import(name, globals=None, locals=None, fromlist=(), level=0):
+    if level == 0 and name == "openalea.lpy.__lpyfuture__" and globals is not None:
+        mod = globals.get("__vd_future")
+        if mod is None:
+            mod = globals["__vd_future"] = _future_module()
+        _lpy.__lpyfuture__ = mod
+        return mod if fromlist else OPENALEA["openalea"]
     if level == 0 and (name == "openalea" or name.startswith("openalea.")):
         mod = OPENALEA.get(name)
         if mod is None:
@@ -473,38 +479,6 @@ class PatternModule(metaclass=_PatternModuleType):
     eDefaultModuleMatching = 2
 
 
-# L-Py's __lpyfuture__: DiscardNewString() drops the result of the step where it is called
-# (the string of the step before is kept); it acts through an EndEach wrapped by
-# enable_string_discard, or the module's own EndEach when the file defines none
-_future = {"discard": False, "last": None}
-
-
-def DiscardNewString():
-    _future["discard"] = True
-
-
-def enable_string_discard(endeach):
-    nargs = endeach.__code__.co_argcount
-
-    def step_end(lstring, *more):
-        res = None
-        if not _future["discard"]:
-            res = endeach(lstring, *more) if nargs else endeach()
-        if _future["discard"]:
-            _future["discard"] = False
-            return _future["last"]
-        _future["last"] = Lstring(lstring)
-        return res
-
-    if nargs >= 2:
-        return lambda lstring, lscene: step_end(lstring, lscene)
-    return lambda lstring: step_end(lstring)
-
-
-def _future_endeach():
-    pass
-
-
 def nsproduce(lstring):
     """Append an L-string object to the current production (L-Py's nsproduce)."""
     _vd.append(_vd_items(lstring))
@@ -516,6 +490,111 @@ def extern(**kw):
     over = g.get("__vd_set", {})
     for k, v in kw.items():
         g[k] = over.get(k, v)
+
+
+class ParameterSet:
+    """A bag of named parameters (L-Py's ParameterSet): attributes, item access, defaults."""
+
+    def __init__(self, **kw):
+        self.__dict__.update(kw)
+
+    def setdefault(self, *args, **kw):
+        pairs = list(zip(args[0::2], args[1::2])) + list(kw.items())
+        for k, v in pairs:
+            if not hasattr(self, k):
+                setattr(self, k, v)
+
+    def hasattr(self, k):
+        return hasattr(self, k)
+
+    def get(self, k, default=None):
+        return getattr(self, k, default)
+
+    def set(self, **kw):
+        self.__dict__.update(kw)
+
+    def rename(self, old, new):
+        setattr(self, new, getattr(self, old))
+        delattr(self, old)
+
+    def parameter_names(self):
+        return list(self.__dict__)
+
+    def copy(self, deep=True):
+        import copy
+        return copy.deepcopy(self) if deep else copy.copy(self)
+
+    def __getitem__(self, k):
+        return getattr(self, k)
+
+    def __setitem__(self, k, v):
+        setattr(self, k, v)
+
+    def __delitem__(self, k):
+        delattr(self, k)
+
+    def __contains__(self, k):
+        return hasattr(self, k)
+
+    def __repr__(self):
+        return "ParameterSet(%s)" % ",".join("%s=%r" % kv for kv in self.__dict__.items())
+
+
+def _future_module():
+    """openalea.lpy.__lpyfuture__, a fresh one for every run: DiscardNewString() drops a step's
+    result (the EndEach it provides, or decorates, gives the string before the step back);
+    pushString/popString keep strings by name."""
+    m = _types.ModuleType("openalea.lpy.__lpyfuture__")
+    state = {"discard": False, "last": None, "push": None, "pop": None, "stack": {}}
+
+    def DiscardNewString():
+        state["discard"] = True
+
+    def enable_string_discard(endeach):
+        n = endeach.__code__.co_argcount
+
+        def wrapped(lstring, lscene=None):
+            if not state["discard"]:
+                res = endeach(*((lstring, lscene)[:n]))
+                if not state["discard"]:
+                    state["last"] = Lstring(lstring)
+                    return res
+            state["discard"] = False
+            return state["last"]
+        return wrapped
+
+    def pushString(name):
+        state["push"] = name
+
+    def popString(name):
+        if name not in state["stack"]:
+            raise ValueError("no string pushed under the name %r" % (name,))
+        state["pop"] = name
+        return state["stack"][name]
+
+    def enable_string_pushpop(endeach):
+        n = endeach.__code__.co_argcount
+
+        def wrapped(lstring, lscene=None):
+            res = endeach(*((lstring, lscene)[:n]))
+            if state["push"] is not None:
+                state["stack"][state["push"]] = Lstring(lstring)
+                state["push"] = None
+            if state["pop"] is not None:
+                res = state["stack"].pop(state["pop"])
+                state["pop"] = None
+            return res
+        return wrapped
+
+    @enable_string_discard
+    def EndEach():
+        pass
+
+    for f in (DiscardNewString, enable_string_discard, pushString, popString, enable_string_pushpop, EndEach):
+        setattr(m, f.__name__, f)
+    m.__all__ = ["DiscardNewString", "enable_string_discard", "pushString", "popString", "enable_string_pushpop",
+                 "EndEach"]
+    return m
 
 
 # ---------------------------------------------------------------------------------------------
@@ -622,6 +701,10 @@ def _context_of_caller():
 
 
 def context():
+    return _context_of_caller()
+
+
+def execContext():
     return _context_of_caller()
 
 
@@ -1113,6 +1196,10 @@ class _Geometry:
 
     def isValid(self):
         return True
+
+    def deepcopy(self):
+        import copy
+        return copy.deepcopy(self)
 
     def getName(self):
         return self.name
@@ -1654,6 +1741,113 @@ class FaceSet(TriangleSet):
 QuadSet = FaceSet
 
 
+class NurbsPatch(_Geometry):
+    """A NURBS surface: a matrix of (x, y, z, w) control points, PlantGL's default knots."""
+
+    def __init__(self, ctrlPointMatrix=None, uKnotList=None, vKnotList=None, udegree=3, vdegree=3, ustride=30,
+                 vstride=30, ccw=True, **kw):
+        if ctrlPointMatrix is None:
+            ctrlPointMatrix = kw.pop("ctrlPointList")
+        rows = [[p if isinstance(p, Vector4) else Vector4(*(tuple(p) + (1.0,) * (4 - len(p)))) for p in r]
+                for r in ctrlPointMatrix]
+        self.ctrlPointMatrix = Point4Matrix(rows)
+        nu, nv = len(rows), len(rows[0])
+        self.udegree, self.vdegree = min(int(udegree), nu - 1), min(int(vdegree), nv - 1)
+        self.uKnotList = RealArray(uKnotList) if uKnotList is not None else RealArray(_default_knots(nu, self.udegree))
+        self.vKnotList = RealArray(vKnotList) if vKnotList is not None else RealArray(_default_knots(nv, self.vdegree))
+        self.ustride, self.vstride, self.ccw = int(ustride), int(vstride), ccw
+        self.name = kw.get("name", "")
+
+    ctrlPointList = property(lambda self: self.ctrlPointMatrix)
+
+    def getPointAt(self, u, v):
+        nu, nv = len(self.ctrlPointMatrix), len(self.ctrlPointMatrix[0])
+        ku, kv, du, dv = self.uKnotList, self.vKnotList, self.udegree, self.vdegree
+        u = min(max(u, ku[du]), ku[nu])
+        v = min(max(v, kv[dv]), kv[nv])
+        su, sv = _find_span(ku, du, nu, u), _find_span(kv, dv, nv, v)
+        Nu, Nv = _basis(ku, du, su, u), _basis(kv, dv, sv, v)
+        C = [0.0] * 4
+        for i in range(du + 1):
+            for j in range(dv + 1):
+                P = self.ctrlPointMatrix[su - du + i][sv - dv + j]._c
+                b = Nu[i] * Nv[j] * P[3]
+                C[0] += P[0] * b
+                C[1] += P[1] * b
+                C[2] += P[2] * b
+                C[3] += b
+        w = C[3] if abs(C[3]) > 1e-10 else 1.0
+        return Vector3(C[0] / w, C[1] / w, C[2] / w)
+
+    def getUTangentAt(self, u, v):
+        h = 1e-6
+        return (self.getPointAt(min(1, u + h), v) - self.getPointAt(max(0, u - h), v)) / (min(1, u + h) - max(0, u - h))
+
+    def getVTangentAt(self, u, v):
+        h = 1e-6
+        return (self.getPointAt(u, min(1, v + h)) - self.getPointAt(u, max(0, v - h))) / (min(1, v + h) - max(0, v - h))
+
+    def getNormalAt(self, u, v):
+        return (self.getUTangentAt(u, v) ^ self.getVTangentAt(u, v)).normed()
+
+    def getIsoUSectionAt(self, u):
+        n = len(self.ctrlPointMatrix[0])
+        return NurbsCurve([tuple(self.getPointAt(u, j / (n - 1))) + (1.0,) for j in range(n)])
+
+    def getIsoVSectionAt(self, v):
+        n = len(self.ctrlPointMatrix)
+        return NurbsCurve([tuple(self.getPointAt(i / (n - 1), v)) + (1.0,) for i in range(n)])
+
+    def _mesh(self):
+        nu, nv = max(1, self.ustride), max(1, self.vstride)
+        ku, kv = self.uKnotList, self.vKnotList
+        u0, u1 = ku[self.udegree], ku[len(self.ctrlPointMatrix)]
+        v0, v1 = kv[self.vdegree], kv[len(self.ctrlPointMatrix[0])]
+        pts = [tuple(self.getPointAt(u0 + (u1 - u0) * i / nu, v0 + (v1 - v0) * j / nv))
+               for i in range(nu + 1) for j in range(nv + 1)]
+        t = []
+        for i in range(nu):
+            for j in range(nv):
+                a, b, c, d = i * (nv + 1) + j, (i + 1) * (nv + 1) + j, (i + 1) * (nv + 1) + j + 1, i * (nv + 1) + j + 1
+                t += [(a, b, c), (a, c, d)] if self.ccw else [(a, c, b), (a, d, c)]
+        return pts, t, False
+
+
+class BezierPatch(NurbsPatch):
+    def __init__(self, ctrlPointMatrix=None, ustride=30, vstride=30, ccw=True, **kw):
+        m = ctrlPointMatrix if ctrlPointMatrix is not None else kw.pop("ctrlPointList")
+        NurbsPatch.__init__(self, m, None, None, len(m) - 1, len(m[0]) - 1, ustride, vstride, ccw, **kw)
+
+
+class Paraboloid(_Geometry):
+    """z = height (r / radius)^shape around the axis (PlantGL's Paraboloid), r from 0 to radius."""
+
+    def __init__(self, radius=0.5, height=1.0, shape=2.0, solid=True, slices=8, stacks=8, **kw):
+        self.radius, self.height, self.shape, self.solid = radius, height, shape, solid
+        self.slices, self.stacks = max(3, int(slices)), max(1, int(stacks))
+
+    def _mesh(self):
+        n, m = self.slices, self.stacks
+        v, t = [(0.0, 0.0, self.height)], []
+        for k in range(1, m + 1):
+            # PlantGL's profile: the height falls from the apex as the radius opens
+            r = self.radius * k / m
+            v += _ring(r, n, self.height * (1 - (k / m) ** self.shape))
+        for i in range(n):
+            j = (i + 1) % n
+            t.append((0, 1 + i, 1 + j))
+            for k in range(m - 1):
+                a, b = 1 + k * n, 1 + (k + 1) * n
+                t += [(a + i, b + i, b + j), (a + i, b + j, a + j)]
+        closed = bool(self.solid)
+        if closed:
+            c = len(v)
+            v.append((0.0, 0.0, 0.0))
+            base = 1 + (m - 1) * n
+            t += [(c, base + (i + 1) % n, base + i) for i in range(n)]
+        return v, t, closed
+
+
 class _Transformed(_Geometry):
     def __init__(self, *a, **kw):
         self.geometry = a[-1] if a else kw.get("geometry")
@@ -1782,11 +1976,37 @@ def _vd_curve(c, n=0):
     return [float(x) for p in pts for x in p], dim
 
 
-def _vd_function(f, n):
-    """n + 1 values of a function of [0, 1] (QuantisedFunction, a curve used as one, a callable)."""
+def _vd_guide(c, m):
+    """A guide for the turtle (PlantGL's TurtlePath): the curve's length (PlantGL's chords of its
+    stride), m + 1 points, unit tangents and unit normals at equal steps of normalised arc length
+    (through getArcLengthToUMapping, as PlantGL), and the dimension; None if c is not a curve."""
+    if not (isinstance(c, _Curve) or (hasattr(c, "getPointAt") and hasattr(c, "getArcLengthToUMapping"))):
+        return None
+    length = c.getLength()
+    f = c.getArcLengthToUMapping()
+    pts, tan, nrm = [], [], []
+    for i in range(m + 1):
+        u = f(i / m)
+        pts += list(c.getPointAt(u))
+        t = c.getTangentAt(u)
+        n = norm(t)
+        tan += [x / n for x in t] if n > 0 else list(t)
+        nn = c.getNormalAt(u) if hasattr(c, "getNormalAt") else t
+        k = norm(nn)
+        nrm += [x / k for x in nn] if k > 0 else list(nn)
+    return float(length), [float(x) for x in pts], [float(x) for x in tan], [float(x) for x in nrm], len(pts) // (m + 1)
+
+
+def _vd_function(f):
+    """(firstx, lastx, values) of a function for the turtle: a QuantisedFunction's own samples
+    (a curve used as a function is quantised first, as L-Py does); None otherwise."""
     if isinstance(f, _Curve):
         f = QuantisedFunction(f)
-    return [float(f(i / n)) for i in range(n + 1)]
+    if isinstance(f, QuantisedFunction):
+        return float(f.firstx), float(f.lastx), [float(v) for v in f.values]
+    if callable(f):
+        return 0.0, 1.0, [float(f(i / 100)) for i in range(101)]
+    return None
 
 
 def _vd_number(x):
@@ -1815,11 +2035,13 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "Point2Matrix", "Point3Matrix", "Point4Matrix", "Color3", "Color4", "Material", "ImageTexture",
                "Texture2D", "Texture2DTransformation", "NurbsCurve2D", "NurbsCurve", "BezierCurve2D", "BezierCurve",
                "Polyline2D", "Polyline", "Curve2D", "QuantisedFunction", "Sphere", "Cylinder", "Cone", "Frustum",
-               "Disc", "Box", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated",
+               "Disc", "Box", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
+               "BezierPatch", "Paraboloid",
                "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
-        "nsproduce", "extern", "context", "isFrameDisplayed", "isAnimationEnabled", "PatternModule"]
+        "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
+        "PatternModule"]
 
 _pgl_math = _module("openalea.plantgl.math", _MATH)
 _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
@@ -1827,14 +2049,10 @@ _pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH)
 _pgl = _module("openalea.plantgl", [])
 _pgl.all, _pgl.math, _pgl.scenegraph = _pgl_all, _pgl_math, _pgl_sg
 _lpy = _module("openalea.lpy", _LPY)
-_lpyfuture = _module("openalea.lpy.__lpyfuture__", ["DiscardNewString", "enable_string_discard"])
-_lpyfuture.EndEach = enable_string_discard(_future_endeach)
-_lpy.__lpyfuture__ = _lpyfuture
 _openalea = _module("openalea", [])
 _openalea.plantgl, _openalea.lpy = _pgl, _lpy
 OPENALEA = {"openalea": _openalea, "openalea.plantgl": _pgl, "openalea.plantgl.all": _pgl_all,
-            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy,
-            "openalea.lpy.__lpyfuture__": _lpyfuture}
+            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy}
 
 _BUILTINS = dict(_builtins.__dict__)
 _BUILTINS["__import__"] = _vd_import

@@ -12,7 +12,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "lsys/lsys_internal.h"
+#include "lsys/lsys_internal.h"  // object parameters (curves, functions, geometry) of the Python engine
 
 #define EPS 1e-10                // lengths and radii below this draw nothing (m)
 #define NF_MAX_STEPS 100000000.0 // nF refuses to draw more segments than this in one module
@@ -46,7 +46,47 @@ typedef struct tstate {
   int gc;            // 1 between @Gc and @Ge
   int gc_prev;       // last segment of the current generalised cylinder, -1 if none
   int polygon;       // 1 between { and }
+  // curve-fed geometry (docs/turtle.md, "Guides, contours, sweeps"): indices into the run's
+  // tables, -1 for none
+  int contour;       // cross section of F and generalised cylinders (a run curve), -1: circle
+  int contour_ccw;   // the contour turns counter-clockwise (face orientation)
+  int gc_contour, gc_ccw;  // the contour when @Gc started (the tube's section)
+  int guide;         // the guide being followed (T->gst), -1 for none
+  int gst_top;       // T->ngst to restore when this state is restored
+  int gcp_start, gcp_n;    // the tube's recorded path (T->gcp) while @Gc is on with a contour
+  int gcp_top;       // T->ngcp to restore when this state is restored
 } tstate;
+
+// Data of an object parameter, fetched from the Python engine once per run and parameter.
+enum { CUR_POINTS = 1, CUR_GUIDE = 2, CUR_FUNC = 3 };
+typedef struct tcurve {
+  double key;        // the parameter it came from (a boxed object handle)
+  int kind;          // CUR_*
+  int dim, n;        // coordinates per point (2, 3), points or samples
+  double* p;         // points (n x dim), or function values (n)
+  double* tan;       // CUR_GUIDE: unit tangents (n x dim)
+  double* nrm;       // CUR_GUIDE: unit normals (n x dim)
+  double length;     // CUR_GUIDE: the curve's own length; CUR_FUNC: first x
+  double lastx;      // CUR_FUNC: last x
+  int closed;        // CUR_POINTS: first and last points coincide
+} tcurve;
+
+// A guide being followed (PlantGL's TurtlePath): its curve and where the turtle is on it.
+typedef struct tguide {
+  int curve;         // run curve (CUR_GUIDE)
+  int yorient, ccw;  // 2D: the curve's y is the turtle's left (else up); the curve turns the other way
+  double total;      // length the whole curve stands for (m, before the turtle scale)
+  double scale;      // total / the curve's own length
+  double t;          // position on the curve, normalised arc length in [0, 1]
+  vd_vec3 pos;       // last position on the curve (curve space; 2D in x, y)
+  vd_vec3 h, l, u;   // last heading on the curve; 3D: with the curve's left and up
+} tguide;
+
+// A point of a generalised cylinder's path (recorded while @Gc is on with a contour).
+typedef struct tgcp {
+  vd_vec3 p, l;      // position and turtle left (m)
+  double r;          // radius (m)
+} tgcp;
 
 // One run of the turtle over one L-string.
 typedef struct turtle {  // NOLINT(clang-analyzer-optin.performance.Padding): fields grouped by meaning; a few per derivation
@@ -91,6 +131,13 @@ typedef struct turtle {  // NOLINT(clang-analyzer-optin.performance.Padding): fi
   // cached sine and cosine of the last angle (degrees)
   double c_deg, c_sin, c_cos;
   int warned_guide, warned_width, warned_color; // warnings already logged once
+  // curve-fed geometry
+  tcurve* cur;       // object parameters read so far (ncur)
+  int ncur, cap_cur;
+  tguide* gst;       // guide states, a stack that follows [ ] (ngst)
+  int ngst, cap_gst;
+  tgcp* gcp;         // recorded tube paths, a stack that follows [ ] (ngcp)
+  int ngcp, cap_gcp;
   double* query; // Nullable: parameter values of the string (query run: ?P ?H ... are filled)
 } turtle;
 
@@ -496,22 +543,384 @@ static void tri(int* t, int k, int a, int b, int c) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// curve-fed geometry: guides, contours, sweeps, custom shapes (PlantGL's Turtle and
+// PglTurtleDrawer semantics; the objects come from the Python engine, lsys_obj_*)
+
+#define GUIDE_SAMPLES 512  // samples of a guide at equal steps of arc length (linear between)
+
+// the run's data for object parameter k of the current module (fetched once); -1 on error
+static int get_curve(turtle* T, int k, int kind, int* out) {
+  double key = T->p[k];
+  uint64_t kb, cb;
+  memcpy(&kb, &key, sizeof kb);
+  for (int c = 0; c < T->ncur; c++) {
+    memcpy(&cb, &T->cur[c].key, sizeof cb);
+    if (T->cur[c].kind == kind && cb == kb) {
+      *out = c;
+      return VD_OK;
+    }
+  }
+  if (!vd_grow((void**)&T->cur, &T->cap_cur, T->ncur + 1, sizeof *T->cur)) return nomem(T);
+  tcurve* c = &T->cur[T->ncur];
+  memset(c, 0, sizeof *c);
+  c->key = key;
+  c->kind = kind;
+  char why[256] = "";
+  vd_status st;
+  if (kind == CUR_POINTS) {
+    st = lsys_obj_points(T->ls, key, &c->p, &c->n, &c->dim, why, sizeof why);
+    if (!st) {
+      double d = 0;
+      for (int q = 0; q < c->dim; q++) d += fabs(c->p[q] - c->p[(c->n - 1) * c->dim + q]);
+      c->closed = d < 1e-10;
+    }
+  } else if (kind == CUR_GUIDE) {
+    c->n = GUIDE_SAMPLES + 1;
+    st = lsys_obj_guide(T->ls, key, GUIDE_SAMPLES, &c->length, &c->p, &c->tan, &c->nrm, &c->dim, why, sizeof why);
+  } else {
+    st = lsys_obj_function(T->ls, key, &c->length, &c->lastx, &c->p, &c->n, why, sizeof why);
+    c->dim = 1;
+  }
+  if (st)
+    return fail(T, st, "parameter %d is not a %s (%s)", k + 1,
+                kind == CUR_FUNC ? "function" : "curve", why);
+  *out = T->ncur++;
+  return VD_OK;
+}
+
+// point and unit tangent of a guide curve at normalised arc length s in [0, 1]
+static void guide_at(const tcurve* c, double s, vd_vec3* p, vd_vec3* tan) {
+  double x = fmin(fmax(s, 0), 1) * (c->n - 1);
+  int i = (int)x;
+  if (i >= c->n - 1) i = c->n - 2;
+  double w = x - i;
+  double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+  for (int q = 0; q < c->dim; q++) {
+    a[q] = c->p[i * c->dim + q] * (1 - w) + c->p[(i + 1) * c->dim + q] * w;
+    b[q] = c->tan[i * c->dim + q] * (1 - w) + c->tan[(i + 1) * c->dim + q] * w;
+  }
+  *p = vd_v3(a[0], a[1], a[2]);
+  *tan = vd_v3(b[0], b[1], b[2]);
+}
+
+// the guide state of the current path, made its own (a branch copies its parent's)
+static tguide* own_guide(turtle* T) {
+  tstate* t = &T->t;
+  if (t->guide < t->gst_top) {
+    if (!vd_grow((void**)&T->gst, &T->cap_gst, T->ngst + 1, sizeof *T->gst)) return NULL;
+    T->gst[T->ngst] = T->gst[t->guide];
+    t->guide = T->ngst++;
+  }
+  return &T->gst[t->guide];
+}
+
+// SetGuide(curve, length[, yorientation, ccw]): follow curve over the next length (Turtle2DPath,
+// Turtle3DPath: start at the curve's start, heading (1,0) or (0,1) in 2D, (0,0,1) in 3D)
+static vd_status set_guide(turtle* T, int k, double length, int yorient, int ccw) {
+  int c = -1;
+  vd_status st = get_curve(T, k, CUR_GUIDE, &c);
+  if (st) return st;
+  if (!(length > 0) || !isfinite(length)) return fail(T, VD_ERR_VALUE, "guide length %g must be positive", length);
+  if (!vd_grow((void**)&T->gst, &T->cap_gst, T->ngst + 1, sizeof *T->gst)) return nomem(T);
+  tguide* g = &T->gst[T->ngst];
+  memset(g, 0, sizeof *g);
+  g->curve = c;
+  g->yorient = yorient;
+  g->ccw = ccw;
+  g->total = length;
+  g->scale = length / T->cur[c].length;
+  vd_vec3 tan;
+  guide_at(&T->cur[c], 0, &g->pos, &tan);
+  if (T->cur[c].dim == 2) {
+    g->h = yorient ? vd_v3(0, ccw ? -1 : 1, 0) : vd_v3(ccw ? -1 : 1, 0, 0);
+  } else {
+    g->h = vd_v3(0, 0, 1);
+    g->u = vd_v3(1, 0, 0);
+    g->l = vd_v3(0, -1, 0);
+  }
+  T->t.guide = T->ngst++;
+  return VD_OK;
+}
+
+// PositionOnGuide(t): jump to length t along the guide (TurtlePath::setPosition)
+static vd_status position_on_guide(turtle* T, double at) {
+  if (T->t.guide < 0) {
+    vd_log(1, "turtle: module %lld 'PositionOnGuide' without a guide; ignored", (long long)T->i);
+    return VD_OK;
+  }
+  tguide* g = own_guide(T);
+  if (!g) return nomem(T);
+  const tcurve* c = &T->cur[g->curve];
+  g->t = fmin(fmax(at / g->total, 0), 1);
+  vd_vec3 tan;
+  guide_at(c, g->t, &g->pos, &tan);
+  g->h = vd_normalize(tan);
+  if (c->dim == 3) {
+    double x = g->t * (c->n - 1);
+    int i = (int)fmin(x, c->n - 1);
+    g->u = vd_normalize(vd_v3(c->nrm[3 * i], c->nrm[3 * i + 1], c->nrm[3 * i + 2]));
+    g->l = vd_normalize(vd_cross(g->u, g->h));
+  }
+  return VD_OK;
+}
+
+// signed angle from a to b in the x, y plane
+static double angle2(vd_vec3 a, vd_vec3 b) { return atan2(a.x * b.y - a.y * b.x, a.x * b.x + a.y * b.y); }
+
+// Follow the guide over a move of *l (Turtle::_applyGuide): the heading turns toward the next
+// point of the curve and *l becomes the chord to it; *l = 0 only turns to the local tangent.
+static void apply_guide(turtle* T, double* l) {
+  tstate* t = &T->t;
+  if (t->guide < 0) return;
+  int local = fabs(*l) < EPS;
+  if (T->gst[t->guide].t >= 1.0 && !local) {
+    t->guide = -1;  // the guide is used up
+    return;
+  }
+  tguide* g = own_guide(T);
+  if (!g) return;
+  const tcurve* c = &T->cur[g->curve];
+  double cur = g->t;
+  vd_vec3 tangent, p;
+  if (local) {
+    guide_at(c, cur, &p, &tangent);
+  } else {
+    double next = cur + *l / g->total, rem = next - 1.0;
+    if (rem > EPS) next = 1.0;
+    vd_vec3 nextpos, endtan;
+    guide_at(c, next, &nextpos, &endtan);
+    vd_vec3 offset = vd_v3(0, 0, 0);
+    if (rem > EPS) offset = vd_scale(vd_normalize(endtan), rem * c->length);
+    tangent = vd_sub(vd_add(nextpos, offset), g->pos);
+    double n = vd_norm(tangent);
+    *l = n * g->scale;
+    if (n > 0) tangent = vd_scale(tangent, 1.0 / n);
+    g->pos = nextpos;
+    g->t = next;
+  }
+  if (c->dim == 2) {
+    double dev = angle2(g->h, tangent);
+    if (g->ccw) dev = -dev;
+    if (!g->yorient) {
+      t->h = vd_rotate(t->h, t->l, -dev);
+      t->u = vd_rotate(t->u, t->l, -dev);
+    } else {
+      t->h = vd_rotate(t->h, t->u, dev);
+      t->l = vd_rotate(t->l, t->u, dev);
+    }
+    count_rotation(T);
+    g->h = tangent;
+    return;
+  }
+  // 3D: the tangent in the curve's last frame, turned into the turtle's frame
+  vd_vec3 pt = vd_v3(vd_dot(tangent, g->h), vd_dot(tangent, g->l), vd_dot(tangent, g->u));
+  vd_vec3 d = vd_normalize(vd_add(vd_add(vd_scale(t->h, pt.x), vd_scale(t->l, pt.y)), vd_scale(t->u, pt.z)));
+  vd_vec3 cp = vd_cross(t->h, d), cp2 = vd_cross(g->h, tangent);
+  double sn = vd_norm(cp);
+  if (sn > EPS) {
+    double ang = atan2(sn, vd_dot(t->h, d));
+    rotate_frame(T, vd_scale(cp, 1.0 / sn), ang);
+    if (vd_norm(cp2) > EPS) {
+      vd_vec3 ax = vd_normalize(cp2);
+      g->l = vd_normalize(vd_rotate(g->l, ax, ang));
+      g->u = vd_normalize(vd_rotate(g->u, ax, ang));
+    }
+  }
+  g->h = vd_norm(tangent) > 0 ? vd_normalize(tangent) : g->h;
+}
+
+// a contour's point k as (x along L, y along U)
+static void contour_xy(const tcurve* c, int k, double* x, double* y) {
+  *x = c->p[k * c->dim];
+  *y = c->p[k * c->dim + 1];
+}
+
+// A tube through path points p[0..n) with frames (left l, radius r) and a contour: rings of the
+// contour (x along the frame's left, y along tangent x left), joined by triangles; the face
+// orientation follows ccw (PlantGL's Extrusion, with the rotation-minimising frame it builds
+// from the first left). The contour's closing point is not repeated.
+static vd_status sweep_mesh(turtle* T, const tgcp* path, int n, const tcurve* c, int ccw, int label) {
+  int m = c->closed ? c->n - 1 : c->n;
+  if (n < 2 || m < 2) return VD_OK;
+  int nt = (n - 1) * (c->closed ? m : m - 1) * 2;
+  vd_status st = scratch(T, n * m, nt);
+  if (st) return st;
+  vd_vec3 prev_t = vd_v3(0, 0, 0), nrm = path[0].l;
+  int k = 0;
+  for (int i = 0; i < n; i++) {
+    // the tangent at a path point: the mean of its two chords (PlantGL's Polyline tangent)
+    vd_vec3 a = i > 0 ? vd_normalize(vd_sub(path[i].p, path[i - 1].p)) : vd_v3(0, 0, 0);
+    vd_vec3 b = i + 1 < n ? vd_normalize(vd_sub(path[i + 1].p, path[i].p)) : vd_v3(0, 0, 0);
+    vd_vec3 tg = vd_add(a, b);
+    tg = vd_norm(tg) > EPS ? vd_normalize(tg) : (i > 0 ? a : b);
+    if (i == 0) {
+      nrm = vd_sub(nrm, vd_scale(tg, vd_dot(nrm, tg)));
+    } else {
+      // carry the frame along: the rotation that takes the last tangent to this one
+      vd_vec3 ax = vd_cross(prev_t, tg);
+      double sn = vd_norm(ax);
+      if (sn > EPS) nrm = vd_rotate(nrm, vd_scale(ax, 1.0 / sn), atan2(sn, vd_dot(prev_t, tg)));
+      nrm = vd_sub(nrm, vd_scale(tg, vd_dot(nrm, tg)));
+    }
+    if (vd_norm(nrm) < EPS) nrm = fabs(tg.z) < 0.9 ? vd_cross(tg, vd_v3(0, 0, 1)) : vd_cross(tg, vd_v3(1, 0, 0));
+    nrm = vd_normalize(nrm);
+    vd_vec3 bin = vd_cross(tg, nrm);
+    prev_t = tg;
+    for (int j = 0; j < m; j++) {
+      double x, y;
+      contour_xy(c, j, &x, &y);
+      T->vbuf[i * m + j] = vd_add(path[i].p, vd_add(vd_scale(nrm, x * path[i].r), vd_scale(bin, y * path[i].r)));
+    }
+  }
+  for (int i = 0; i + 1 < n; i++)
+    for (int j = 0; j < (c->closed ? m : m - 1); j++) {
+      int j1 = (j + 1) % m;
+      int a = i * m + j, b = i * m + j1, d = (i + 1) * m + j, e = (i + 1) * m + j1;
+      if (ccw) {
+        tri(T->tbuf, k++, a, b, e);
+        tri(T->tbuf, k++, a, e, d);
+      } else {
+        tri(T->tbuf, k++, a, e, b);
+        tri(T->tbuf, k++, a, d, e);
+      }
+    }
+  // an open tube: a thin surface, as PlantGL draws it (no caps)
+  return add_mesh(T, n * m, k, 0, label, module_of(T, T->i), T->t.node, T->t.parent);
+}
+
+// F with a contour (PglTurtleDrawer::smallSweep): the contour swept from the position to end
+static vd_status contour_segment(turtle* T, vd_vec3 end, double r0, double r1, int label) {
+  tstate* t = &T->t;
+  tgcp path[2] = {{t->pos, t->l, r0}, {end, t->l, r1}};
+  vd_status st = sweep_mesh(T, path, 2, &T->cur[t->contour], t->contour_ccw, label);
+  if (st) return st;
+  move_to(t, end);
+  return VD_OK;
+}
+
+// record a point of the tube's path (TurtleParam::pushPosition)
+static vd_status gc_record(turtle* T) {
+  tstate* t = &T->t;
+  if (t->gcp_start + t->gcp_n != T->ngcp) {
+    // the path continues in a branch: copy it to the top of the stack first
+    if (!vd_grow((void**)&T->gcp, &T->cap_gcp, T->ngcp + t->gcp_n + 1, sizeof *T->gcp)) return nomem(T);
+    memmove(T->gcp + T->ngcp, T->gcp + t->gcp_start, sizeof *T->gcp * (size_t)t->gcp_n);
+    t->gcp_start = T->ngcp;
+    T->ngcp += t->gcp_n;
+  }
+  if (!vd_grow((void**)&T->gcp, &T->cap_gcp, T->ngcp + 1, sizeof *T->gcp)) return nomem(T);
+  T->gcp[T->ngcp++] = (tgcp){t->pos, t->l, t->width * t->scale};
+  t->gcp_n++;
+  return VD_OK;
+}
+
+// the width changed inside a tube: its last point takes it (TurtleParam::pushRadius)
+static void gc_width(turtle* T) {
+  tstate* t = &T->t;
+  if (t->gc && t->gc_contour >= 0 && t->gcp_n > 0) T->gcp[t->gcp_start + t->gcp_n - 1].r = t->width * t->scale;
+}
+
+// @Ge with a contour: the tube through the recorded path (Turtle::stopGC)
+static vd_status gc_end(turtle* T) {
+  tstate* t = &T->t;
+  vd_status st = VD_OK;
+  if (t->gc && t->gc_contour >= 0 && t->gcp_n > 1)
+    st = sweep_mesh(T, T->gcp + t->gcp_start, t->gcp_n, &T->cur[t->gc_contour], t->gc_ccw, t->color);
+  t->gcp_n = 0;
+  return st;
+}
+
+// @g(geometry[, scale]) / PglShape: the object's mesh placed in the turtle's frame (local x along
+// U, y along -L, z along H, PglTurtleDrawer::transform), scaled by scale x the turtle scale
+static vd_status custom_geometry(turtle* T) {
+  tstate* t = &T->t;
+  double sc = 1, *xyz;
+  int nv, nt, closed, *tr;
+  vd_status st;
+  if (T->np > 1 && (st = num(T, 1, &sc))) return st;
+  if (!vd_lsys_value_is_obj(T->p[0])) {
+    vd_log(1, "turtle: module %lld '@g' needs a geometry object; ignored", (long long)T->i);
+    return VD_OK;
+  }
+  char why[256] = "";
+  if (lsys_obj_mesh(T->ls, T->p[0], &xyz, &nv, &tr, &nt, &closed, why, sizeof why) != VD_OK) {
+    // a material or an appearance only changes colours: nothing to draw
+    vd_log(1, "turtle: module %lld '@g': %s; nothing drawn", (long long)T->i, why);
+    return VD_OK;
+  }
+  st = scratch(T, nv, nt);
+  if (!st) {
+    double s = sc * t->scale;
+    for (int i = 0; i < nv; i++) {
+      vd_vec3 q = vd_add(vd_add(vd_scale(t->u, xyz[3 * i] * s), vd_scale(t->l, -xyz[3 * i + 1] * s)),
+                         vd_scale(t->h, xyz[3 * i + 2] * s));
+      T->vbuf[i] = vd_add(t->pos, q);
+    }
+    memcpy(T->tbuf, tr, sizeof(int) * 3 * (size_t)nt);
+    st = add_mesh(T, nv, nt, closed, t->color, module_of(T, T->i), t->node, t->parent);
+  }
+  vd_free(xyz, sizeof(double) * 3 * (size_t)nv);
+  vd_free(tr, sizeof(int) * 3 * (size_t)nt);
+  return st;
+}
+
+// SetContour(curve[, ccw]): the cross section of the following F and tubes
+static vd_status set_contour(turtle* T, int k, int ccw) {
+  int c = -1;
+  vd_status st = get_curve(T, k, CUR_POINTS, &c);
+  if (st) return st;
+  T->t.contour = c;
+  T->t.contour_ccw = ccw;
+  if (T->t.gc && T->t.gcp_n <= 1) {  // set while the tube starts: it is the tube's
+    T->t.gc_contour = c;
+    T->t.gc_ccw = ccw;
+  }
+  return VD_OK;
+}
+
+// the value of a function table at x (QuantisedFunction::getValue: x clamped, linear)
+static double func_at(const tcurve* c, double x) {
+  double fx = c->length, lx = c->lastx;
+  x = fmin(fmax(x, fx), lx);
+  double idx = (c->n - 1) * (x - fx) / (lx - fx);
+  int i = (int)floor(idx);
+  double d = idx - i;
+  if (i >= c->n - 1 || fabs(d) < 1e-12) return c->p[i < c->n ? i : c->n - 1];
+  return (1 - d) * c->p[i] + d * c->p[i + 1];
+}
+
+// ---------------------------------------------------------------------------------------------
 // drawing commands
 
 // F(len, top): tropism, frustum from width to top (top < 0: cylinder), move; width := top.
 // A negative length turns around, draws, and turns back (PlantGL's Turtle::F).
 static vd_status draw_F(turtle* T, double len, double top, int label) {
   tstate* t = &T->t;
+  double zero = 0;
   if (len > 0) {
+    if (t->guide >= 0) apply_guide(T, &len);  // the move becomes the chord along the guide
     apply_tropism(T);
     if (len > EPS) {
       double r1 = top > -EPS ? fmax(top, 0) : t->width;
-      vd_status st = add_segment(T, vd_madd(t->pos, t->h, len * t->scale), t->width * t->scale,
-                                 r1 * t->scale, label);
+      vd_vec3 end = vd_madd(t->pos, t->h, len * t->scale);
+      vd_status st = VD_OK;
+      if (t->gc && t->gc_contour >= 0)
+        move_to(t, end);  // a tube with a contour: drawn from its recorded path at @Ge
+      else if (t->contour >= 0)
+        st = contour_segment(T, end, t->width * t->scale, r1 * t->scale, label);
+      else
+        st = add_segment(T, end, t->width * t->scale, r1 * t->scale, label);
       if (st) return st;
+      if (t->guide >= 0) apply_guide(T, &zero);
+      if (t->gc && t->gc_contour >= 0 && (st = gc_record(T))) return st;
       if (t->polygon && (st = poly_push(T))) return st;
+    } else if (t->guide >= 0) {
+      apply_guide(T, &zero);
     }
-    if (top > -EPS) t->width = fmax(top, 0);
+    if (top > -EPS) {
+      t->width = fmax(top, 0);
+      gc_width(T);
+    }
   } else if (len < -EPS) {
     turn_around(t);
     vd_status st = draw_F(T, -len, top, label);
@@ -523,8 +932,12 @@ static vd_status draw_F(turtle* T, double len, double top, int label) {
 
 // f(len): tropism and move without drawing
 static void move_f(turtle* T, double len) {
+  int guided = len > 0 && T->t.guide >= 0;
+  if (guided) apply_guide(T, &len);
   apply_tropism(T);
   move_to(&T->t, vd_madd(T->t.pos, T->t.h, len * T->t.scale));
+  double zero = 0;
+  if (guided && T->t.guide >= 0) apply_guide(T, &zero);
 }
 
 // LineTo family: orient H toward target, draw exactly to it, optionally restore the frame
@@ -548,22 +961,27 @@ static vd_status line_to(turtle* T, vd_vec3 target, double top, int keep_frame) 
   return VD_OK;
 }
 
-// nF(len, dl[, radius]): F(dl) repeated, plus the remainder; radius varies linearly to radius
-static vd_status draw_nF(turtle* T) {
-  double len, dl, radius = -1;
+// nF(len, dl[, radius[, radius law]]): F(dl) repeated, plus the remainder; the radius goes
+// linearly to radius, or follows radius x the law (a function over its x range, Turtle::nF)
+static vd_status run_nF(turtle* T, double len, double dl, double radius, int law) {
   vd_status st;
-  if (T->np < 2) {
-    vd_log(1, "turtle: module %lld 'nF' needs length and step; ignored", (long long)T->i);
-    return VD_OK;
-  }
-  if ((st = nonneg_or(T, 0, 0, "length", &len)) || (st = num(T, 1, &dl))) return st;
   if (dl <= 0) return fail(T, VD_ERR_VALUE, "step %g must be positive", dl);
-  if (T->np >= 3 && (st = nonneg_or(T, 2, 0, "radius", &radius))) return st;
-  if (T->np >= 4) vd_log(1, "turtle: nF radius law ignored (linear radius used)");
   double nsteps = floor(len / dl);
   if (nsteps > NF_MAX_STEPS) return fail(T, VD_ERR_LIMIT, "%g steps is too many", nsteps);
   double delta = len - nsteps * dl;
   int n = (int)nsteps, label = T->t.color;
+  if (law >= 0 && len > 0) {
+    const tcurve* f = &T->cur[law];
+    double u = f->length, du = (dl / len) * (f->lastx - f->length);
+    T->t.width = fmax(func_at(f, u) * radius, 0);
+    gc_width(T);
+    for (int k = 1; k <= n; k++) {
+      u += du;
+      if ((st = draw_F(T, dl, fmax(func_at(f, u) * radius, 0), label))) return st;
+    }
+    if (delta > EPS) return draw_F(T, delta, fmax(radius * func_at(f, f->lastx), 0), label);
+    return VD_OK;
+  }
   if (radius < 0) {
     for (int k = 0; k < n; k++)
       if ((st = draw_F(T, dl, -1, label))) return st;
@@ -575,6 +993,21 @@ static vd_status draw_nF(turtle* T) {
     if ((st = draw_F(T, dl, w + dw * dl * k, label))) return st;
   if (delta > EPS) return draw_F(T, delta, radius, label);
   return VD_OK;
+}
+
+static vd_status draw_nF(turtle* T) {
+  double len, dl, radius = -1;
+  vd_status st;
+  int law = -1;
+  if (T->np < 2) {
+    vd_log(1, "turtle: module %lld 'nF' needs length and step; ignored", (long long)T->i);
+    return VD_OK;
+  }
+  if ((st = nonneg_or(T, 0, 0, "length", &len)) || (st = num(T, 1, &dl))) return st;
+  if (T->np >= 3 && (st = nonneg_or(T, 2, 0, "radius", &radius))) return st;
+  if (T->np >= 4 && vd_lsys_value_is_obj(T->p[3]) && (st = get_curve(T, 3, CUR_FUNC, &law))) return st;
+  if (T->np >= 4 && law < 0) vd_log(1, "turtle: nF radius law is not a function (linear radius used)");
+  return run_nF(T, len, dl, radius, law);
 }
 
 // @O(r): sphere at the position
@@ -928,14 +1361,27 @@ static vd_status step(turtle* T) {
   case VD_SYM_SB:
     if (!vd_grow((void**)&T->stack, &T->cap_stack, T->nstack + 1, sizeof *T->stack))
       return nomem(T);
+    // guide states and tube paths of the branch go above the parent's (dropped at ])
+    t->gst_top = T->ngst;
+    t->gcp_top = T->ngcp;
     T->stack[T->nstack++] = *t;
+    // a tube continues into the branch from its last point only (Turtle::push)
+    if (t->gc && t->gc_contour >= 0 && t->gcp_n > 0) {
+      if (!vd_grow((void**)&T->gcp, &T->cap_gcp, T->ngcp + 1, sizeof *T->gcp)) return nomem(T);
+      T->gcp[T->ngcp] = T->gcp[t->gcp_start + t->gcp_n - 1];
+      t->gcp_start = T->ngcp++;
+      t->gcp_n = 1;
+    }
     t->pending = 1;
     t->tail = -1;
     return VD_OK;
   case VD_SYM_EB:
     if (T->nstack == 0) return fail(T, VD_ERR_SYNTAX, "']' without a matching '['");
     end_axis(T, t);
+    if ((st = gc_end(T))) return st;  // a branch's tube ends with it (Turtle::pop)
     *t = T->stack[--T->nstack];
+    T->ngst = t->gst_top;
+    T->ngcp = t->gcp_top;
     return VD_OK;
 
   // moves and drawing
@@ -1003,6 +1449,7 @@ static vd_status step(turtle* T) {
              (long long)T->i, sym_name(T, T->sym));
       T->warned_width = 1;
     }
+    gc_width(T);
     return VD_OK;
 
   // colour = label
@@ -1066,8 +1513,15 @@ static vd_status step(turtle* T) {
   case VD_SYM_STARTGC:
     t->gc = 1;
     t->gc_prev = -1;
+    // a contour makes the tube a swept mesh (its path recorded from here)
+    t->gc_contour = t->contour;
+    t->gc_ccw = t->contour_ccw;
+    t->gcp_n = 0;
+    t->gcp_start = T->ngcp;
+    if (t->gc_contour >= 0 && (st = gc_record(T))) return st;
     return VD_OK;
   case VD_SYM_ENDGC:
+    if ((st = gc_end(T))) return st;
     t->gc = 0;
     t->gc_prev = -1;
     return VD_OK;
@@ -1170,10 +1624,48 @@ static vd_status step(turtle* T) {
   case VD_SYM_HEADINGREFLECTION:
     return fail(T, VD_ERR_UNSUPPORTED, "unsupported: reflections of the drawn shapes");
 
-  // curves are not supported: accepted and ignored with one warning
+  // curve-fed geometry (object parameters of the Python engine)
   case VD_SYM_SETGUIDE:
-  case VD_SYM_SWEEP:
+    if (T->np == 0) {
+      t->guide = -1;
+      return VD_OK;
+    }
+    if (T->np >= 2 && vd_lsys_value_is_obj(T->p[0])) {
+      double yo = 0, cw = 0;
+      if ((st = num(T, 1, &a)) || (st = num_or(T, 2, 0, &yo)) || (st = num_or(T, 3, 0, &cw))) return st;
+      return set_guide(T, 0, a, yo != 0, cw != 0);
+    }
+    goto no_curve;
   case VD_SYM_SETCONTOUR:
+    if (T->np >= 1 && vd_lsys_value_is_obj(T->p[0])) {
+      double cw = 0;
+      if ((st = num_or(T, 1, 0, &cw))) return st;
+      return set_contour(T, 0, cw != 0);
+    }
+    goto no_curve;
+  case VD_SYM_SWEEP:
+    // Sweep(path, section, length, dl[, radius, radius law]) = SetGuide(path, length),
+    // SetContour(section), nF(length, dl, radius, radius law) (Turtle::sweep)
+    if (T->np >= 4 && vd_lsys_value_is_obj(T->p[0])) {
+      double dl, radius = 1;
+      int law = -1;
+      if ((st = nonneg_or(T, 2, 0, "length", &a)) || (st = num(T, 3, &dl)) || (st = nonneg_or(T, 4, 1, "radius", &radius)))
+        return st;
+      if (T->np >= 6 && vd_lsys_value_is_obj(T->p[5]) && (st = get_curve(T, 5, CUR_FUNC, &law))) return st;
+      if ((st = set_guide(T, 0, a, 0, 0)) || (st = set_contour(T, 1, 0))) return st;
+      return run_nF(T, a, dl, radius, law);
+    }
+    goto no_curve;
+  case VD_SYM_ENDGUIDE:
+    t->guide = -1;
+    return VD_OK;
+  case VD_SYM_POSONGUIDE:
+    if ((st = num_or(T, 0, 0, &a))) return st;
+    return position_on_guide(T, a);
+  case VD_SYM_PGLSHAPE:
+    if (T->np == 0) return VD_OK;
+    return custom_geometry(T);
+  no_curve:
     if (!T->warned_guide) {
       vd_log(1, "turtle: module %lld '%s' needs curve objects; ignored", (long long)T->i,
              sym_name(T, T->sym));
@@ -1187,11 +1679,8 @@ static vd_status step(turtle* T) {
   case VD_SYM_LABEL:
   case VD_SYM_FRAME:
   case VD_SYM_ARROW:
-  case VD_SYM_PGLSHAPE:
   case VD_SYM_2D:
   case VD_SYM_3D:
-  case VD_SYM_ENDGUIDE:
-  case VD_SYM_POSONGUIDE:
   case VD_SYM_TEXSCALE:
   case VD_SYM_TEXUSCALE:
   case VD_SYM_TEXVSCALE:
@@ -1235,6 +1724,16 @@ static vd_status check_def(const vd_turtle_def* d, vd_error* err) {
 }
 
 static void release(turtle* T) {
+  for (int k = 0; k < T->ncur; k++) {
+    tcurve* c = &T->cur[k];
+    size_t n = (size_t)(c->kind == CUR_FUNC ? c->n : c->n * c->dim);
+    vd_free(c->p, sizeof(double) * n);
+    vd_free(c->tan, c->tan ? sizeof(double) * n : 0);
+    vd_free(c->nrm, c->nrm ? sizeof(double) * n : 0);
+  }
+  vd_free(T->cur, (size_t)T->cap_cur * sizeof *T->cur);
+  vd_free(T->gst, (size_t)T->cap_gst * sizeof *T->gst);
+  vd_free(T->gcp, (size_t)T->cap_gcp * sizeof *T->gcp);
   vd_free(T->stack, (size_t)T->cap_stack * sizeof *T->stack);
   vd_free(T->hkey, (size_t)T->hcap * sizeof *T->hkey);
   vd_free(T->hval, (size_t)T->hcap * sizeof *T->hval);
@@ -1283,6 +1782,8 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
   t->parent = -1;
   t->tail = -1;
   t->gc_prev = -1;
+  t->contour = t->gc_contour = t->guide = -1;
+  t->contour_ccw = t->gc_ccw = 1;
   T.next_axis = 1;
 
   // interpret every predefined module; organ modules have no geometry
@@ -1313,7 +1814,8 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
     st = step(&T);
   }
 
-  // the string ends every open axis (unclosed [ are tolerated, as in L-Py)
+  // the string ends every open axis (unclosed [ are tolerated, as in L-Py) and the current tube
+  if (st == VD_OK) st = gc_end(&T);
   if (st == VD_OK) {
     end_axis(&T, &T.t);
     for (int k = T.nstack - 1; k >= 0; k--)
