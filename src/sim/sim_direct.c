@@ -212,6 +212,33 @@ SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// the step's frame velocities, SIM_W segments at a time (the log map's series vectorises)
+
+SIM_CLONES void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work* w, double s, int t0, int t1) {
+  for (int b = t0; b < t1; b += SIM_W) {
+    int n = t1 - b < SIM_W ? t1 - b : SIM_W;
+    lane q[4], qp[4], dq[4], v[3], need;
+    for (int l = 0; l < SIM_W; l++) {
+      int t = b + (l < n ? l : 0);
+      vd_quat a = d->seg_quat[t], c = w->seg_prev[t];
+      q[0][l] = a.w, q[1][l] = a.x, q[2][l] = a.y, q[3][l] = a.z;
+      qp[0][l] = c.w, qp[1][l] = c.x, qp[2][l] = c.y, qp[3][l] = c.z;
+    }
+    qmul_lanes(q, qp, dq, 1, -1);
+    qlog_lanes(dq, v, need);
+    for (int l = 0; l < n; l++) {
+      int t = b + l;
+      if (m->seg_flags[t] & VD_SIM_FIXED) {
+        d->seg_omega[t] = vd_v3(0, 0, 0);
+        continue;
+      }
+      vd_vec3 r = need[l] > 0 ? quat_log((vd_quat){dq[0][l], dq[1][l], dq[2][l], dq[3][l]}) : vd_v3(v[0][l], v[1][l], v[2][l]);
+      d->seg_omega[t] = vd_scale(r, s);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // linearisation of the bodies and joints of a block
 
 // a block's inputs, gathered lane by lane (the model's part is in the plan's sim_stat)
@@ -343,7 +370,7 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   lane acs[3], acb[3];
   for (int k = 0; k < 3; k++) {
     L acs[k][l] = in->st->cs[k][l] / h2;
-    L acb[k][l] = in->bend[l] > 0 ? in->st->cb[k][l] / h2 : 1.0 / h2;
+    L acb[k][l] = (in->bend[l] > 0 ? in->st->cb[k][l] : 1.0) / h2;
   }
   // body: world inertia ib I + (it - ib) d3 d3^T; g_t = I (dth - h om) - h^2 (tau - om x I om)
   lane* d3 = b->d3;
@@ -456,14 +483,16 @@ static void held_terms(const vd_sim_model* m, const vd_sim_data* d, const sim_wo
 }
 
 // add the children's contributions to slot s's body (lane l of block b), in their fixed order
-PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, sim_blk* b, int l, int s) {
+PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, sim_blk* restrict b, int l, int s) {
+  double* restrict bh = &b->h[0][l];  // element i of the lane at bh[SIM_W * i]; g follows h
   for (int k = p->kid_start[s]; k < p->kid_start[s + 1]; k++) {
     int c = p->kid_slot[k];
     if (d->seg_broken[p->slot_seg[c]]) continue;  // it hangs from its spare now
     const sim_blk* cb = &p->blk[c / SIM_W];
-    int cl = c % SIM_W;
-    for (int i = 0; i < 21; i++) b->h[i][l] += cb->dh[i][cl];
-    for (int i = 0; i < 6; i++) b->g[i][l] += cb->dg[i][cl];
+    const double* restrict ch = &cb->dh[0][c % SIM_W];
+    const double* restrict cg = &cb->dg[0][c % SIM_W];
+    _Pragma("GCC unroll 21") for (int i = 0; i < 21; i++) bh[SIM_W * i] += ch[SIM_W * i];
+    _Pragma("GCC unroll 6") for (int i = 0; i < 6; i++) b->g[i][l] += cg[SIM_W * i];
   }
 }
 

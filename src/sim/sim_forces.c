@@ -16,11 +16,6 @@ vd_vec3 sim_wind_at(const vd_sim_opt* o, double t) {
   return vd_wind_at(o->wind, o->gust_amplitude, o->gust_period, o->wind_series, o->nwind, t);
 }
 
-// velocity of a node (zero when kinematic)
-static vd_vec3 node_v(const vd_sim_model* m, const vd_sim_data* d, int n) {
-  return sim_node_moves(m, d, n) ? d->node_vel[n] : vd_v3(0, 0, 0);
-}
-
 typedef struct forces_ctx {
   const vd_sim_model* m;
   vd_sim_data* d;
@@ -74,7 +69,7 @@ static void seg_drag(void* p, int k, int t0, int t1) {
     int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
     int ma = sim_node_moves(m, d, na), mb = sim_node_moves(m, d, nb);
     if (!ma && !mb) continue;
-    vd_vec3 u = vd_sub(c->wind, vd_scale(vd_add(node_v(m, d, na), node_v(m, d, nb)), 0.5));
+    vd_vec3 z = vd_v3(0, 0, 0), u = vd_sub(c->wind, vd_scale(vd_add(ma ? d->node_vel[na] : z, mb ? d->node_vel[nb] : z), 0.5));
     vd_quat qt = d->seg_quat[t];
     vd_vec3 d3 = quat_d3(qt);
     vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));

@@ -354,6 +354,9 @@ static inline void sim_warn(vd_sim_data* d, int k) {
 // Both solvers: project all constraints for one step (positions and frames in d are moved).
 // sim_solve_direct returns 0 when a factorisation failed (the step must be retaken), else 1.
 int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
+// The frames' velocities at the end of a step, lane-parallel (sim_direct.c; the same bytes as
+// the scalar log map): segments [t0, t1) get omega = s log(q conj(q_prev)) (fixed ones 0).
+void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work* w, double s, int t0, int t1);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
 // 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division

@@ -137,15 +137,14 @@ static void velocity_range(void* p, int k, int i0, int i1) {
   const sim_work* w = c->w;
   double s = c->damp / c->h;
   (void)k;
-  for (int i = i0; i < i1; i++) {
-    if (i < m->nnode_all)
-      d->node_vel[i] = !sim_node_moves(m, d, i) || c->statics ? vd_v3(0, 0, 0)
-                                                              : vd_scale(vd_sub(d->node_pos[i], w->node_prev[i]), s);
-    if (i < m->nseg)
-      d->seg_omega[i] = (m->seg_flags[i] & VD_SIM_FIXED) || c->statics
-                            ? vd_v3(0, 0, 0)
-                            : vd_scale(quat_log(q_mul(d->seg_quat[i], q_conj(w->seg_prev[i]))), s);
-  }
+  for (int i = i0; i < i1 && i < m->nnode_all; i++)
+    d->node_vel[i] = !sim_node_moves(m, d, i) || c->statics ? vd_v3(0, 0, 0)
+                                                            : vd_scale(vd_sub(d->node_pos[i], w->node_prev[i]), s);
+  int t1 = i1 < m->nseg ? i1 : m->nseg;
+  if (c->statics)
+    for (int t = i0; t < t1; t++) d->seg_omega[t] = vd_v3(0, 0, 0);
+  else if (i0 < t1)
+    sim_frame_velocities(m, d, w, s, i0, t1);
 }
 
 void sim_detach(const vd_sim_model* m, vd_sim_data* d, int t) {
