@@ -619,9 +619,9 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
   for (uint64_t v = 0; v < nevlr && evlr >= offset && evlr <= len && len - evlr >= 60; v++) {
     const unsigned char* h = b + evlr;
     uint64_t elen = le(h + 20, 8);
-    if (elen > len - evlr - 60) return fail(r, evlr, "extended VLR %lld runs past the end of the file", (long long)v);
+    if (elen > len - evlr - 60) return fail(r, 0, "extended VLR %lld runs past the end of the file", (long long)v);
     if (!memcmp(h + 2, "verdant", 8) && le(h + 18, 2) == 1) {
-      if (elen > 65535ull * 1024) return fail(r, evlr, "label table of %llu bytes", (unsigned long long)elen);
+      if (elen > 65535ull * 1024) return fail(r, 0, "label table of %llu bytes", (unsigned long long)elen);
       r->nlabel = 0;
       vd_status st = las_label_table(r, h + 60, (unsigned)elen);
       if (st) return st;
