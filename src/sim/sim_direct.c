@@ -253,43 +253,47 @@ typedef struct sim_in {
   sim_stat* st;               // the block's model data
 } sim_in;
 
-// gather lane l of a block from slot s (padding: a unit body and joint)
+// gather the lanes of block bi from their slots (padding: a unit body and joint)
 PROF_NOINLINE static void gather_in(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
-                                    sim_in* in, int l, int s) {
+                                    sim_in* restrict in, int bi) {
   const sim_plan* p = &w->plan;
-  int t = p->slot_seg[s];
-  double h = ctx->h;
-  if (t < 0) {
-    double* f = &in->qt[0][0];
-    for (size_t k = 0; k < offsetof(sim_in, st) / sizeof(lane); k++) f[SIM_W * k + l] = 0;
-    in->qt[0][l] = in->qp[0][l] = in->qv[0][l] = 1;
-    in->mass[l] = 1;
-    return;
+  const double h = ctx->h;
+  const int damped = ctx->gamma > 0;
+  if (!damped)
+    for (int k = 0; k < 6; k++) L in->cp[k][l] = 0;
+  for (int l = 0; l < SIM_W; l++) {
+    int s = bi * SIM_W + l, t = p->slot_seg[s];
+    if (t < 0) {
+      double* f = &in->qt[0][0];
+      for (size_t k = 0; k < offsetof(sim_in, st) / sizeof(lane); k++) f[SIM_W * k + l] = 0;
+      in->qt[0][l] = in->qp[0][l] = in->qv[0][l] = 1;
+      in->mass[l] = 1;
+      continue;
+    }
+    int nb = m->seg_node[2 * t + 1], na = d->seg_start[t], par = m->seg_parent[t];
+    int bend = !d->seg_broken[t] && par >= 0;
+    vd_quat q = d->seg_quat[t], qp = bend ? d->seg_quat[par] : vd_quat_identity(), qv = w->seg_prev[t];
+    in->qt[0][l] = q.w, in->qt[1][l] = q.x, in->qt[2][l] = q.y, in->qt[3][l] = q.z;
+    in->qp[0][l] = qp.w, in->qp[1][l] = qp.x, in->qp[2][l] = qp.y, in->qp[3][l] = qp.z;
+    in->qv[0][l] = qv.w, in->qv[1][l] = qv.x, in->qv[2][l] = qv.y, in->qv[3][l] = qv.z;
+    vd_vec3 xb = d->node_pos[nb], xa = d->node_pos[na], xv = w->node_prev[nb], v = d->node_vel[nb];
+    vd_vec3 fe = w->node_fext[nb], om = d->seg_omega[t], te = w->seg_text[t];
+    in->e[0][l] = xb.x - xa.x, in->e[1][l] = xb.y - xa.y, in->e[2][l] = xb.z - xa.z;
+    in->dx[0][l] = xb.x - xv.x - v.x * h, in->dx[1][l] = xb.y - xv.y - v.y * h, in->dx[2][l] = xb.z - xv.z - v.z * h;
+    in->fe[0][l] = fe.x, in->fe[1][l] = fe.y, in->fe[2][l] = fe.z;
+    in->om[0][l] = om.x, in->om[1][l] = om.y, in->om[2][l] = om.z;
+    in->te[0][l] = te.x, in->te[1][l] = te.y, in->te[2][l] = te.z;
+    const double* lam = d->seg_lambda + 6 * t;
+    for (int k = 0; k < 6; k++) in->lam[k][l] = lam[k];
+    if (damped) {
+      const double* cp = w->c_prev + 6 * t;
+      for (int k = 0; k < 6; k++) in->cp[k][l] = cp[k];
+    }
+    for (int k = 0; k < 3; k++) in->tieg[k][l] = p->tie_g[3 * s + k];
+    in->mass[l] = d->node_mass[nb] + h * w->node_drag[nb];
+    in->tieh[l] = p->tie_h[s];
+    in->bend[l] = bend;
   }
-  int nb = m->seg_node[2 * t + 1], na = d->seg_start[t], par = m->seg_parent[t];
-  int bend = !d->seg_broken[t] && par >= 0;
-  vd_quat q = d->seg_quat[t], qp = bend ? d->seg_quat[par] : vd_quat_identity(), qv = w->seg_prev[t];
-  in->qt[0][l] = q.w, in->qt[1][l] = q.x, in->qt[2][l] = q.y, in->qt[3][l] = q.z;
-  in->qp[0][l] = qp.w, in->qp[1][l] = qp.x, in->qp[2][l] = qp.y, in->qp[3][l] = qp.z;
-  in->qv[0][l] = qv.w, in->qv[1][l] = qv.x, in->qv[2][l] = qv.y, in->qv[3][l] = qv.z;
-  vd_vec3 xb = d->node_pos[nb], xa = d->node_pos[na], xv = w->node_prev[nb], v = d->node_vel[nb];
-  vd_vec3 fe = w->node_fext[nb], om = d->seg_omega[t], te = w->seg_text[t];
-  in->e[0][l] = xb.x - xa.x, in->e[1][l] = xb.y - xa.y, in->e[2][l] = xb.z - xa.z;
-  in->dx[0][l] = xb.x - xv.x - v.x * h, in->dx[1][l] = xb.y - xv.y - v.y * h, in->dx[2][l] = xb.z - xv.z - v.z * h;
-  in->fe[0][l] = fe.x, in->fe[1][l] = fe.y, in->fe[2][l] = fe.z;
-  in->om[0][l] = om.x, in->om[1][l] = om.y, in->om[2][l] = om.z;
-  in->te[0][l] = te.x, in->te[1][l] = te.y, in->te[2][l] = te.z;
-  const double* lam = d->seg_lambda + 6 * t;
-  for (int k = 0; k < 6; k++) in->lam[k][l] = lam[k];
-  const double* cp = w->c_prev + 6 * t;
-  if (ctx->gamma > 0)
-    for (int k = 0; k < 6; k++) in->cp[k][l] = cp[k];
-  else
-    for (int k = 0; k < 6; k++) in->cp[k][l] = 0;
-  for (int k = 0; k < 3; k++) in->tieg[k][l] = p->tie_g[3 * s + k];
-  in->mass[l] = d->node_mass[nb] + h * w->node_drag[nb];
-  in->tieh[l] = p->tie_h[s];
-  in->bend[l] = bend;
 }
 
 // bend-twist strain and its Jacobian dC/dpsi of the lanes (sim_bend_strain, lane-parallel);
@@ -502,7 +506,8 @@ PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, s
 // forward elimination of a block: H^-1, S = J H^-1 J^T + alpha^, r, S^-1 and the contribution
 // to the parent; tip: the body matrix is (mass) I and the inertia, its inverse written down
 SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
-  lane hi[21], sm[21], ok;
+  // H^-1 and S^-1 are written where the block keeps them (a tip's straight into b->h)
+  lane hl[21], sm[21], ok, *hi = tip ? b->h : hl, *si = b->s;
   L ok[l] = 1.0;
   if (tip) {
     // (m I)^-1 and R diag(1/ib, 1/ib, 1/it) R^T = (1/ib) I + (1/it - 1/ib) d3 d3^T
@@ -563,7 +568,6 @@ SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
     L r[i][l] = -b->c[i][l] + hg[i][l] + ew[i][l];
     L r[3 + i][l] = -b->c[3 + i][l] + g[3 * i][l] * hg[3][l] + g[3 * i + 1][l] * hg[4][l] + g[3 * i + 2][l] * hg[5][l];
   }
-  lane si[21];
   inv6s(sm, si, ok);
   // contribution J_p^T S^-1 J_p = [[S^-1_A, S^-1_B G], [., G^T S^-1_D G]] and to g_p:
   // [(S^-1 r)_s + f; G^T ((S^-1 r)_b + lambda_b)]
@@ -584,8 +588,8 @@ SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
     L pb[k][l] = sr[3 + k][l] + b->lf[3 + k][l];
   }
   for (int k = 0; k < 3; k++) L b->dg[3 + k][l] = g[k][l] * pb[0][l] + g[3 + k][l] * pb[1][l] + g[6 + k][l] * pb[2][l];
-  for (int k = 0; k < 21; k++) L b->h[k][l] = hi[k][l];
-  for (int k = 0; k < 21; k++) L b->s[k][l] = si[k][l];
+  if (!tip)
+    for (int k = 0; k < 21; k++) L b->h[k][l] = hi[k][l];
   for (int k = 0; k < 6; k++) L b->r[k][l] = r[k][l];
   L b->ok[l] = ok[l];
 }
@@ -647,7 +651,7 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
     sim_blk* b = &p->blk[bi];
     sim_in in;
     in.st = &p->stat[bi];
-    for (int l = 0; l < SIM_W; l++) gather_in(m, d, w, ctx, &in, l, bi * SIM_W + l);
+    gather_in(m, d, w, ctx, &in, bi);
     eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l;
