@@ -11,8 +11,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "growth_hopea.h"  // data/hopea.lpy as a string
-#include "growth_tree.h"   // data/tree.lpy as a string (cmake/embed.cmake)
+#include "growth_hopea_lpy.h"  // data/hopea.lpy as a string
+#include "growth_tree_lpy.h"   // data/tree.lpy as a string (cmake/embed.cmake)
 #include "verdant/growth.h"
 
 typedef struct gv {
