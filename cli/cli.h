@@ -96,6 +96,17 @@ void cli_unwatch(int slot);
 
 // Monotonic seconds.
 double cli_now(void);
+// A progress bar on stderr: "\rWHAT [####    ] TEXT" (frac in [0, 1]); the caller ends it with
+// a newline. Callers show it only when stderr is a terminal (cli_plant_opts.progress).
+void cli_progress_bar(const char* what, double frac, const char* text);
+// When to redraw a bar: at the first call, then at most ten times a second; off when on is 0.
+typedef struct cli_progress {
+  int on, shown;
+  double last;  // cli_now() of the last redraw
+} cli_progress;
+int cli_progress_due(cli_progress* p);
+// End a bar that was shown (a newline).
+void cli_progress_end(cli_progress* p);
 // Does path end with ext (case-insensitive, ext with the dot)?
 int cli_has_ext(const char* path, const char* ext);
 

@@ -309,6 +309,30 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
   return 0;
 }
 
+void cli_progress_bar(const char* what, double frac, const char* text) {
+  int w = 30, fill = (int)(frac * w + 1e-6);
+  if (!(fill >= 0)) fill = 0;
+  if (fill > w) fill = w;
+  char bar[64];
+  for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
+  bar[w] = 0;
+  fprintf(stderr, "\r%s [%s] %s", what, bar, text);
+  fflush(stderr);
+}
+
+int cli_progress_due(cli_progress* p) {
+  if (!p->on) return 0;
+  double now = cli_now();
+  if (p->shown && now - p->last < 0.1) return 0;
+  p->shown = 1, p->last = now;
+  return 1;
+}
+
+void cli_progress_end(cli_progress* p) {
+  if (p->shown) fputc('\n', stderr);
+  p->shown = 0;
+}
+
 // progress bar on stderr: only when it is a terminal
 static int progress_cb(void* user, int step, int steps, int64_t modules) {
   (void)user;
