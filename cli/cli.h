@@ -37,6 +37,8 @@ typedef struct cli_plant_opts {
   double curve_distance;   // --curve-distance (m), < 0: the file's or the default
   int engine;              // --engine auto|native|python (vd_lsys_engine), VD_LSYS_AUTO by default
   const char* lstring_out; // --lstring FILE: the derived L-string as JSON (.lpy files), NULL: none
+  int instances;           // --instances: a vd_instance_mode, or -1 (default): organs for .lpy
+                           // files, a plant file's own numbering
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
