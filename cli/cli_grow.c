@@ -96,7 +96,7 @@ static vd_status write_traits(const char* path, const vd_plant_spec* p, const vd
     char name[VD_LABEL_NAME_MAX];
     size_t k = 0;
     for (const char* c = l ? l->name : ""; *c && k + 1 < sizeof name; c++)  // a CSV field: no commas, quotes or breaks
-      name[k++] = (*c == ',' || *c == '"' || (unsigned char)*c < 0x20) ? '_' : *c;
+      name[k++] = (char)((*c == ',' || *c == '"' || (unsigned char)*c < 0x20) ? '_' : *c);
     name[k] = 0;
     fprintf(f.fp, "%d,%d,%s,%s,%d,%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", o->instance, o->label, name,
             vd_organ_name(o->organ), o->nseg, o->nsphere, o->nmesh, o->length, o->area, o->diameter, o->volume,
