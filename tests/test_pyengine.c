@@ -474,3 +474,17 @@ TEST(pyengine, pglshape_places_the_geometry) {
   CHECK_NEAR(ymax, 1.0, 1e-12);
   vd_plant_spec_destroy(p);
 }
+
+TEST(pyengine, interpretation_hooks_produce_around_the_string) {
+  if (!python_here()) return;
+  vd_error e = {0};
+  // StartInterpretation's modules come first (a sphere, a turn), EndInterpretation's last
+  vd_plant_spec* p = grow_py("def StartInterpretation():\n  produce @O(0.2) +(90)\n"
+                             "def EndInterpretation(turtle):\n  produce @O(0.3)\nAxiom: F(1)\n",
+                             &e);
+  REQUIRE(p && p->nsphere == 2 && p->nseg == 1);
+  CHECK_NEAR(p->sphere[0].radius, 0.2, 1e-12);
+  CHECK_NEAR(p->sphere[1].radius, 0.3, 1e-12);
+  CHECK_NEAR(p->sphere[1].center.y, -1, 1e-12);  // after F(1) turned toward L = -Y
+  vd_plant_spec_destroy(p);
+}

@@ -371,6 +371,7 @@ static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 // (with source index src)
 static vd_status interpretation_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src,
                                      int64_t max_modules) {
+  if (ls->py) return lsys_py_produce_hook(ls, name, out, src, max_modules);
   int fi = find_hook(ls, name);
   if (fi < 0) return VD_OK;
   func* f = ls->funcs[fi];

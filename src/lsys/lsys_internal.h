@@ -507,6 +507,9 @@ vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, 
 // call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
 // the current string (an End hook may return a new one). Missing hooks are fine.
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
+// call hook name (StartInterpretation, EndInterpretation) with what it produces appended to out,
+// recorded as coming from module src; a hook that declares a parameter gets the turtle (None)
+vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules);
 // drop objects that no module of s refers to any more (after a step)
 void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)

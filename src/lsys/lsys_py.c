@@ -1129,6 +1129,19 @@ static int arity(PyObject* f) {
   return k;
 }
 
+vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules) {
+  lsys_py* py = ls->py;
+  if (!py->ns) return VD_OK;
+  PyObject* f = PyDict_GetItemString(py->ns, name);  // borrowed
+  if (!f || !PyCallable_Check(f)) return VD_OK;
+  PyObject* args[1] = {Py_None};
+  vm_out vo = {out, src, max_modules, 0, 0};
+  Py_INCREF(f);
+  vd_status st = call_rule(ls, f, args, arity(f) >= 1 ? 1 : 0, &vo);
+  Py_DECREF(f);
+  return st;
+}
+
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules) {
   lsys_py* py = ls->py;
   if (!py->ns) return VD_OK;
