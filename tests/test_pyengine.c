@@ -488,3 +488,22 @@ TEST(pyengine, interpretation_hooks_produce_around_the_string) {
   CHECK_NEAR(p->sphere[1].center.y, -1, 1e-12);  // after F(1) turned toward L = -Y
   vd_plant_spec_destroy(p);
 }
+
+TEST(pyengine, hooks_get_the_scene) {
+  if (!python_here()) return;
+  // End(lstring, lscene): one Shape per primitive, id = the drawing module's index, PlantGL's
+  // geometry (a cone when the top radius is 0, a polyline for a zero radius, a placed cylinder)
+  const char* src =
+      "def End(lstring, lscene):\n"
+      "    assert type(lscene) == Scene\n"
+      "    ids = sorted(lscene.todict().keys())\n"
+      "    assert ids == [0, 2, 3, 4], ids\n"
+      "    assert type(lscene[0].geometry) == Cone\n"
+      "    assert type(lscene[1].geometry) == Polyline\n"
+      "    g = lscene[2].geometry\n"
+      "    assert type(g) == Translated and type(g.geometry) == Cylinder and abs(g.translation.z - 2) < 1e-9\n"
+      "    assert type(lscene[3].geometry.geometry) == Sphere\n"
+      "    return lstring, lscene\n"
+      "Axiom: F(1, 0) ; F(1) _(0.5) F(1) @O(1)\n";
+  CHECK_PY(src, 1, "F(1,0);F(1)_(0.5)F(1)@O(1)");
+}

@@ -400,6 +400,21 @@ static vd_status interpret_into(vd_lsystem* ls, const vd_lstring* in, vd_lstring
   return interpretation_hook(ls, "EndInterpretation", out, in->n + 1, P->max_modules);
 }
 
+vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant) {
+  lsys_pass P;
+  memset(&P, 0, sizeof P);
+  P.max_modules = INT64_MAX / 64;
+  vd_lstring geo = vd_lstring_empty();
+  vd_status st = interpret_into(ls, s, &geo, &P);
+  if (!st) {
+    vd_turtle_def td = vd_turtle_def_default();
+    st = vd_turtle_run(ls, &geo, &td, plant, ls->err);
+  }
+  vd_lstring_free(&geo);
+  lsys_pass_free(&P);
+  return st;
+}
+
 // L-Py's environmental programs: before a step whose rules read query modules, the turtle
 // interprets the string and fills ?P ?H ?U ?L ?R with its position and frame (in the modules
 // the interpretation rules leave as they are)

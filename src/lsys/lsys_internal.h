@@ -510,6 +510,9 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
 // call hook name (StartInterpretation, EndInterpretation) with what it produces appended to out,
 // recorded as coming from module src; a hook that declares a parameter gets the turtle (None)
 vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules);
+// the plant the string s draws (interpretation with its hooks, then the turtle), for the scene
+// a Python hook receives (EndEach(lstring, lscene))
+vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant);
 // drop objects that no module of s refers to any more (after a step)
 void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)

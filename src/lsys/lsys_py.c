@@ -808,6 +808,65 @@ static PyObject* vd_append(PyObject* self, PyObject* arg) {
   return py_none();
 }
 
+static PyObject* vec_tuple(vd_vec3 v) { return Py_BuildValue("(ddd)", v.x, v.y, v.z); }
+
+// a primitive of the hook's scene: (kind, module, parent, ...) as _vd_build_scene reads it
+static PyObject* scene_prims(const vd_plant_spec* p) {
+  PyObject* list = PyList_New(0);
+  for (int i = 0; list && i < p->nseg; i++) {
+    const vd_segment_spec* g = &p->seg[i];
+    PyObject* it = Py_BuildValue("(sLiNNddN)", "seg", (long long)g->module, g->parent, vec_tuple(p->node[g->node0]),
+                                 vec_tuple(p->node[g->node1]), g->r0, g->r1, vec_tuple(g->up));
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  for (int i = 0; list && i < p->nsphere; i++) {
+    const vd_sphere_spec* g = &p->sphere[i];
+    PyObject* it =
+        Py_BuildValue("(sLiNd)", "sph", (long long)g->module, g->parent, vec_tuple(g->center), g->radius);
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  for (int i = 0; list && i < p->nmesh; i++) {
+    const vd_mesh_spec* m = &p->mesh[i];
+    PyObject* v = PyList_New(m->nvert);
+    PyObject* t = PyList_New(m->ntri);
+    for (int k = 0; v && k < m->nvert; k++) PyList_SET_ITEM(v, k, vec_tuple(p->vert[m->vert_start + k]));
+    for (int k = 0; t && k < m->ntri; k++) {
+      const int* q = &p->tri[3 * (m->tri_start + k)];
+      PyList_SET_ITEM(t, k, Py_BuildValue("(iii)", q[0], q[1], q[2]));
+    }
+    PyObject* it = v && t ? Py_BuildValue("(sLiNNi)", "mesh", (long long)m->module, m->parent, v, t, m->closed) : NULL;
+    if (!it) {
+      Py_XDECREF(v);
+      Py_XDECREF(t);
+    }
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  return list;
+}
+
+// _vd.scene(): the primitives the hook's string draws
+static PyObject* vd_scene(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  if (!ls->py->hook_s) {
+    PyErr_SetString(PyExc_RuntimeError, "the scene is only known inside a hook");
+    return NULL;
+  }
+  vd_plant_spec* p = vd_plant_spec_create();
+  if (!p) return PyErr_NoMemory();
+  vm_out* saved = ls->py->out;
+  vd_status st = lsys_scene(ls, ls->py->hook_s, p);
+  ls->py->out = saved;
+  PyObject* r = st ? NULL : scene_prims(p);
+  vd_plant_spec_destroy(p);
+  if (st) return vd_abort();
+  return r;
+}
+
 static PyObject* vd_use_group(PyObject* self, PyObject* arg) {
   (void)self;
   vd_lsystem* ls = current();
@@ -882,6 +941,7 @@ static PyMethodDef vd_methods[] = {
     {"mk", (PyCFunction)(void (*)(void))vd_mk, METH_FASTCALL, "the items of a template"},
     {"parse", vd_parse, METH_O, "modules of an L-string text"},
     {"append", vd_append, METH_O, "append (name, params) items to the production"},
+    {"scene", vd_scene, METH_NOARGS, "the primitives the hook's string draws"},
     {"use_group", vd_use_group, METH_O, "useGroup"},
     {"get_group", vd_get_group, METH_NOARGS, "getGroup"},
     {"iteration", vd_iteration, METH_NOARGS, "getIterationNb"},
@@ -1158,8 +1218,11 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
     n = 1;
   }
   if (want >= 2) {
-    Py_INCREF(Py_None);
-    args[1] = Py_None;
+    args[1] = shim_call("_vd_lazy_scene", NULL);  // made from s when the hook reads it
+    if (!args[1]) {
+      Py_DECREF(args[0]);
+      return py_error(ls);
+    }
     n = 2;
   }
   Py_INCREF(f);
@@ -1172,14 +1235,25 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   }
   lstr_clear(scratch);
   vm_out* saved = py->out;
+  const vd_lstring* saved_s = py->hook_s;
   py->out = &vo;  // an nproduce in a hook has nowhere to go but is not an error
+  py->hook_s = s;
   PyObject* r = PyObject_Vectorcall(f, args, (size_t)n, NULL);
   py->out = saved;
+  py->hook_s = saved_s;
   Py_DECREF(f);
   for (int i = 0; i < n; i++) Py_DECREF(args[i]);
   if (!r) return py_error(ls);
   vd_status st = VD_OK;
-  if (r != Py_None && r != Py_True && r != Py_False) {
+  // a hook may return (lstring, scene): the string counts
+  if (PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 2) {
+    PyObject* first = PyTuple_GET_ITEM(r, 0);
+    Py_INCREF(first);
+    Py_DECREF(r);
+    r = first;
+  }
+  PyObject* scene_type = PyDict_GetItemString(g_shim, "Scene");  // borrowed
+  if (r != Py_None && r != Py_True && r != Py_False && !(scene_type && PyObject_IsInstance(r, scene_type) == 1)) {
     // the hook returned a new string: it replaces the current one
     PyObject* items = shim_call("_vd_items", r);
     lstr_clear(scratch);

@@ -1721,7 +1721,11 @@ class Box(_Geometry):
         return v, t, True
 
 
-class TriangleSet(_Geometry):
+class Mesh(_Geometry):
+    """The base of PlantGL's explicit meshes (TriangleSet, QuadSet, FaceSet)."""
+
+
+class TriangleSet(Mesh):
     def __init__(self, pointList=(), indexList=(), *a, **kw):
         self.pointList = Point3Array(pointList)
         self.indexList = [tuple(int(i) for i in f) for f in indexList]
@@ -1934,11 +1938,98 @@ class Shape(_Geometry):
 
 
 class Scene(list):
+    """A list of Shapes. The one a hook receives (EndEach(lstring, lscene)) is filled on first use
+    with what the turtle draws from the string: one Shape per primitive, id = the module's index
+    in the string, geometry as PglTurtleDrawer builds it (Cylinder/Frustum/Cone placed by
+    Oriented and Translated, Polyline for zero radii, Sphere, TriangleSet)."""
+    _vd_pending = False
+
+    def _vd_fill(self):
+        if self._vd_pending:
+            self._vd_pending = False
+            list.extend(self, _vd_build_scene(_vd.scene()))
+
+    def __len__(self):
+        self._vd_fill()
+        return list.__len__(self)
+
+    def __getitem__(self, i):
+        self._vd_fill()
+        return list.__getitem__(self, i)
+
+    def __iter__(self):
+        self._vd_fill()
+        return list.__iter__(self)
+
+    def __bool__(self):
+        return self.__len__() > 0
+
     def add(self, s):
+        self._vd_fill()
         self.append(s)
+
+    def todict(self):
+        d = {}
+        for sh in self:
+            d.setdefault(sh.id, []).append(sh)
+        return d
 
     def _mesh(self):
         return Group(list(self))._mesh()
+
+
+def _vd_lazy_scene(_=None):
+    sc = Scene()
+    sc._vd_pending = True
+    return sc
+
+
+def _placed(g, pos, u, l):
+    """PglTurtleDrawer::transform: local x along U, y along -L, z along H, then the position."""
+    if abs(u.x - 1) > 1e-9 or abs(u.y) > 1e-9 or abs(u.z) > 1e-9 or abs(l.x) > 1e-9 or abs(l.y + 1) > 1e-9 or abs(l.z) > 1e-9:
+        g = Oriented(u, -l, g)
+    if norm(pos) > 1e-12:
+        g = Translated(pos, g)
+    return g
+
+
+def _vd_build_scene(prims):
+    """Shapes from the turtle's primitives (kind, module, parent, ...), in module order."""
+    out = []
+    order = sorted(range(len(prims)), key=lambda k: (prims[k][1], k))
+    for k in order:
+        p = prims[k]
+        kind, mid, parent = p[0], int(p[1]), int(p[2])
+        if kind == "seg":
+            p0, p1, r0, r1, up = Vector3(*p[3]), Vector3(*p[4]), p[5], p[6], Vector3(*p[7])
+            d = p1 - p0
+            length = norm(d)
+            h = d / length if length > 0 else Vector3(0, 0, 1)
+            l = (up ^ h).normed()
+            if r0 > 1e-6:
+                taper = r1 / r0
+                if abs(taper) < 1e-6:
+                    g = Cone(r0, length, False)
+                elif abs(taper - 1) < 1e-6:
+                    g = Cylinder(r0, length, False)
+                else:
+                    g = Frustum(r0, length, taper, False)
+                g = _placed(g, p0, up, l)
+            elif r1 < 1e-6:
+                g = Polyline([p0, p1])
+            else:
+                g = Cone(r1, length, False)
+                if abs(l.x - 1) > 1e-9 or abs(l.y) > 1e-9 or abs(l.z) > 1e-9 or abs(up.y + 1) > 1e-9:
+                    g = Oriented(l, -up, g)
+                g = Translated(p1, g)
+        elif kind == "sph":
+            g = Sphere(p[4])
+            if norm(Vector3(*p[3])) > 1e-12:
+                g = Translated(Vector3(*p[3]), g)
+        else:
+            g = TriangleSet(p[3], p[4])
+        out.append(Shape(g, None, mid, parent))
+    return out
 
 
 def _mesh_of(g):
@@ -2035,7 +2126,7 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "Point2Matrix", "Point3Matrix", "Point4Matrix", "Color3", "Color4", "Material", "ImageTexture",
                "Texture2D", "Texture2DTransformation", "NurbsCurve2D", "NurbsCurve", "BezierCurve2D", "BezierCurve",
                "Polyline2D", "Polyline", "Curve2D", "QuantisedFunction", "Sphere", "Cylinder", "Cone", "Frustum",
-               "Disc", "Box", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
+               "Disc", "Box", "Mesh", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
                "BezierPatch", "Paraboloid",
                "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
