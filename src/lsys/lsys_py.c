@@ -1242,6 +1242,13 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   py->out = saved;
   py->hook_s = saved_s;
   Py_DECREF(f);
+  // a hook that changed the L-string it was given in place (lstring[0][0] = 2) and returned
+  // nothing: the changed string is the result, as the hook saw L-Py's own string
+  if (r == Py_None && n >= 1) {
+    Py_DECREF(r);
+    Py_INCREF(args[0]);
+    r = args[0];
+  }
   for (int i = 0; i < n; i++) Py_DECREF(args[i]);
   if (!r) return py_error(ls);
   vd_status st = VD_OK;

@@ -590,8 +590,10 @@ def _future_module():
     def EndEach():
         pass
 
-    for f in (DiscardNewString, enable_string_discard, pushString, popString, enable_string_pushpop, EndEach):
-        setattr(m, f.__name__, f)
+    for name, f in (("DiscardNewString", DiscardNewString), ("enable_string_discard", enable_string_discard),
+                    ("pushString", pushString), ("popString", popString),
+                    ("enable_string_pushpop", enable_string_pushpop), ("EndEach", EndEach)):
+        setattr(m, name, f)
     m.__all__ = ["DiscardNewString", "enable_string_discard", "pushString", "popString", "enable_string_pushpop",
                  "EndEach"]
     return m
@@ -2042,6 +2044,42 @@ def _mesh_of(g):
 
 
 # ---------------------------------------------------------------------------------------------
+# display and extensions: verdant has no viewer (every Viewer call does nothing, as in L-Py's
+# batch runs); tools it does not provide fail when called, not when imported
+
+
+class _NoDisplay:
+    """PlantGL's Viewer without a window: attributes and calls accepted, nothing shown."""
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return _NoDisplay()
+
+    def __setattr__(self, name, value):
+        pass
+
+    def __call__(self, *a, **k):
+        return None
+
+
+Viewer = _NoDisplay()
+eStatic, eAnimatedPrimitives, eAnimatedScene = 0, 1, 2
+
+
+def pgl_support_extension(name):
+    """PlantGL's optional extensions (CGAL, ...): none here."""
+    return False
+
+
+def _unsupported(what):
+    def f(*a, **k):
+        raise NotImplementedError("%s is not available in verdant's PlantGL" % what)
+    f.__name__ = what
+    return f
+
+
+# ---------------------------------------------------------------------------------------------
 # what the turtle asks for
 
 
@@ -2134,23 +2172,30 @@ _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGr
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
         "PatternModule"]
 
+_DISPLAY = ["Viewer", "eStatic", "eAnimatedPrimitives", "eAnimatedScene", "pgl_support_extension"]
 _pgl_math = _module("openalea.plantgl.math", _MATH)
 _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
-_pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH)
+_pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH + _DISPLAY)
+_pgl_light = _types.ModuleType("openalea.plantgl.light.light")
+_pgl_light.diffuseInterception = _unsupported("diffuseInterception")
+_pgl_light.directionalInterception = _unsupported("directionalInterception")
+_pgl_light_pkg = _types.ModuleType("openalea.plantgl.light")
+_pgl_light_pkg.light = _pgl_light
 _pgl = _module("openalea.plantgl", [])
-_pgl.all, _pgl.math, _pgl.scenegraph = _pgl_all, _pgl_math, _pgl_sg
+_pgl.all, _pgl.math, _pgl.scenegraph, _pgl.light = _pgl_all, _pgl_math, _pgl_sg, _pgl_light_pkg
 _lpy = _module("openalea.lpy", _LPY)
 _openalea = _module("openalea", [])
 _openalea.plantgl, _openalea.lpy = _pgl, _lpy
 OPENALEA = {"openalea": _openalea, "openalea.plantgl": _pgl, "openalea.plantgl.all": _pgl_all,
-            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy}
+            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy,
+            "openalea.plantgl.light": _pgl_light_pkg, "openalea.plantgl.light.light": _pgl_light}
 
 _BUILTINS = dict(_builtins.__dict__)
 _BUILTINS["__import__"] = _vd_import
 _BUILTINS["print"] = _vd_print
 
 BASE = {"__builtins__": _BUILTINS, "__name__": "__lpy__"}
-for _n in _MATH + _SCENEGRAPH + _LPY:
+for _n in _MATH + _SCENEGRAPH + _LPY + _DISPLAY:
     BASE[_n] = globals()[_n]
 BASE["__vd_p"] = _vd.p
 BASE["__vd_mk"] = _vd_mk
