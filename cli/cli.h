@@ -58,6 +58,10 @@ typedef struct cli_grow_info {
   const char* engine;       // the engine that ran the .lpy file ("native", "python"), NULL otherwise
 } cli_grow_info;
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err);
+// What the file at path is when it is not a plant ("a mesh (PLY)", "a point cloud (LAS)", "a
+// simulation run", JSON of another format), told from its first bytes and its name; NULL when it
+// may be one (L-Py text, plant or curves JSON). buf holds the text for some kinds (cli_kind.c).
+const char* cli_not_a_plant(const char* path, char* buf, size_t cap);
 // Free what cli_load_plant put in info.
 void cli_grow_info_free(cli_grow_info* info);
 
@@ -154,6 +158,9 @@ void cli_cloud_opts_init(cli_cloud_opts* o);
 int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int* i);
 // Check option combinations after parsing; prints and returns EXIT_USAGE, or 0 when fine.
 int cli_cloud_check(const cli_cloud_opts* o, const char* cmd);
+// Check the writer options against the output (a file name, a format name "ply", or NULL when
+// nothing is written): --ascii needs PLY or PCD, --ply-scalar-prefix PLY. Prints, EXIT_USAGE.
+int cli_cloud_check_output(const cli_cloud_opts* o, const char* cmd, const char* out);
 // Help text lines for the cloud options.
 extern const char* cli_cloud_help;
 
@@ -309,6 +316,11 @@ void cli_view_record(const cli_view_opts* v, const cli_view* view, struct cJSON*
 // Append the render options that make a view again to a recipe (fields in braces: {azimuth},
 // {elevation}, {eye}, {lookat}, {up}, {light}, {sky}, {floor}, arrays written A,B,...).
 void cli_view_recipe(const cli_view_opts* v, struct cJSON* a);
+
+// Rewrite the command line before dispatch (cli_args.c): --opt=value into --opt value, operands
+// after -- that start with '-' as ./-name, 'help CMD' as 'CMD --help'; a repeated -o/--output is
+// an error. Returns 0, or the exit code after printing why.
+int cli_args_normalize(int* argc, char*** argv);
 
 // Subcommands.
 int cli_harvest(int argc, char** argv);

@@ -223,6 +223,17 @@ int cli_cloud_opt(cli_cloud_opts* o, const char* cmd, int argc, char** argv, int
   return 1;
 }
 
+int cli_cloud_check_output(const cli_cloud_opts* o, const char* cmd, const char* out) {
+  int ply = out && (cli_has_ext(out, ".ply") || !strcmp(out, "ply"));
+  int pcd = out && (cli_has_ext(out, ".pcd") || !strcmp(out, "pcd"));
+  if (o->wdef.ascii && !ply && !pcd)
+    return cli_usage_error(cmd, "--ascii applies to PLY and PCD clouds (XYZ and CSV are text, LAS is binary)%s",
+                           out ? "" : "; there is no cloud output");
+  if (o->wdef.ply_prefix && !ply)
+    return cli_usage_error(cmd, "--ply-scalar-prefix applies to PLY clouds%s", out ? "" : "; there is no cloud output");
+  return 0;
+}
+
 int cli_cloud_check(const cli_cloud_opts* o, const char* cmd) {
   if (o->density_given && o->def.sensor != VD_SENSOR_DISTANCE)
     return cli_usage_error(cmd, "--density-law applies to --sensor distance");
@@ -484,7 +495,7 @@ int cli_cloud(int argc, char** argv) {
   if (!out && !stats) return cli_usage_error("cloud", "nothing to do: give -o OUT and/or --stats");
   if (out && vd_cloud_format_of(out) == VD_CLOUD_AUTO)
     return cli_usage_error("cloud", "output '%s': unknown format (use .ply, .pcd, .xyz, .csv or .las)", out);
-  if (cli_cloud_check(&co, "cloud")) return EXIT_USAGE;
+  if (cli_cloud_check(&co, "cloud") || cli_cloud_check_output(&co, "cloud", out)) return EXIT_USAGE;
   const char* ins[2] = {po.path, co.scanners_file};
   if (out && cli_check_outputs("cloud", &out, 1, ins, 2)) return EXIT_USAGE;
   vd_error err = {0};

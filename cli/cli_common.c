@@ -347,6 +347,12 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   memset(info, 0, sizeof *info);
   *out = NULL;
   vd_status st;
+  // a file of another kind says what it is (not an L-Py syntax error in a mesh)
+  char kind_buf[160];
+  const char* kind = cli_not_a_plant(o->path, kind_buf, sizeof kind_buf);
+  if (kind)
+    return vd_error_set(err, VD_ERR_FORMAT, o->path, 0, 0, "%s, not a plant: verdant takes an .lpy file or a plant .json",
+                        kind);
   if (cli_has_ext(o->path, ".json")) {
     if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
     // a plant file or a curves file, by its "format"

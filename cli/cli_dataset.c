@@ -877,7 +877,7 @@ int cli_dataset(int argc, char** argv) {
   if (ds.count < 0) return cli_usage_error("dataset", "missing --count K");
   if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
-  if (cli_cloud_check(&co, "dataset")) return EXIT_USAGE;
+  if (cli_cloud_check(&co, "dataset") || cli_cloud_check_output(&co, "dataset", ds.ext)) return EXIT_USAGE;
   if (co.has_cloud_seed)
     return cli_usage_error("dataset", "--cloud-seed does not apply to a dataset: each item's cloud is seeded by its "
                            "item seed (from --seed)");

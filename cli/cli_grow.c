@@ -125,6 +125,8 @@ int cli_grow(int argc, char** argv) {
   if (!out && !stats) return cli_usage_error("grow", "nothing to do: give -o OUT and/or --stats");
   if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
     return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
+  if (ascii && !(out && cli_has_ext(out, ".ply")))
+    return cli_usage_error("grow", "--ascii applies to a .ply output (plant JSON and OBJ are text already)");
   char files[2][4200];
   const char* outs[2] = {files[0], files[1]};
   int nf = out ? cli_plant_files(out, files) : 0;

@@ -257,6 +257,7 @@ typedef struct sim_opts {
   vd_vec3 mesh_pos[8];     // ... and their placements (m)
   int nmesh;
   double max_steps;
+  int ke_tol_set, gust_set, fps_set;  // given on the command line (checked against what they need)
   vd_sim_def def;
   vd_sim_opt opt;
 } sim_opts;
@@ -485,6 +486,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->statics = 1;
     } else if (!strcmp(a, "--ke-tol")) {
       NUM(o->ke_tol, x_ > 0, "an energy > 0 (J)");
+      o->ke_tol_set = 1;
     } else if (!strcmp(a, "--sag-free")) {
       o->def.sag_free = 1;
     } else if (!strcmp(a, "--stake")) {
@@ -535,6 +537,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       double v[2];
       if (!parse_list(val, v, 2) || !(v[1] > 0)) return cli_usage_error(cmd, "--gust expects AMPLITUDE,PERIOD (-, s > 0), got '%s'", val);
       o->opt.gust_amplitude = v[0], o->opt.gust_period = v[1];
+      o->gust_set = 1;
     } else if (!strcmp(a, "--wind-file")) {
       VAL();
       o->wind_file = val;
@@ -588,6 +591,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       o->frames = val;
     } else if (!strcmp(a, "--fps")) {
       NUM(o->fps, x_ > 0 && x_ <= 100000, "a rate in (0, 100000] (1/s)");
+      o->fps_set = 1;
     } else if (!strcmp(a, "--final")) {
       VAL();
       if (!cli_has_ext(val, ".json") && !cli_has_ext(val, ".obj") && !cli_has_ext(val, ".ply"))
@@ -631,6 +635,21 @@ static int run_outputs(const sim_opts* o, char path[SIM_MAX_OUT][4200], unsigned
   return n;
 }
 
+// options that do nothing without another one are refused, not ignored
+static int check_applies(const sim_opts* o) {
+  const char* cmd = "sim";
+  if (o->frames && !o->out) return cli_usage_error(cmd, "--frames applies to a run folder (-o DIR)");
+  if (o->fps_set && (!o->out || (o->frames && !strcmp(o->frames, "none"))))
+    return cli_usage_error(cmd, "--fps sets the frame rate of DIR/frames: give -o DIR (and frames other than none)");
+  if (o->ramp_set && !o->npull) return cli_usage_error(cmd, "--ramp applies to --pull and --move");
+  if (o->ke_tol_set && !o->settle) return cli_usage_error(cmd, "--ke-tol applies to --settle");
+  if (o->gust_set && o->wind_file)
+    return cli_usage_error(cmd, "--gust does not apply with --wind-file (the series replaces the wind and its gusts)");
+  if (o->gust_set && o->opt.wind.x == 0 && o->opt.wind.y == 0 && o->opt.wind.z == 0)
+    return cli_usage_error(cmd, "--gust modulates the mean wind: give --wind X,Y,Z");
+  return 0;
+}
+
 // no output may replace an input (the plant, the wind series, collider meshes)
 static int check_clash(const sim_opts* o) {
   char opath[SIM_MAX_OUT][4200];
@@ -664,7 +683,7 @@ int cli_sim(int argc, char** argv) {
   if (rc) return rc;
   if (!o.po.path) return cli_usage_error("sim", "missing PLANT (an .lpy or plant .json file)");
   if (!o.out && !o.stats && !o.final) return cli_usage_error("sim", "nothing to do: give -o DIR, --final FILE and/or --stats");
-  if (check_clash(&o)) return EXIT_USAGE;
+  if (check_clash(&o) || check_applies(&o)) return EXIT_USAGE;
   if ((o.settle || o.statics) && !o.duration_set) o.duration = 0;
   if (!o.frames) o.frames = "bin";
   // the run's steps, counted (a time sum stalls once time + dt == time): at most --max-steps

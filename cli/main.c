@@ -25,7 +25,9 @@ static const char* main_help =
     "  harvest   a MuJoCo robot picks a fruit (pull, bend, twist) → summary, events, frames\n"
     "  export    plant → URDF, SDF or MuJoCo MJCF for robot simulators\n"
     "\n"
-    "Run 'verdant <command> --help' for the options of a command.\n"
+    "Run 'verdant <command> --help' or 'verdant help <command>' for the options of a command;\n"
+    "'verdant --version' prints the version. Options take their value as '--opt value' or\n"
+    "'--opt=value'; after '--' every argument is a file name.\n"
     "Exit codes: 0 success, 1 failed run, 2 bad usage or bad input.\n";
 
 int main(int argc, char** argv) {
@@ -35,6 +37,8 @@ int main(int argc, char** argv) {
     fputs(main_help, stderr);
     return EXIT_USAGE;
   }
+  int rc = cli_args_normalize(&argc, &argv);  // --opt=value, --, help CMD, a repeated -o
+  if (rc) return rc;
   const char* cmd = argv[1];
   if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
     fputs(main_help, stdout);

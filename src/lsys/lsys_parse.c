@@ -2626,6 +2626,7 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
   memset(&P, 0, sizeof P);
   P.ls = ls;
   ls->cur_filter = -1;
+  if (len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3)) text += 3, len -= 3;  // a UTF-8 byte-order mark
   size_t init_at;
   vd_status st = split_lines(&P, text, len, &init_at);
   if (st) goto done;
