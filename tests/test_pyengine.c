@@ -507,3 +507,16 @@ TEST(pyengine, hooks_get_the_scene) {
       "Axiom: F(1, 0) ; F(1) _(0.5) F(1) @O(1)\n";
   CHECK_PY(src, 1, "F(1,0);F(1)_(0.5)F(1)@O(1)");
 }
+
+TEST(pyengine, context_turtle_settings_apply) {
+  if (!python_here()) return;
+  vd_error e = {0};
+  // execContext().turtle.setAngleIncrement(90): + turns 90 degrees, so F + F ends at (0, -1, 1)
+  vd_plant_spec* p = grow_py("execContext().turtle.setAngleIncrement(90)\nAxiom: F(1) + F(1)\n", &e);
+  REQUIRE(p && p->nseg == 2);
+  vd_vec3 end = p->node[p->seg[1].node1];
+  CHECK_NEAR(end.x, 0, 1e-12);
+  CHECK_NEAR(end.y, -1, 1e-12);
+  CHECK_NEAR(end.z, 1, 1e-12);
+  vd_plant_spec_destroy(p);
+}

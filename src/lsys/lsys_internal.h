@@ -534,6 +534,9 @@ vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* 
 // A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
 vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
                         char* why, size_t cap);
+// The turtle settings the file made through context().turtle (setAngleIncrement,
+// setWidthIncrement, setScaleMultiplier, setElasticity) applied over td (Python engine).
+void lsys_py_turtle_def(const vd_lsystem* ls, vd_turtle_def* td);
 // repr() of an object parameter into buf (cap bytes); "None" for a stale handle
 void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 

@@ -1627,3 +1627,22 @@ vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, i
   lsys_py_leave(mls);
   return st;
 }
+
+void lsys_py_turtle_def(const vd_lsystem* ls, vd_turtle_def* td) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  if (!ls || !ls->py || !ls->py->ns || g_state != 1) return;
+  lsys_py_enter(mls);
+  PyObject* d = shim_call("_vd_turtle_settings", ls->py->ns);
+  static const char* names[] = {"setAngleIncrement", "setWidthIncrement", "setScaleMultiplier", "setElasticity"};
+  double* fields[] = {&td->angle, &td->width_inc, &td->scale_factor, &td->elasticity};
+  for (int k = 0; d && PyDict_Check(d) && k < 4; k++) {
+    PyObject* a = PyDict_GetItemString(d, names[k]);  // borrowed: the arguments' tuple
+    if (!a || !PyTuple_Check(a) || PyTuple_GET_SIZE(a) < 1) continue;
+    double v = PyFloat_AsDouble(PyTuple_GET_ITEM(a, 0));
+    if (!PyErr_Occurred() && isfinite(v)) *fields[k] = v;
+    PyErr_Clear();
+  }
+  Py_XDECREF(d);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+}

@@ -685,6 +685,12 @@ class _Context:
         self[k] = v
 
 
+def _vd_turtle_settings(ns):
+    """The turtle settings the file made through context().turtle: {setter name: arguments}."""
+    ctx = ns.get("__vd_context")
+    return dict(ctx.turtle.settings) if ctx is not None else {}
+
+
 def _vd_init_context(ns):
     ctx = _Context(ns)
     ns["__vd_context"] = ctx

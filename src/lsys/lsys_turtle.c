@@ -1750,6 +1750,8 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
   memset(&T, 0, sizeof T);
   T.query = query;
   T.def = def ? *def : vd_turtle_def_default();
+  // the file's own turtle settings (context().turtle.setAngleIncrement(90) ...) are its defaults
+  if (ls && ls->py) lsys_py_turtle_def(ls, &T.def);
   vd_status st = check_def(&T.def, err);
   if (st) return st;
   T.ls = ls;
