@@ -36,6 +36,8 @@ static const char* sim_help =
     "      --max-steps N       most time steps of a run, duration / dt (default 1000000000)\n"
     "model:\n"
     "      --segment-length S  rod segment length sigma_distance (m), default 0.02\n"
+    "      --clamp L           the pot: the first L of the plant's base held fixed (m), default\n"
+    "                          0.01; 0 holds only the base node and its frame (a clamped end)\n"
     "      --max-segments N    most rod segments of the model (default 1000000, about 2 kB each)\n"
     "      --bend-measure M    bend-twist strain: log (rotation vector, default) or quat\n"
     "                          (Kugelstadt & Schomer's Im(q), the model before 2026-11)\n"
@@ -46,6 +48,8 @@ static const char* sim_help =
     "      --break-moment [C=]M    ... or above this moment (N m)\n"
     "      --break-strain [C=]CS,CB  ... or when |C_s| > CS or |C_b| > CB (1/m), Gazebo Plants' form\n"
     "      --no-fracture       nothing breaks\n"
+    ;
+static const char* sim_help_loads =
     "loads:\n"
     "      --gravity X,Y,Z     gravity (m/s^2), default 0,0,-9.81\n"
     "      --wind X,Y,Z        mean wind (m/s); pressure 0.613 |v|^2 Pa on the drag areas\n"
@@ -493,6 +497,8 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
     } else if (!strcmp(a, "--segment-length")) {
       NUM(o->def.segment_length, x_ > 0, "a length > 0 (m)");
+    } else if (!strcmp(a, "--clamp")) {
+      NUM(o->def.clamp_length, x_ >= 0 && x_ <= 1e3, "a length >= 0 (m)");
     } else if (!strcmp(a, "--max-segments")) {
       NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
     } else if (!strcmp(a, "--bend-measure")) {
@@ -666,6 +672,7 @@ int cli_sim(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(sim_help, stdout);
+      fputs(sim_help_loads, stdout);
       fputs(sim_help_output, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;

@@ -62,7 +62,8 @@ for kind, body in blocks:
                 if not os.path.isdir(os.path.join(t, "build/python")) or not os.path.exists("/usr/bin/python3"):
                     print("skip " + cmd + " (no python package built)")
                     continue
-                r = run(cmd)
+                # a sanitizer build preloads its runtimes into the interpreter (CMakeLists.txt)
+                r = run((os.environ.get("VD_README_PYENV", "") + " " + cmd).strip())
                 want = lines[i + 1].split("# prints: ")[1].split("   ")[0] if i + 1 < len(lines) and "# prints:" in lines[i + 1] else None
                 report(r.returncode == 0 and (want is None or r.stdout.strip() == want), cmd[:70], r.stderr + r.stdout)
                 continue
@@ -99,12 +100,16 @@ for kind, body in blocks:
         report(ok, "the README's L-Py model grows", r.stderr + r.stdout[:300])
     elif kind == "c":
         # the library example compiles against the built library and runs (from the source tree)
+        # the model's size is printed before the example frees everything (the sanitizer build
+        # checks that it leaks nothing)
         prog = body.split("\n", 1)
-        code = prog[0] + "\n#include <stdio.h>\nint main(void) {\n" + prog[1] + \
-            "  printf(\"%d segments\\n\", m->nseg);\n  return m->nseg > 0 ? 0 : 1;\n}\n"
+        main = prog[1].replace("vd_data_destroy(d);", "nseg = m->nseg;\nvd_data_destroy(d);", 1)
+        code = prog[0] + "\n#include <stdio.h>\nint main(void) {\nint nseg = 0;\n" + main + \
+            "  printf(\"%d segments\\n\", nseg);\n  return nseg > 0 ? 0 : 1;\n}\n"
         open(os.path.join(t, "readme.c"), "w").write(code)
         # the link flags of the pkg-config file (verdant.pc), with the library of this build
-        r = run(f"cc -std=c11 -I{src}/include readme.c {build}/libverdant.a "
+        cflags = os.environ.get("VD_README_CFLAGS", "")
+        r = run(f"cc -std=c11 {cflags} -I{src}/include readme.c {build}/libverdant.a "
                 f"$(PKG_CONFIG_PATH={build} pkg-config --libs --static verdant | sed 's/-lverdant//') -o readme_c")
         report(r.returncode == 0, "the README's C example compiles", r.stderr)
         if r.returncode == 0:

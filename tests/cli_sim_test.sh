@@ -170,6 +170,13 @@ expect "validate json" 0 "$V" validate --json --case cantilever_tip --no-progres
 json_check "validate fields" "len(d) == 2 and all(set(r) >= {'name','measured','reference','error','tolerance','pass'} and r['pass'] for r in d)"
 expect "validate table" 0 "$V" validate --case torsion --no-progress
 expect "validate bad option" 2 "$V" validate --frobnicate
+# a control check prints what it measured (issue 12, item 22): the penetration of the run without
+# self-collision, against the 2 mm it must reach
+expect "validate control" 0 "$V" validate --json --case no_penetration_self --no-progress
+json_check "control prints its measured value" "[r for r in d if r['name'] == 'no_penetration_self_off'][0]['measured'] > 2e-3 and [r for r in d if r['name'] == 'no_penetration_self_off'][0]['reference'] == 2e-3"
+# --clamp: 0 holds only the base node and its frame; a negative length is refused
+expect "sim --clamp 0" 0 "$V" sim "$T/p.lpy" --clamp 0 --duration 0.05 --stats
+expect "sim --clamp -1" 2 "$V" sim "$T/p.lpy" --clamp -1 --stats
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

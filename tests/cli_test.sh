@@ -95,6 +95,16 @@ else
 fi
 # an unwritable output: exit 1 (failed run), no temporary file left
 expect "unwritable output" 1 "$V" grow "$T/plant.lpy" -o "/nonexistent-dir/x.obj"
+# --lstring: the derived string as JSON (names and parameters)
+expect "grow --lstring" 0 "$V" grow "$T/plant.lpy" -o "$T/ls.json" --lstring "$T/lstring.json" -n 1
+if /usr/bin/python3 -c 'import json,sys; m = json.load(open(sys.argv[1]))["modules"]; assert [x[0] for x in m] == ["SetWidth", "I", "[", "+", "Leaf", "]", "/", "A"] and m[7] == ["A", 2]' "$T/lstring.json"; then
+  ok "lstring json"
+else
+  bad "lstring json"
+fi
+# a turtle fault names the rule's line (issue 12 item 7)
+printf 'Axiom: A\nproduction:\nA --> F(1e308 * 10)\n' >"$T/bad.lpy"
+if "$V" grow "$T/bad.lpy" -o "$T/bad.json" 2>&1 | grep -q "bad.lpy:3: turtle: module 0 'F'"; then ok "turtle error names the line"; else bad "turtle error names the line"; fi
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -297,3 +297,64 @@ TEST(lpy, argument_lists_in_patterns_python_engine) {
   PY_DERIVES("Axiom: I(0) I(1) A\nproduction:\nx(I(t)) < A :\n  assert t == [0, 1]\n  produce B\n", 1, "I(0)I(1)B");
   PY_DERIVES("Axiom: A I(0) I(1)\nproduction:\nA > x(I(t)) :\n  assert t == [0, 1]\n  produce B\n", 1, "BI(0)I(1)");
 }
+
+// ---------------------------------------------------------------------------------------------
+// turtle errors and warnings name the file line of the rule or axiom (issue 12 items 7 and 8)
+
+static char logged[2048];
+
+static void keep_log(void* user, int level, const char* msg) {
+  (void)user;
+  (void)level;
+  size_t n = strlen(logged);
+  snprintf(logged + n, sizeof logged - n, "%s\n", msg);
+}
+
+// grow src (with --set-like overrides name=value), status and error in *e
+static vd_status grow_status(const char* src, const char* name, const char* value, vd_error* e) {
+  vd_lsystem* ls;
+  memset(e, 0, sizeof *e);
+  vd_status st = vd_lsys_parse(src, strlen(src), "t.lpy", &ls, e);
+  if (st) return st;
+  if (name) st = vd_lsys_set_global(ls, name, value, e);
+  vd_plant_spec* P = vd_plant_spec_create();
+  if (!st) st = vd_lsys_grow(ls, NULL, NULL, P, e);
+  vd_plant_spec_destroy(P);
+  vd_lsys_destroy(ls);
+  return st;
+}
+
+TEST(lpy, turtle_errors_name_the_file_line) {
+  const char* src =
+      "PHYLLO = 137.5\n"
+      "Axiom: A\n"
+      "derivation length: 2\n"
+      "production:\n"
+      "A --> F(1) /(PHYLLO) B\n"
+      "B --> F(1e308 * 10)\n";
+  vd_error e;
+  CHECK_STATUS(grow_status(src, NULL, NULL, &e), VD_ERR_VALUE, e);
+  CHECK_INT(e.line, 6);
+  CHECK_STR(e.file, "t.lpy");
+  CHECK_STATUS(grow_status(src, "PHYLLO", "1e400", &e), VD_ERR_VALUE, e);
+  CHECK_INT(e.line, 5);
+  CHECK_STATUS(grow_status("Axiom: F\nproduction:\nF --> F ] F\n", NULL, NULL, &e), VD_ERR_SYNTAX, e);
+  CHECK_INT(e.line, 3);
+  // the axiom's line when the module comes from the axiom
+  CHECK_STATUS(grow_status("x = 1\nAxiom: F ] F\n", NULL, NULL, &e), VD_ERR_SYNTAX, e);
+  CHECK_INT(e.line, 2);
+}
+
+TEST(lpy, turtle_warnings_name_the_file_line) {
+  // an unclosed '[' and negative widths and radii are accepted (as L-Py does) with a warning
+  logged[0] = 0;
+  vd_set_log(keep_log, NULL);
+  vd_error e;
+  vd_status st = grow_status("Axiom: F\nderivation length: 1\nproduction:\nF --> F [ F _(-0.1) F(1, -0.2)\n", NULL,
+                             NULL, &e);
+  vd_set_log(NULL, NULL);
+  CHECK_STATUS(st, VD_OK, e);
+  CHECK(strstr(logged, "t.lpy:4: turtle: module 3 '_': negative width") != NULL);
+  CHECK(strstr(logged, "t.lpy:4: turtle: module 4 'F': negative radius") != NULL);
+  CHECK(strstr(logged, "t.lpy:4: turtle: module 1 '[': 1 '[' not closed") != NULL);
+}

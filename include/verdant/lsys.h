@@ -128,11 +128,13 @@ typedef struct vd_lstring {
   double* val;    // parameter values (par[n]); strings are NaN-boxed ids (vd_lsys_value_str)
   int64_t* src;   // Nullable: index of the derived-string module each module came from (n)
   int64_t cap, vcap;  // capacities of the module and value arrays
+  int32_t* line;  // Nullable: file line of the rule or axiom that wrote each module (n); kept
+                  // only when an error or warning is traced back to the file
 } vd_lstring;
 
 // Empty L-string (no allocation).
 static inline vd_lstring vd_lstring_empty(void) {
-  vd_lstring s = {0, 0, 0, 0, 0, 0, 0};
+  vd_lstring s = {0, 0, 0, 0, 0, 0, 0, 0};
   return s;
 }
 // Free an L-string's arrays and make it empty.

@@ -118,7 +118,8 @@ int vd_sim_bend_parse(const char* name);
 // Rod-model settings for vd_sim_build.
 typedef struct vd_sim_def {
   double segment_length;          // target rod segment length sigma_distance (m)
-  double clamp_length;            // length of each root segment held fixed, like a pot (m)
+  double clamp_length;            // length of each root segment held fixed, like a pot (m); 0: only
+                                  // the root node and its frame held (an exact clamped end)
   int clamp_roots;                // 1: segments of organ root are fixed (no soil model yet)
   vd_sim_material material[VD_SIM_CLASS_COUNT];  // per class; see vd_sim_def_default
   double leaf_areal_density;      // mass of leaf lamina per area (kg/m^2)

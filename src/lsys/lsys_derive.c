@@ -357,7 +357,8 @@ static vd_status eval_max_depth(vd_lsystem* ls, int sec) {
 static vd_status rewrite_section(vd_lsystem* ls, int sec, vd_lstring* cur, vd_lstring* tmp, lsys_pass* P,
                                  int* matched) {
   lstr_clear(tmp);
-  if (!lstr_reserve(tmp, cur->n + 16, (cur->par ? cur->par[cur->n] : 0) + 16) || (cur->src && !lstr_enable_src(tmp)))
+  if (!lstr_reserve(tmp, cur->n + 16, (cur->par ? cur->par[cur->n] : 0) + 16) || (cur->src && !lstr_enable_src(tmp)) ||
+      (cur->line && !lstr_enable_line(tmp)))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory growing the L-string");
   vd_status st = lsys_recursive(ls, sec, cur, tmp, P, ls->max_depth[sec], 0, matched);
   if (st) return st;
@@ -392,7 +393,8 @@ static vd_status interpret_into(vd_lsystem* ls, const vd_lstring* in, vd_lstring
   vd_status st = lsys_build_index(ls, ls->current_group, 0);  // interpretation reads forward
   if (st) return vm_error(ls, st, 0, 0, "out of memory");
   lstr_clear(out);
-  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16))
+  if (!lstr_enable_src(out) || !lstr_reserve(out, in->n + 16, (in->par ? in->par[in->n] : 0) + 16) ||
+      (in->line && !lstr_enable_line(out)))
     return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
   if ((st = interpretation_hook(ls, "StartInterpretation", out, in->n, P->max_modules))) return st;
   int m = 0;
@@ -487,6 +489,8 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
   // axiom
   lstr_clear(out);
   if (!lstr_reserve(out, 64, 64)) return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  if (ls->track_lines && (!lstr_enable_line(out) || !lstr_enable_line(tmp)))
+    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
   vm_out vo = {out, 0, d->max_modules, 0, 0};
   if (ls->py) {
     st = lsys_py_emit_axiom(ls, &vo);
@@ -551,6 +555,8 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
   ls->err = err ? err : &local;
   lsys_pass P;
   vd_lsys_def d = run_def(ls, def, &P);
+  ls->last_def = d;
+  ls->has_last_def = 1;
   vd_lstring tmp = vd_lstring_empty();
   int steps = 0, early = 0;
   vd_status st = run_setup(ls, &d, out, &tmp, &P, &steps, &early);
@@ -593,6 +599,8 @@ vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstrin
   ls->err = err ? err : &local;
   lsys_pass P;
   vd_lsys_def d = run_def(ls, def, &P);
+  ls->last_def = d;
+  ls->has_last_def = 1;
   vd_lstring tmp = vd_lstring_empty();
   int early = 0;
   vd_status st = run_setup(ls, &d, out, &tmp, &P, NULL, &early);
@@ -634,6 +642,36 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
   if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
   vd_status st = interpret_into(ls, in, out, &P);
   return end_run(ls, st, &tmp, &P);
+}
+
+const char* lsys_file(const vd_lsystem* ls) { return ls->file; }
+
+int lsys_trace_lines(vd_lsystem* ls, const vd_lstring* s, const int64_t* idx, int n, int* lines) {
+  for (int k = 0; k < n; k++) lines[k] = 0;
+  if (!ls->has_last_def || ls->track_lines) return 0;
+  // the same derivation (same settings, as many steps as were made), quiet, keeping lines
+  vd_lsys_def d = ls->last_def;
+  d.steps = ls->steps_done;
+  d.progress = NULL;
+  vd_error e = {0};
+  vd_lstring der = vd_lstring_empty(), geo = vd_lstring_empty();
+  ls->track_lines = 1;
+  ls->quiet = 1;
+  vd_status st = vd_lsys_derive(ls, &d, &der, &e);
+  if (!st) st = vd_lsys_interpret(ls, &d, &der, &geo, &e);
+  ls->track_lines = 0;
+  ls->quiet = 0;
+  // s is the interpreted string, or the derived one, when modules and symbols agree
+  const vd_lstring* same = NULL;
+  if (!st && geo.line && geo.n == s->n && (!s->n || !memcmp(geo.sym, s->sym, sizeof(int32_t) * (size_t)s->n)))
+    same = &geo;
+  else if (!st && der.line && der.n == s->n && (!s->n || !memcmp(der.sym, s->sym, sizeof(int32_t) * (size_t)s->n)))
+    same = &der;
+  for (int k = 0; same && k < n; k++)
+    if (idx[k] >= 0 && idx[k] < same->n) lines[k] = same->line[idx[k]];
+  vd_lstring_free(&der);
+  vd_lstring_free(&geo);
+  return same != NULL;
 }
 
 vd_status vd_lsys_parse_lstring(vd_lsystem* ls, const char* text, vd_lstring* out, vd_error* err) {

@@ -3,6 +3,7 @@
 // CPython's algorithms, L-Py's control functions) and emission of successor templates.
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -662,10 +663,14 @@ vd_status vm_emit_tmpl(vd_lsystem* ls, const tmpl* t, value* frame, vm_out* out)
   if (!lstr_reserve(s, s->n + t->n, s->par[s->n] + nparam))
     return vm_error(ls, VD_ERR_NOMEM, t->n ? t->mod[0].line : 0, 0, "out of memory growing the L-string");
   int64_t n = s->n, v = s->par[n];
+  if (__builtin_expect(((uintptr_t)s->src | (uintptr_t)s->line) != 0, 0)) {
+    // source indices (interpretation) and file lines (tracing an error): rare
+    for (int i = 0; s->src && i < t->n; i++) s->src[n + i] = out->src;
+    for (int i = 0; s->line && i < t->n; i++) s->line[n + i] = t->mod[i].line;
+  }
   for (int i = 0; i < t->n; i++) {
     const tmod* m = &t->mod[i];
     s->sym[n] = m->sym;
-    if (s->src) s->src[n] = out->src;
     for (int k = 0; k < m->nparam; k++) {
       const expr* e = m->param[k];
       value x;
@@ -793,6 +798,7 @@ static vd_status exec_list(vd_lsystem* ls, stmt* s, value* frame, exec_state* X)
       case S_BREAK: X->flow = FLOW_BREAK; return VD_OK;
       case S_CONTINUE: X->flow = FLOW_CONTINUE; return VD_OK;
       case S_PRINT: {
+        if (ls->quiet) break;  // a repeat run (tracing an error back to the file)
         char line[1024] = "";
         size_t n = 0;
         for (int i = 0; i < s->nargs; i++) {

@@ -328,6 +328,11 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int64_t ops_left;        // what is left of it
   vd_error* err;           // error sink during a run
   struct vm_out* cur_out;  // where produce writes in the rule body (or hook) being run, NULL outside
+  // tracing a turtle error or warning back to the file (lsys_trace_lines)
+  vd_lsys_def last_def;    // the settings of the last derivation
+  int has_last_def;        // a derivation ran
+  int track_lines;         // keep the file line of every module (vd_lstring.line)
+  int quiet;               // print() says nothing (the run is a repeat)
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -356,6 +361,8 @@ int global_slot(vd_lsystem* ls, const char* name, int len, int create);
 int lstr_reserve(vd_lstring* s, int64_t nmod, int64_t nval);
 void lstr_clear(vd_lstring* s);
 int lstr_enable_src(vd_lstring* s);
+// Give s a line array (file line of the rule or axiom of each module); 0 out of memory.
+int lstr_enable_line(vd_lstring* s);
 // Copy src into dst (dst's arrays reused; src indices copied when src has them); 0 out of memory.
 int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src);
 
@@ -445,6 +452,12 @@ int lsys_mlist_new(vd_lsystem* ls, int n);
 // the parameters of the query modules ?P ?H ?U ?L ?R of s.
 vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
 #define LSYS_SRC_IDENTITY (INT64_C(1) << 62)  // on a source index: the module was copied unchanged
+// File lines of the modules idx[0..n) of s, a string the last derivation made (interpreted or
+// not): the derivation runs again keeping lines; 1 when s is that string (lines[k] is 0 where
+// unknown), 0 otherwise.
+int lsys_trace_lines(vd_lsystem* ls, const vd_lstring* s, const int64_t* idx, int n, int* lines);
+// The file name of an lsystem ("" when parsed from text without one).
+const char* lsys_file(const vd_lsystem* ls);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
 int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
 

@@ -627,6 +627,7 @@ static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_
     int64_t n = s->n, v = s->par[n];
     s->sym[n] = t->mod[m].sym;
     if (s->src) s->src[n] = out->src;
+    if (s->line) s->line[n] = t->mod[m].line;
     if (t->mod[m].nparam) {
       PyObject* tup = args[a++];
       Py_ssize_t np = PyTuple_GET_SIZE(tup);
@@ -753,6 +754,7 @@ static int append_items(vd_lsystem* ls, vd_lstring* s, PyObject* items, int64_t 
     int64_t m = s->n, v = s->par[m];
     s->sym[m] = sym;
     if (s->src) s->src[m] = src < 0 ? m : src;
+    if (s->line) s->line[m] = 0;  // made by Python code: no line of the file
     for (Py_ssize_t k = 0; k < np && ok; k++) ok = object_param(ls, PyTuple_GET_ITEM(params, k), &s->val[v + k]);
     if (!ok) break;
     s->par[m + 1] = v + np;
@@ -932,6 +934,8 @@ static PyObject* vd_log_text(PyObject* self, PyObject* arg) {
   (void)self;
   const char* s = PyUnicode_AsUTF8(arg);
   if (!s) return NULL;
+  vd_lsystem* ls = current();
+  if (ls && ls->quiet) return py_none();  // a repeat run (tracing an error back to the file)
   vd_log(0, "%s", s);
   return py_none();
 }

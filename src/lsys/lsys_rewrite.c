@@ -319,6 +319,7 @@ static inline vd_status copy_module(vd_lsystem* ls, const vd_lstring* in, int64_
   int64_t n = out->n;
   out->sym[n] = in->sym[i];
   if (out->src) out->src[n] = src;
+  if (out->line) out->line[n] = in->line ? in->line[i] : 0;
   int64_t v = out->par[n];
   for (int64_t k = 0; k < np; k++) out->val[v + k] = in->val[a + k];
   out->par[n + 1] = v + np;
@@ -355,6 +356,11 @@ void lsys_reverse_tail(vd_lstring* s, int64_t a) {
       int64_t u = s->src[x];
       s->src[x] = s->src[y];
       s->src[y] = u;
+    }
+    if (s->line) {
+      int32_t u = s->line[x];
+      s->line[x] = s->line[y];
+      s->line[y] = u;
     }
   }
   int64_t off = v0;
@@ -502,6 +508,7 @@ static vd_status step_simple(vd_lsystem* ls, int sec, const lsys_mctx* M, vd_lst
   const int* first = ls->rule_first[sec];
   const int* list = ls->rule_list[sec];
   int nsym = ls->rule_index_nsym;
+  const int py = ls->py != NULL;  // the engine does not change during a step
   value small[64];
   vm_out vo = {out, 0, max_modules, 0, 0};
   for (int64_t i = 0; i < in->n;) {
@@ -534,7 +541,7 @@ static vd_status step_simple(vd_lsystem* ls, int sec, const lsys_mctx* M, vd_lst
           vo.src = src;
           vo.produced = vo.nproduced = 0;
           vd_status st;
-          if (ls->py) {
+          if (py) {
             st = lsys_py_apply_rule(ls, r, frame, &vo);
           } else if (r->succ) {
             st = vm_emit_tmpl(ls, r->succ, frame, &vo);
@@ -645,7 +652,7 @@ vd_status lsys_recursive(vd_lsystem* ls, int sec, const vd_lstring* in, vd_lstri
       // the production is rewritten again, on its own, one level deeper
       vd_lstring* buf = &P->lvl[level].buf;
       lstr_clear(buf);
-      if (!lstr_reserve(buf, 16, 16) || (out->src && !lstr_enable_src(buf)))
+      if (!lstr_reserve(buf, 16, 16) || (out->src && !lstr_enable_src(buf)) || (out->line && !lstr_enable_line(buf)))
         return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
       r = apply_try(ls, &M, P->max_modules, sec, i, buf, &b, &e, &st, 0);
       if (r < 0) return st;

@@ -242,21 +242,26 @@ int lstr_reserve(vd_lstring* s, int64_t nmod, int64_t nval) {
     int32_t* sym = vd_malloc((size_t)nc * sizeof(int32_t));
     int64_t* par = vd_malloc((size_t)(nc + 1) * sizeof(int64_t));
     int64_t* src = s->src ? vd_malloc((size_t)nc * sizeof(int64_t)) : NULL;
-    if (!sym || !par || (s->src && !src)) {
+    int32_t* line = s->line ? vd_malloc((size_t)nc * sizeof(int32_t)) : NULL;
+    if (!sym || !par || (s->src && !src) || (s->line && !line)) {
       vd_free(sym, (size_t)nc * sizeof(int32_t));
       vd_free(par, (size_t)(nc + 1) * sizeof(int64_t));
       vd_free(src, (size_t)nc * sizeof(int64_t));
+      vd_free(line, (size_t)nc * sizeof(int32_t));
       return 0;
     }
     if (s->n) memcpy(sym, s->sym, (size_t)s->n * sizeof(int32_t));
     memcpy(par, s->par ? s->par : (int64_t[]){0}, (size_t)(s->n + 1) * sizeof(int64_t));
     if (src && s->n) memcpy(src, s->src, (size_t)s->n * sizeof(int64_t));
+    if (line && s->n) memcpy(line, s->line, (size_t)s->n * sizeof(int32_t));
     vd_free(s->sym, (size_t)s->cap * sizeof(int32_t));
     vd_free(s->par, s->cap ? (size_t)(s->cap + 1) * sizeof(int64_t) : 0);
     if (s->src) vd_free(s->src, (size_t)s->cap * sizeof(int64_t));
+    if (s->line) vd_free(s->line, (size_t)s->cap * sizeof(int32_t));
     s->sym = sym;
     s->par = par;
     if (s->src) s->src = src;
+    if (s->line) s->line = line;
     s->cap = nc;
   }
   if (nval > s->vcap) {
@@ -280,10 +285,19 @@ int lstr_enable_src(vd_lstring* s) {
   return s->src != NULL;
 }
 
+int lstr_enable_line(vd_lstring* s) {
+  if (s->line) return 1;
+  if (!s->cap && !lstr_reserve(s, 64, 0)) return 0;
+  s->line = vd_calloc((size_t)s->cap, sizeof(int32_t));
+  return s->line != NULL;
+}
+
 int lsys_lstring_copy(vd_lstring* dst, const vd_lstring* src) {
   lstr_clear(dst);
   if (!lstr_reserve(dst, src->n + 1, src->par[src->n] + 1)) return 0;
   if (src->src && !lstr_enable_src(dst)) return 0;
+  if (src->line && !lstr_enable_line(dst)) return 0;
+  if (src->line) memcpy(dst->line, src->line, sizeof(int32_t) * (size_t)src->n);
   memcpy(dst->sym, src->sym, sizeof(int32_t) * (size_t)src->n);
   memcpy(dst->par, src->par, sizeof(int64_t) * (size_t)(src->n + 1));
   memcpy(dst->val, src->val, sizeof(double) * (size_t)src->par[src->n]);
@@ -302,6 +316,7 @@ void vd_lstring_free(vd_lstring* s) {
   vd_free(s->sym, (size_t)s->cap * sizeof(int32_t));
   vd_free(s->par, s->cap ? (size_t)(s->cap + 1) * sizeof(int64_t) : 0);
   vd_free(s->src, (size_t)s->cap * sizeof(int64_t));
+  vd_free(s->line, (size_t)s->cap * sizeof(int32_t));
   vd_free(s->val, (size_t)s->vcap * sizeof(double));
   *s = vd_lstring_empty();
 }

@@ -46,6 +46,7 @@ typedef struct tstate {
   int gc;            // 1 between @Gc and @Ge
   int gc_prev;       // last segment of the current generalised cylinder, -1 if none
   int polygon;       // 1 between { and }
+  int64_t open_at;   // module of the '[' that opened this state's branch
   // curve-fed geometry (docs/turtle.md, "Guides, contours, sweeps"): indices into the run's
   // tables, -1 for none
   int contour;       // cross section of F and generalised cylinders (a run curve), -1: circle
@@ -139,7 +140,16 @@ typedef struct turtle {  // NOLINT(clang-analyzer-optin.performance.Padding): fi
   tgcp* gcp;         // recorded tube paths, a stack that follows [ ] (ngcp)
   int ngcp, cap_gcp;
   double* query; // Nullable: parameter values of the string (query run: ?P ?H ... are filled)
+  // warnings, reported after the run with the file line of their first module
+  struct twarn {
+    int64_t i;     // first module it happened at
+    int sym;       // its symbol
+    int count;     // times
+    char msg[160]; // what happened
+  } warn[3];
 } turtle;
+
+enum { WARN_WIDTH, WARN_RADIUS, WARN_BRACKET };
 
 // ---------------------------------------------------------------------------------------------
 // defaults
@@ -185,6 +195,32 @@ static vd_status fail(turtle* T, vd_status st, const char* fmt, ...) {
 
 static vd_status nomem(turtle* T) {
   return fail(T, VD_ERR_NOMEM, "out of memory");
+}
+
+// a value L-Py accepts with a warning (it is ignored): kept for the report after the run
+static void warn_module(turtle* T, int kind, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void warn_module(turtle* T, int kind, const char* fmt, ...) {
+  struct twarn* w = &T->warn[kind];
+  if (w->count++ == 0) {
+    w->i = T->i;
+    w->sym = T->sym;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(w->msg, sizeof w->msg, fmt, ap);
+    va_end(ap);
+  }
+}
+
+// a negative width or radius parameter k: L-Py warns and ignores it (1 when it was negative)
+static int negative_ignored(turtle* T, int k, double v, int kind) {
+  if (v >= 0) return 0;
+  warn_module(T, kind, "negative %s %g (ignored, as in L-Py)", kind == WARN_WIDTH ? "width" : "radius", v);
+  (void)k;
+  return 1;
 }
 
 // parameter k of the current module as a finite number
@@ -1015,10 +1051,9 @@ static vd_status draw_sphere(turtle* T) {
   double r;
   int label;
   vd_status st;
-  if ((st = max_params(T, 2)) || (st = nonneg_or(T, 0, T->t.width, "radius", &r)) ||
-      (st = label_at(T, 1, &label)))
+  if ((st = max_params(T, 2)) || (st = num_or(T, 0, T->t.width, &r)) || (st = label_at(T, 1, &label)))
     return st;
-  if (r <= EPS) return VD_OK;
+  if (negative_ignored(T, 0, r, WARN_RADIUS) || r <= EPS) return VD_OK;
   vd_sphere_spec g = vd_sphere_spec_default();
   g.center = T->t.pos;
   g.radius = r * T->t.scale;
@@ -1037,10 +1072,9 @@ static vd_status draw_disc(turtle* T) {
   double r;
   int label;
   vd_status st;
-  if ((st = max_params(T, 2)) || (st = nonneg_or(T, 0, T->t.width, "radius", &r)) ||
-      (st = label_at(T, 1, &label)))
+  if ((st = max_params(T, 2)) || (st = num_or(T, 0, T->t.width, &r)) || (st = label_at(T, 1, &label)))
     return st;
-  if (r <= EPS) return VD_OK;
+  if (negative_ignored(T, 0, r, WARN_RADIUS) || r <= EPS) return VD_OK;
   const tstate* t = &T->t;
   int n = t->slices;
   if ((st = scratch(T, n + 1, n))) return st;
@@ -1126,7 +1160,8 @@ static vd_status draw_box_quad(turtle* T, int box) {
   if ((st = max_params(T, 3)) || (st = num_or(T, 0, T->def.step, &len)) ||
       (st = num_or(T, 1, T->t.width, &top)) || (st = label_at(T, 2, &label)))
     return st;
-  return box_quad(T, len, top < 0 ? T->t.width : top, label, box);
+  if (T->np > 1 && negative_ignored(T, 1, top, WARN_RADIUS)) top = T->t.width;
+  return box_quad(T, len, top, label, box);
 }
 
 // ~l(s): PlantGL's predefined leaf, a flat hexagon of length s along H, s/2 wide along L,
@@ -1365,6 +1400,7 @@ static vd_status step(turtle* T) {
     t->gst_top = T->ngst;
     t->gcp_top = T->ngcp;
     T->stack[T->nstack++] = *t;
+    t->open_at = T->i;
     // a tube continues into the branch from its last point only (Turtle::push)
     if (t->gc && t->gc_contour >= 0 && t->gcp_n > 0) {
       if (!vd_grow((void**)&T->gcp, &T->cap_gcp, T->ngcp + 1, sizeof *T->gcp)) return nomem(T);
@@ -1390,6 +1426,7 @@ static vd_status step(turtle* T) {
     if ((st = max_params(T, 3)) || (st = num_or(T, 0, T->def.step, &a)) ||
         (st = num_or(T, 1, -1, &b)) || (st = label_at(T, 2, &label)))
       return st;
+    if (T->np > 1 && negative_ignored(T, 1, b, WARN_RADIUS)) b = -1;  // a cylinder
     return draw_F(T, a, b, label);
   }
   case VD_SYM_f:
@@ -1435,8 +1472,8 @@ static vd_status step(turtle* T) {
   case VD_SYM_DECWIDTH:
   case VD_SYM_SETWIDTH:
     if (T->np > 0) {
-      if ((st = nonneg_or(T, 0, 0, "width", &a))) return st;
-      t->width = a;
+      if ((st = num(T, 0, &a))) return st;
+      if (!negative_ignored(T, 0, a, WARN_WIDTH)) t->width = a;
     } else if (T->sym == VD_SYM_INCWIDTH) {
       t->width += T->def.width_inc;
     } else if (T->sym == VD_SYM_DECWIDTH && t->width - T->def.width_inc > -EPS) {
@@ -1743,6 +1780,36 @@ static void release(turtle* T) {
   vd_free(T->ibuf, (size_t)T->cap_ibuf * sizeof *T->ibuf);
 }
 
+// Name the file line of the rule or axiom behind a failed module and behind each warning
+// (the derivation runs again keeping lines: nothing is paid for them while all goes well).
+static void report(turtle* T, vd_status st, vd_error* err) {
+  int64_t idx[4];
+  int line[4] = {0, 0, 0, 0}, n = 0;
+  if (st && err) idx[n++] = T->i;
+  for (int k = 0; k < 3; k++)
+    if (T->warn[k].count) idx[n++] = T->warn[k].i;
+  if (!n) return;
+  int found = T->ls && !T->query && lsys_trace_lines((vd_lsystem*)T->ls, T->s, idx, n, line);
+  const char* file = T->ls ? lsys_file(T->ls) : "";
+  int j = 0;
+  if (st && err) {
+    if (found && line[0] > 0 && err->line == 0) {
+      snprintf(err->file, sizeof err->file, "%s", file);
+      err->line = line[0];
+    }
+    j = 1;
+  }
+  for (int k = 0; k < 3; k++) {
+    const struct twarn* w = &T->warn[k];
+    if (!w->count) continue;
+    char where[300] = "";
+    if (found && line[j] > 0) snprintf(where, sizeof where, "%s:%d: ", file, line[j]);
+    vd_log(1, "%sturtle: module %lld '%s': %s%s", where, (long long)w->i, sym_name(T, w->sym), w->msg,
+           w->count > 1 ? " (and more like it)" : "");
+    j++;
+  }
+}
+
 static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
                             vd_plant_spec* plant, vd_error* err, double* query) {
   VD_ASSERT(s && plant);
@@ -1824,7 +1891,14 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
       end_axis(&T, &T.stack[k]);
     if (T.t.polygon && T.npoly > 0)
       vd_log(1, "turtle: polygon not closed with '}' at the end of the string; dropped");
+    if (T.nstack > 0) {
+      // L-Py accepts the string (each open branch ends there); the innermost '[' is named
+      T.i = T.t.open_at;
+      T.sym = VD_SYM_SB;
+      warn_module(&T, WARN_BRACKET, "%d '[' not closed at the end of the string", T.nstack);
+    }
   }
+  report(&T, st, err);
   // the largest instance id in use, whether or not the plant's add functions track it
   if (T.ninst > plant->ninstance) plant->ninstance = T.ninst;
   release(&T);

@@ -4,7 +4,7 @@
 // changes, attachment points of leaves and fruits, pedicel abscission nodes) into chains, and
 // each chain is resampled to rod segments of about sigma_distance with nodes on the plant's
 // polyline. Leaves become small rod graphs, spheres hang from a stalk segment, the first
-// clamp_length of every root segment is held fixed. Then masses, rest frames (parallel
+// clamp_length of every root segment is held fixed (0: the root node and its frame only). Then masses, rest frames (parallel
 // transport), compliances, fracture thresholds and the elimination order are set, and every
 // plant element is bound to the rod it follows.
 #include <stdlib.h>
@@ -107,6 +107,7 @@ typedef struct bseg {
   unsigned flags;
   double radius, mass, ib, it;
   vd_vec3 leafn;  // lamina area times normal, world frame while building
+  int ghost;      // the fixed segment behind a root held without a pot (clamp_length 0): no mass
 } bseg;
 
 typedef struct pend {
@@ -230,8 +231,8 @@ static vd_status check_def(const vd_sim_def* d, vd_error* err) {
 #define BAD(...) return vd_error_set(err, VD_ERR_VALUE, "", 0, 0, __VA_ARGS__)
   if (!(isfinite(d->segment_length) && d->segment_length > 0))
     BAD("sim: segment length must be a number > 0 (m), got %g", d->segment_length);
-  if (!(isfinite(d->clamp_length) && d->clamp_length > 0))
-    BAD("sim: clamp length must be a number > 0 (m), got %g", d->clamp_length);
+  if (!(isfinite(d->clamp_length) && d->clamp_length >= 0))
+    BAD("sim: clamp length must be a number >= 0 (m), got %g", d->clamp_length);
   for (int c = 0; c < VD_SIM_CLASS_COUNT; c++) {
     const vd_sim_material* mt = &d->material[c];
     const char* n = class_names[c];
@@ -485,8 +486,22 @@ static vd_status build_chains(bld* b) {
     } else if (is_root) {
       // the pot: the first clamp_length held, the rest free
       double c = b->def->clamp_length < total ? b->def->clamp_length : total;
-      last = resample(b, segs, pts, cum, k, 0, c, start, 1, 0, c >= total ? end_plant : -1);
-      if (last >= 0 && c < total) last = resample(b, segs, pts, cum, k, c, total, last, 0, 0, end_plant);
+      if (c > 0) {
+        last = resample(b, segs, pts, cum, k, 0, c, start, 1, 0, c >= total ? end_plant : -1);
+        if (last >= 0 && c < total) last = resample(b, segs, pts, cum, k, c, total, last, 0, 0, end_plant);
+      } else {
+        // no pot: only the root node and its frame held, by a massless fixed segment behind the
+        // root along the first one and as long (the mirror image of a clamped end)
+        double nrod = floor(total / b->def->segment_length + 0.5), l1 = total / (nrod < 1 ? 1 : nrod);
+        int j = 1;
+        while (j < k && !(cum[j] > 1e-12)) j++;
+        vd_vec3 dir = vd_scale(vd_sub(pts[j], pts[0]), 1.0 / cum[j]);
+        int g = add_node(b, vd_sub(b->node[start].pos, vd_scale(dir, l1)), 1);
+        int t = g < 0 ? -1 : add_seg(b, g, start, cls, p->seg_label[first], p->seg_instance[first], -1,
+                                      p->seg_radius[2 * first], VD_SIM_FIXED);
+        if (t >= 0) b->seg[t].ghost = 1;
+        last = t < 0 ? -1 : resample(b, segs, pts, cum, k, 0, total, start, 0, 0, end_plant);
+      }
     } else {
       last = resample(b, segs, pts, cum, k, 0, total, start, 0, (int)first_flags, end_plant);
     }
@@ -845,7 +860,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     double l = v_norm(vd_sub(b->node[s->n1].pos, b->node[s->n0].pos));
     m->seg_len0[t] = l > 1e-12 ? l : 1e-12;
     double r = s->radius, area = VD_PI * r * r;
-    double mass = (s->flags & VD_SIM_FRUITSEG) ? 0.0 : mt->density * area * m->seg_len0[t];
+    double mass = (s->flags & VD_SIM_FRUITSEG) || s->ghost ? 0.0 : mt->density * area * m->seg_len0[t];
     m->seg_mass[t] = mass;
     m->node_mass[s->n0] += 0.5 * mass;
     m->node_mass[s->n1] += 0.5 * mass;

@@ -23,8 +23,10 @@
 //   in the fixed order of its children, so the bytes do not depend on the schedule or threads.
 // * Tips (a third of the tomato) have a diagonal body matrix: their inverse is written down.
 // * 6x6 inverses by 3x3 Schur blocks (two divisions each), used through products.
-#include <omp.h>
 #include <stddef.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "sim_internal.h"
 
@@ -699,7 +701,11 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     int nt = p->nthread, ok = 1;
 #pragma omp parallel num_threads(nt)
     {
+#ifdef _OPENMP
       int team = omp_get_num_threads(), me = omp_get_thread_num(), mine = 1;
+#else
+      int team = 1, me = 0, mine = 1;
+#endif
       for (int k = me; k < nt; k += team) mine &= forward_range(m, d, w, ctx, p->part[k], p->part[k + 1]);
       if (!mine) {
 #pragma omp atomic write
