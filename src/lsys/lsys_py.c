@@ -1606,13 +1606,15 @@ vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, i
     int ok = p && t && a % 3 == 0 && b % 3 == 0 && a > 0 && b > 0;
     int* ti = ok ? vd_malloc(sizeof(int) * (size_t)b) : NULL;
     double nvert = (double)(a - a % 3) / 3.0;  // vertices (a is a multiple of 3 here)
-    for (int i = 0; ti && i < b; i++) {
-      if (!(t[i] >= 0 && t[i] < nvert)) {
-        vd_free(ti, sizeof(int) * (size_t)b);
-        ti = NULL;
-        break;
+    int bad = 0;
+    if (ti)
+      for (int i = 0; i < b && !bad; i++) {
+        bad = !(t[i] >= 0 && t[i] < nvert);
+        if (!bad) ti[i] = (int)t[i];
       }
-      ti[i] = (int)t[i];
+    if (bad) {
+      vd_free(ti, sizeof(int) * (size_t)b);
+      ti = NULL;
     }
     if (t) free_doubles(t, b);
     if (ti) {
