@@ -272,6 +272,9 @@ int cli_frame_files(const char* out, int depth, int masks, char path[5][4200]);
 vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int masks, vd_error* err);
 // Render a simulation run folder (cli_render_run.c); returns the exit code.
 int cli_render_run(const cli_render_opts* o);
+// Render a growth run folder (growth.json, age_NNN.json; cli_render_growth.c): the last age, the
+// one nearest --time, or every age into a folder; returns the exit code.
+int cli_render_growth(const cli_render_opts* o);
 
 // The pictures of `verdant dataset --images N` (cli_views.c): render options and what varies
 // from view to view.
@@ -324,6 +327,8 @@ int cli_args_normalize(int* argc, char*** argv);
 
 // Subcommands.
 int cli_harvest(int argc, char** argv);
+// verdant sim PLANT --grow (cli_sim_grow.c): growth with physics between the age steps.
+int cli_sim_grow(int argc, char** argv);
 int cli_grow(int argc, char** argv);
 int cli_cloud(int argc, char** argv);
 int cli_dataset(int argc, char** argv);

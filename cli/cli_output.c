@@ -13,10 +13,21 @@ static vd_status write_plant(const vd_plant_spec* plant, const char* path, int a
   vd_mesh mesh;
   st = vd_geom_tessellate(m, NULL, NULL, &mesh, err);
   if (!st) {
-    if (cli_has_ext(path, ".obj"))
+    if (cli_has_ext(path, ".obj")) {
       st = vd_geom_write_obj(&mesh, m->labels, m->nlabel, path, err);
-    else
+    } else if (vd_plant_has_stress(plant)) {
+      // a simulated plant's stress (Pa) on every vertex
+      double* val = vd_malloc(sizeof(double) * (size_t)(mesh.nvert ? mesh.nvert : 1));
+      if (!val) {
+        st = vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+      } else {
+        vd_geom_vertex_values(m, NULL, &mesh, plant->node_stress, plant->seg_stress, val);
+        st = vd_geom_write_ply_values(&mesh, m->labels, m->nlabel, val, "stress", path, !ascii, err);
+        vd_free(val, sizeof(double) * (size_t)(mesh.nvert ? mesh.nvert : 1));
+      }
+    } else {
       st = vd_geom_write_ply(&mesh, m->labels, m->nlabel, path, !ascii, err);
+    }
     vd_mesh_free(&mesh);
   }
   vd_model_destroy(m);

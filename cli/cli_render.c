@@ -424,7 +424,13 @@ int cli_render(int argc, char** argv) {
                   "cloud, or a folder of 'verdant sim -o')");
   // a simulation run
   struct stat sb;
-  if (stat(o.po.path, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_render_run(&o);
+  if (stat(o.po.path, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+    // a growth run ('verdant sim --grow -o RUN/') has its own index of ages
+    char idx[4200];
+    snprintf(idx, sizeof idx, "%s/growth.json", o.po.path);
+    if (stat(idx, &sb) == 0) return cli_render_growth(&o);
+    return cli_render_run(&o);
+  }
   if (!o.out) return cli_usage_error("render", "missing -o OUT.png");
   if (!cli_has_ext(o.out, ".png"))
     return cli_usage_error("render", "output '%s' must end in .png", o.out);
@@ -450,11 +456,8 @@ int cli_render(int argc, char** argv) {
   if ((is_cloud || is_mesh) && style.color_by != VD_COLOR_LABEL &&
       style.color_by != VD_COLOR_INSTANCE)
     return cli_usage_error("render", "a point cloud or a mesh is coloured by label or instance");
-  if (!is_cloud && style.color_by == VD_COLOR_STRESS)
-    return cli_usage_error(
-        "render",
-        "--color-by stress needs a simulation state (a run folder of 'verdant sim -o RUN/'); "
-        "a plant at rest carries no stress");
+  // stress: a plant file that carries it (a growth run's snapshot), else a run folder
+  int want_stress = !is_cloud && style.color_by == VD_COLOR_STRESS;
   vd_render_def def = o.def;
   // load what is drawn
   vd_error err = {0};
@@ -479,8 +482,16 @@ int cli_render(int argc, char** argv) {
       st = vd_error_set(&err, VD_ERR_LIMIT, o.po.path, 0, 0, "more than 2^31 points");
   } else {
     st = cli_load_plant(&o.po, &plant, &ginfo, &err);
+    if (!st && want_stress && !vd_plant_has_stress(plant)) {
+      code = cli_usage_error("render",
+                             "--color-by stress needs a simulation state (a run folder of 'verdant sim -o RUN/', "
+                             "or a plant file with stress from 'verdant sim --grow'); a plant at rest carries no stress");
+      goto done;
+    }
     if (!st) st = vd_plant_compile(plant, &model, &err);
     cli_blame_input(&err, o.po.path);
+    // a simulated plant's stress, on the paper's logarithmic scale (its Figure 7)
+    if (!st && want_stress) style.seg_stress = plant->seg_stress, style.log_scale = 1;
   }
   if (st) {
     code = cli_report("render", &err, st);

@@ -17,6 +17,8 @@ static const char* sim_help =
     "\n"
     "Simulate a plant (.lpy or plant .json) as Cosserat rods (XPBD, direct tree solver) and\n"
     "write frames, fracture events and the final plant to DIR; --stats prints a JSON summary.\n"
+    "With --grow the L-system grows the plant age step by age step with physics in between\n"
+    "(mass-spring trees, with a rigid part, or rods): 'verdant sim --grow --help'.\n"
     "\n"
     "run:\n"
     "  -o, --output DIR        write DIR/frames.bin (or .jsonl), DIR/colliders.jsonl,\n"
@@ -77,6 +79,10 @@ static const char* sim_help_loads =
     ;
 // (in two parts: C99 compilers need only take string literals up to 4095 bytes)
 static const char* sim_help_output =
+    "soil:\n"
+    "      --soil S            roots held by a soil (loam, sandy-loam, clay, singapore-residual;\n"
+    "                          docs/physics.md) instead of clamped (no ground plane then);\n"
+    "                          clamp (default) holds them\n"
     "output:\n"
     "      --frames F          bin (default), jsonl or none\n"
     "      --fps N             frames per simulated second, default 30\n"
@@ -257,6 +263,7 @@ typedef struct sim_opts {
   double ramp;
   int ramp_set;
   const char* wind_file;
+  const char* soil;        // --soil PRESET: roots held by the soil instead of clamped
   char mesh_path[8][512];  // --collider-mesh files
   vd_vec3 mesh_pos[8];     // ... and their placements (m)
   int nmesh;
@@ -571,6 +578,12 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       double x[3];
       if (colon && parse_list(colon + 1, x, 3)) *colon = 0, at = vd_v3(x[0], x[1], x[2]);
       o->mesh_pos[o->nmesh++] = at;
+    } else if (!strcmp(a, "--soil")) {
+      VAL();
+      vd_soil tmp;
+      if (vd_soil_preset(val, &tmp) != VD_OK)
+        return cli_usage_error(cmd, "--soil expects clamp, loam, sandy-loam, clay or singapore-residual, got '%s'", val);
+      o->soil = val;
     } else if (!strcmp(a, "--self-collision")) {
       o->opt.self_collision = 1;
     } else if (!strcmp(a, "--no-self-collision")) {
@@ -669,6 +682,9 @@ static int check_clash(const sim_opts* o) {
 }
 
 int cli_sim(int argc, char** argv) {
+  // growth with physics between the age steps has its own options (cli_sim_grow.c)
+  for (int i = 1; i < argc; i++)
+    if (!strcmp(argv[i], "--grow")) return cli_sim_grow(argc, argv);
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(sim_help, stdout);
@@ -716,6 +732,14 @@ int cli_sim(int argc, char** argv) {
   vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
   if (!st) cli_grow_info_free(&info);
   if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
+  // a soil holds the roots: the axiom's roots and trunk share their base, nothing is clamped
+  vd_soil soil;
+  vd_sim_soil* held = NULL;
+  int use_soil = o.soil && vd_soil_preset(o.soil, &soil) == VD_OK && soil.method != VD_SOIL_CLAMP;
+  if (!st && use_soil) {
+    vd_plant_join_bases(spec);
+    o.def.clamp_roots = 0;
+  }
   if (!st) st = vd_plant_compile(spec, &plant, &err);
   if (!st) st = vd_sim_build(plant, &o.def, &m, &err);
   cli_blame_input(&err, o.po.path);
@@ -741,7 +765,9 @@ int cli_sim(int argc, char** argv) {
     else if (p->move && (p->tie = vd_sim_add_tie(d, p->node, d->node_pos[p->node], 1e-5)) < 0)  // NOLINT(clang-analyzer-core.NullDereference): d exists whenever st is VD_OK
       st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
-  if (!st && !o.no_ground) {
+  if (!st && use_soil) st = vd_sim_soil_attach(m, d, &soil, &held, &err);
+  // the ground plane would push the roots out of the soil: with a soil there is none
+  if (!st && !o.no_ground && !use_soil) {
     vd_sim_collider c = {VD_SIM_PLANE, {0, 0, 0}, vd_v3(0, 0, o.ground), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
     vd_sim_add_collider(d, &c);
   }
@@ -830,6 +856,7 @@ int cli_sim(int argc, char** argv) {
         vd_sim_set_collider_pose(m, d, pr->id, vd_add(pr->p0, vd_scale(vd_sub(pr->p1, pr->p0), s)), vd_quat_identity());
       }
       st = vd_sim_step(m, d);
+      vd_sim_soil_update(m, d, held);
       if (out.frames_open && d->time >= next_frame - 1e-12) {
         double tf = o.profile ? cli_now() : 0;
         if (cli_frames_write(&out, m, d)) break;  // reported by the commit below
@@ -917,6 +944,7 @@ done:
   cli_unwatch(out.watch);
   cli_unwatch(out.cwatch);
   vd_free(out.bbuf, out.fbuf_n);
+  vd_sim_soil_destroy(held);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);
   vd_model_destroy(plant);

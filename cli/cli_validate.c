@@ -82,10 +82,28 @@ int cli_validate(int argc, char** argv) {
   int n = 0;
   double t0 = cli_now();
   st = vd_sim_validate(&def, &r, &n, &err);
+  // the mass-spring trees and growth runs (docs/validation.md) after the rods
+  for (int part = 0; part < 2 && !st; part++) {
+    vd_validate_result* r2 = NULL;
+    int n2 = 0;
+    st = part == 0 ? vd_mss_validate(&def, &r2, &n2, &err) : vd_growth_validate(&def, &r2, &n2, &err);
+    if (!st && n2) {
+      vd_validate_result* all = vd_realloc(r, sizeof *r * (size_t)n, sizeof *r * (size_t)(n + n2));
+      if (!all) {
+        st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
+      } else {
+        memcpy(all + n, r2, sizeof *r2 * (size_t)n2);
+        r = all;
+        n += n2;
+      }
+    }
+    vd_free(r2, sizeof *r2 * (size_t)n2);
+  }
   if (po.progress) fprintf(stderr, "\r%60s\r", "");
   vd_model_destroy(plant);
   vd_plant_spec_destroy(spec);
   if (st) {
+    vd_free(r, sizeof *r * (size_t)n);
     cli_report("validate", &err, st);
     return EXIT_FAIL;
   }

@@ -217,3 +217,47 @@ TEST(mss, oscillator_period_and_decay) {
   CHECK_NEAR(ratio, exp(-2 * VD_PI * (zeta + zeta_num) / sqrt(1 - zeta * zeta)), 0.01);
   osc_free(&o);
 }
+
+TEST(mss, validate_cases_pass) {
+  // the closed-form cases of verdant validate (quick sizes) and the growth momentum check
+  vd_validate_def def;
+  memset(&def, 0, sizeof def);
+  vd_validate_result* r = NULL;
+  int n = 0;
+  vd_error e = {0};
+  REQUIRE(vd_mss_validate(&def, &r, &n, &e) == VD_OK);
+  CHECK(n >= 15);
+  for (int k = 0; k < n; k++)
+    if (!r[k].pass) vdt_fail(__FILE__, __LINE__, "%s: %s = %g, reference %g", r[k].name, r[k].quantity, r[k].measured, r[k].reference);
+  vd_free(r, sizeof *r * (size_t)n);
+  REQUIRE(vd_growth_validate(&def, &r, &n, &e) == VD_OK);
+  CHECK_INT(n, 2);
+  for (int k = 0; k < n; k++) CHECK(r[k].pass);
+  vd_free(r, sizeof *r * (size_t)n);
+}
+
+TEST(mss, rigid_release_and_join_momentum) {
+  // joining nodes keeps linear momentum (eq. 7) and, with the corrected eq. 8, angular momentum
+  vd_model* p = chain(4, 1.0, 0.02, vd_v3(0, 0, 1), 5);
+  REQUIRE(p);
+  vd_mss_def def = vd_mss_def_default();
+  vd_mss_model* m = NULL;
+  vd_error e = {0};
+  REQUIRE(vd_mss_build(p, &def, NULL, &m, &e) == VD_OK);
+  vd_mss_data* d = vd_mss_data_create(m);
+  REQUIRE(d);
+  for (int i = 0; i < m->nnode; i++) d->vel[i] = vd_v3(0.1 * i, -0.05, 0.02 * i * i);
+  vd_vec3 p0 = vd_mss_momentum(m, d);
+  unsigned char join[5] = {0, 1, 1, 1, 0};
+  double lc[6];
+  vd_mss_rigid_join(m, d, join, 0, lc);
+  vd_vec3 p1 = vd_mss_momentum(m, d);
+  CHECK_NEAR(vd_norm(vd_sub(p1, p0)), 0, 1e-14);
+  CHECK_NEAR(lc[0], lc[3], 1e-14);
+  CHECK_NEAR(lc[1], lc[4], 1e-14);
+  CHECK_NEAR(lc[2], lc[5], 1e-14);
+  CHECK_INT(d->rb.n, 3);
+  vd_mss_data_destroy(d);
+  vd_mss_model_destroy(m);
+  vd_model_destroy(p);
+}

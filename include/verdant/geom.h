@@ -137,6 +137,17 @@ vd_status vd_geom_write_obj(const vd_mesh* mesh, const vd_label* labels, int nla
 // Write PLY (binary little-endian when binary is 1, else ASCII) with face label and instance.
 vd_status vd_geom_write_ply(const vd_mesh* mesh, const vd_label* labels, int nlabel,
                             const char* path, int binary, vd_error* err);
+// Write PLY with one more per-vertex float property value_name (Nullable: "value") from value
+// (Nullable: none, as vd_geom_write_ply) (nvert), NaN where there is none.
+vd_status vd_geom_write_ply_values(const vd_mesh* mesh, const vd_label* labels, int nlabel,
+                                   const double* value, const char* value_name, const char* path,
+                                   int binary, vd_error* err);
+// Per-vertex values of a tessellated plant (vd_geom_tessellate of m in state d, Nullable: rest)
+// from values at the plant's nodes and segments (Nullable each; NaN: none): a segment's vertex
+// takes the value of the node at its nearer end (the segment's value where the node has none);
+// spheres and meshes have none (NaN). out: mesh->nvert values.
+void vd_geom_vertex_values(const vd_model* m, const vd_data* d, const vd_mesh* mesh,
+                           const double* node_value, const double* seg_value, double* out);
 
 // ---------------------------------------------------------------------------------------------
 // bounding volume hierarchy: binned SAH build over boxes, flat node array, built sequentially so

@@ -73,7 +73,8 @@ vd_growth_def vd_growth_def_default(void);
 
 // The seed's own choices, for reproducing it: paper springs (k0 d / l, alternate-node springs),
 // eq. 3, the paper's wind load (eqs. 9-10 on node cross-sections) with Stokes drag (eq. 11), eq. 8
-// as printed, no strain limiting, no stress-free growth (the rest of def is left as it is).
+// as printed, no strain limiting, a rigid part stepped by RK4 even when nothing holds it, no
+// stress-free growth (the rest of def is left as it is).
 void vd_growth_def_paper(vd_growth_def* def);
 
 // One event of a growth run.

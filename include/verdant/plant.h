@@ -157,6 +157,9 @@ vd_status vd_plant_complete_labels(vd_plant_spec* s);
 // yellow, blue, purple), then a colour hashed from the id.
 void vd_plant_default_rgb(int id, float rgb[3]);
 
+// Segments without a parent that start at one point (the turtle starts a node per branch of an
+// axiom: roots and trunk) are made to start at one node; returns the nodes no longer used.
+int vd_plant_join_bases(vd_plant_spec* s);
 // Attach stress (a simulation's result) to a spec: node (Nullable, nnode values) and seg
 // (Nullable, nseg values) in Pa, NaN where there is none; copied. Both NULL removes it.
 vd_status vd_plant_set_stress(vd_plant_spec* s, const double* node, const double* seg);

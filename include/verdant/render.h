@@ -218,6 +218,9 @@ typedef struct vd_render_style {
   int slices;               // tessellation sides (>= 3), or 0 for each primitive's own; default 0
   const vd_data* ref;       // Nullable: state displacement is measured from (a run's first
                             // frame); NULL: the model's rest shape; default NULL
+  int log_scale;            // 1: the colour scale is logarithmic (values <= 0 at its bottom;
+                            // an automatic range spans the positive values, four decades at
+                            // most); default 0
 } vd_render_style;
 
 // Defaults: colour by label in the distinct palette, no stress, automatic range, slices 0,

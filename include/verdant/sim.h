@@ -120,7 +120,8 @@ typedef struct vd_sim_def {
   double segment_length;          // target rod segment length sigma_distance (m)
   double clamp_length;            // length of each root segment held fixed, like a pot (m); 0: only
                                   // the root node and its frame held (an exact clamped end)
-  int clamp_roots;                // 1: segments of organ root are fixed (no soil model yet)
+  int clamp_roots;                // 1: segments of organ root are fixed (0: a soil may hold them,
+                                  // vd_sim_soil_attach; the stem's collar stays held)
   vd_sim_material material[VD_SIM_CLASS_COUNT];  // per class; see vd_sim_def_default
   double leaf_areal_density;      // mass of leaf lamina per area (kg/m^2)
   double leaf_vein_ratio;         // midrib radius at the leaf base / blade length (-)
@@ -488,6 +489,21 @@ typedef struct vd_validate_def {
   const vd_model* plant;  // Nullable: also run the sag-free gate on this plant (e.g. the tomato)
 } vd_validate_def;
 
+// A growing list of validation results (for the modules' own cases).
+typedef struct vd_validate_list {
+  vd_validate_result* r;  // results (n, capacity cap)
+  int n, cap;
+} vd_validate_list;
+
+// Append a checked quantity: error relative to the reference (absolute when abs_err is set or
+// the reference is 0); pass when finite and within tol. note is printf-style. 0 when out of
+// memory.
+int vd_validate_add(vd_validate_list* l, const char* name, const char* form, const char* quantity,
+                    double measured, double reference, double tol, int abs_err, const char* note,
+                    ...) __attribute__((format(printf, 9, 10)));
+// Hand the list's results to a caller as vd_sim_validate does (*out exactly n entries, or NULL).
+vd_status vd_validate_finish(vd_validate_list* l, vd_validate_result** out, int* n, vd_error* err);
+
 // Run the validation cases; *out (free with vd_free(*out, *n * sizeof **out)) gets the results.
 vd_status vd_sim_validate(const vd_validate_def* def, vd_validate_result** out, int* n,
                           vd_error* err);
@@ -585,11 +601,12 @@ double vd_soil_max_force(const vd_soil* s, double depth, double radius, double a
 // Check a soil's numbers (water > 0, density > 0, Poisson below 0.5, ...); errors name the field.
 vd_status vd_soil_check(const vd_soil* s, vd_error* err);
 
-// Soil for the rods engine, instead of clamped roots: every root node below the ground (and the
-// nodes where roots meet the stem at the ground) is held by a tie to the point where it grew, of
-// stiffness soil->stiffness; after each step a tie that pulls harder than the node's maximum
-// resistance (vd_soil_max_force) slips so that it pulls exactly that much (the node has
-// yielded). Build the rod model with def.clamp_roots = 0.
+// Soil for the rods engine, instead of clamped roots: every root node below the ground is held by
+// a tie to the point where it grew, of stiffness soil->stiffness; after each step a tie that pulls
+// harder than the node's maximum resistance (vd_soil_max_force) slips so that it pulls exactly
+// that much (the node has yielded). Build the rod model with def.clamp_roots = 0; the stem's
+// collar (the pot length of its first segment) stays held: rods join the stem and its roots at
+// the base without a bending joint (no parent between them), so the roots cannot hold it upright.
 typedef struct vd_sim_soil {
   int n;              // held nodes
   int* node;          // rod node (n)
@@ -609,6 +626,23 @@ vd_status vd_sim_soil_attach(const vd_sim_model* m, vd_sim_data* d, const vd_soi
 void vd_sim_soil_update(const vd_sim_model* m, vd_sim_data* d, vd_sim_soil* s);
 // Free (NULL is fine).
 void vd_sim_soil_destroy(vd_sim_soil* s);
+
+// Wood of a species: stiffness, density and strength for mass-spring trees (docs/physics.md).
+typedef struct vd_wood {
+  const char* name;    // species name ("hopea-odorata")
+  double young;        // modulus of elasticity along the grain (Pa)
+  double density;      // density of the wood (kg/m^3)
+  double mor;          // modulus of rupture, static bending strength (Pa)
+  const char* source;  // where the numbers come from
+} vd_wood;
+
+// Wood of a species by name: "generic-broadleaf" (green hardwood), "hopea-odorata" (merawan,
+// the seed's species). VD_ERR_NAME for an unknown name; vd_wood_count/vd_wood_get list them.
+vd_status vd_wood_species(const char* name, vd_wood* out);
+// Number of species in the table.
+int vd_wood_count(void);
+// Species i of the table (0 <= i < vd_wood_count()).
+const vd_wood* vd_wood_get(int i);
 
 // A rigid body in the MRL manner: state for RK4 with a quaternion.
 typedef struct vd_rigid {
@@ -690,13 +724,15 @@ typedef struct vd_mss_opt {
   int breaking;                 // 1: an internode breaks when its stress exceeds its MOR
   double strain_limit;          // internodes stretched or shortened by more than this after a
                                 // substep are put back to it, parents first (Provot 1995); 0 off
+  int rigid_release;            // 1: a rigid part nothing holds (its soil gave way) is released into
+                                // the springs; 0: stepped by RK4 against them (the paper's; unstable)
 } vd_mss_opt;
 
 // Defaults: dt 0.01 s, integrator implicit, cg_iterations 500, cg_tolerance 1e-8, gravity
 // (0, 0, -9.81) m/s^2, no wind, gust_period 2 s, wind_model area, air_density 1.226 kg/m^3,
 // drag_cd 1.2, leaf_cd 0.1, drag quadratic, viscosity 1.81e-5 Pa s, no light, light_k 1 N m^2,
 // no gravitropism, gravi_k 0.1 N, bastien_beta 0.5 1/(m year), bastien_gamma 1 1/year,
-// growth_zone_age 2 years, soil 1, breaking 1, strain_limit 1e-4.
+// growth_zone_age 2 years, soil 1, breaking 1, strain_limit 1e-4, rigid_release 1.
 vd_mss_opt vd_mss_opt_default(void);
 
 // node flags
@@ -711,12 +747,16 @@ typedef struct vd_mss_model {
   int ninter;             // internode springs: springs 0 .. ninter-1, one per stem/root segment
   int nspring;            // all springs: internodes, then alternate-node springs
   int nhinge;             // hinge (bending) springs
+  int nplant;             // nodes of the plant it was built from
   vd_mss_opt opt;         // run settings
   vd_mss_springs springs; // spring law it was built with
   double rigid_age;       // nodes at least this old join the rigid body (time unit)
   double damping;         // c of eq. 5 (-)
   // nodes (nnode)
   int* node_plant;        // plant node
+  int* plant_node;        // mass-spring node of each plant node, -1 if none (nplant); the bases
+                          // of axes that start at one point (roots and trunk from the axiom) share
+                          // one node
   int* node_parent;       // node at the other end of its owner internode, -1 for bases
   int* node_owner;        // its owner internode (the spring ending at it), -1 for bases
   unsigned* node_flags;   // VD_MSS_* flags
@@ -821,8 +861,13 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d);
 void vd_mss_rigid_join(const vd_mss_model* m, vd_mss_data* d, const unsigned char* join,
                        int paper_eq8, double* lcheck);
 // Recompute the rigid body's mass, centre and inertia from its members' current masses and
-// positions, keeping p and the angular momentum (docs/physics.md).
+// positions, keeping p and the angular momentum (docs/physics.md); members flagged removed leave
+// with their momentum.
 void vd_mss_rigid_update(const vd_mss_model* m, vd_mss_data* d);
+// Rebuild the rigid body from the members it has now, which move rigidly (v = V + omega x r) at
+// angular velocity omega (rad/s): p and the angular momentum are theirs (members that are gone
+// took theirs away).
+void vd_mss_rigid_refit(const vd_mss_model* m, vd_mss_data* d, vd_vec3 omega);
 // Stress of every internode and node section (d->spring_stress, d->node_stress) from the loads of
 // the last substep: the subtree beyond each section is in equilibrium with the section's force N
 // and moment M, sigma = |N| / (pi r^2) + 4 |M| / (pi r^3).

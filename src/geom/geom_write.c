@@ -199,6 +199,12 @@ static void put_f32le(unsigned char* p, double v) {
 
 vd_status vd_geom_write_ply(const vd_mesh* mesh, const vd_label* labels, int nlabel,
                             const char* path, int binary, vd_error* err) {
+  return vd_geom_write_ply_values(mesh, labels, nlabel, NULL, NULL, path, binary, err);
+}
+
+vd_status vd_geom_write_ply_values(const vd_mesh* mesh, const vd_label* labels, int nlabel,
+                                   const double* value, const char* value_name, const char* path, int binary,
+                                   vd_error* err) {
   vd_status st = check_mesh(mesh, path, err);
   if (st) return st;
   if (nlabel < 0 || (nlabel > 0 && !labels)) nlabel = 0;
@@ -216,22 +222,28 @@ vd_status vd_geom_write_ply(const vd_mesh* mesh, const vd_label* labels, int nla
   }
   fprintf(fp,
           "element vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
-          "property float nx\nproperty float ny\nproperty float nz\n"
+          "property float nx\nproperty float ny\nproperty float nz\n",
+          mesh->nvert);
+  // a per-vertex value (a simulation's stress): one more float property, NaN where none
+  if (value) fprintf(fp, "property float %s\n", value_name && *value_name ? value_name : "value");
+  fprintf(fp,
           "element face %d\nproperty list uchar int vertex_indices\nproperty int label\n"
           "property int instance\nend_header\n",
-          mesh->nvert, mesh->ntri);
+          mesh->ntri);
   // vertices: position and normal (zero normal when the mesh has none)
   for (int v = 0; v < mesh->nvert; v++) {
     double val[6] = {mesh->pos[3 * v], mesh->pos[3 * v + 1], mesh->pos[3 * v + 2], 0, 0, 0};
     if (mesh->normal) memcpy(val + 3, mesh->normal + 3 * v, 3 * sizeof(double));
     if (binary) {
-      unsigned char rec[24];
+      unsigned char rec[28];
       for (int k = 0; k < 6; k++)
         put_f32le(rec + 4 * k, val[k]);
-      fwrite(rec, 1, sizeof rec, fp);
+      if (value) put_f32le(rec + 24, value[v]);
+      fwrite(rec, 1, value ? 28 : 24, fp);
     } else {
-      fprintf(fp, "%.9g %.9g %.9g %.7g %.7g %.7g\n", val[0], val[1], val[2], val[3], val[4],
-              val[5]);
+      fprintf(fp, "%.9g %.9g %.9g %.7g %.7g %.7g", val[0], val[1], val[2], val[3], val[4], val[5]);
+      if (value) fprintf(fp, " %.7g", value[v]);
+      fputc('\n', fp);
     }
   }
   // faces: count, three indices, label, instance

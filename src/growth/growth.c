@@ -204,6 +204,7 @@ void vd_growth_def_paper(vd_growth_def* d) {
   d->opt.wind_model = VD_MSS_WIND_PAPER;
   d->opt.drag = VD_MSS_DRAG_STOKES;
   d->opt.strain_limit = 0;
+  d->opt.rigid_release = 0;
   d->paper_eq8 = 1;
   d->stress_free = 0;
 }
@@ -351,6 +352,8 @@ static vd_status turtle_plant(vd_growth* g, vd_plant_spec** out, vd_error* err) 
     st = vd_plant_set_label(spec, id, name);
   }
   if (!st) st = vd_plant_complete_labels(spec);
+  // the axiom's roots and trunk start at one node (the base)
+  if (!st) vd_plant_join_bases(spec);
   vd_lstring_free(&geo);
   if (st) {
     vd_plant_spec_destroy(spec);
@@ -387,6 +390,7 @@ static vd_status build_physics(vd_growth* g, vd_error* err) {
     vd_sim_def rdef = def->rods;
     int soil = def->mss.soil.method != VD_SOIL_CLAMP;
     if (soil) rdef.clamp_roots = 0;
+    if (g->plant->nseg == 0) return VD_OK;  // nothing to simulate yet (an axiom that draws nothing)
     vd_status st = vd_sim_build(g->plant, &rdef, &g->rm, err);
     if (st) return st;
     vd_vec3 gr = g->rm->opt.gravity;
@@ -418,11 +422,11 @@ static vd_status build_physics(vd_growth* g, vd_error* err) {
 // total momentum of the carried state over the nodes that survive into the new plant, and the
 // scale sum m |v|
 static vd_vec3 carried_momentum(const vd_growth* g, double* scale) {
-  vd_vec3 p = g->rb.n > 0 ? g->rb.p : vd_v3(0, 0, 0);
-  double sc = g->rb.n > 0 ? vd_norm(g->rb.p) : 0;
+  vd_vec3 p = vd_v3(0, 0, 0);
+  double sc = 0;
   for (int i = 0; i < g->nnode; i++) {
     int o = carry_find(&g->c, g->key[i]);
-    if (o < 0 || g->c.rigid[o] || g->c.mass[o] <= 0) continue;
+    if (o < 0 || g->c.mass[o] <= 0) continue;
     p = vd_madd(p, g->c.vel[o], g->c.mass[o]);
     sc += g->c.mass[o] * vd_norm(g->c.vel[o]);
   }
@@ -502,7 +506,8 @@ static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
   }
   vd_free(old, sizeof(int) * (size_t)(nn ? nn : 1));
   vd_free(share, sizeof(double) * (size_t)(nn ? nn : 1));
-  // the rigid body as it was, recentred on its surviving members
+  // the rigid body as it was, refitted to the members that survive (they carry their rigid
+  // velocities; members cut with a branch took their momentum away)
   d->rb = g->rb;
   int nr = 0;
   for (int k = 0; k < nn; k++) nr += d->rigid[k];
@@ -510,7 +515,7 @@ static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
     memset(&d->rb, 0, sizeof d->rb);
     d->rb.q = vd_quat_identity();
   } else {
-    vd_mss_rigid_update(m, d);
+    vd_mss_rigid_refit(m, d, vd_rigid_omega(&g->rb));
   }
   vd_vec3 p1 = vd_mss_momentum(m, d);
   note_momentum(g, p0, p1, fmax(scale0, mss_scale(m, d)));
@@ -570,7 +575,14 @@ static void map_rods(vd_growth* g) {
       }
       placed[na] = 1;
     }
-    d->node_pos[nb] = vd_add(d->node_pos[na], vd_quat_rotate(rot[t], vd_sub(m->node_pos0[nb], m->node_pos0[na])));
+    // clamped nodes and segments stay where they are held
+    if (m->seg_flags[t] & VD_SIM_FIXED) {
+      rot[t] = vd_quat_identity();
+      placed[nb] = 1;
+      continue;
+    }
+    if (!m->node_fixed[nb])
+      d->node_pos[nb] = vd_add(d->node_pos[na], vd_quat_rotate(rot[t], vd_sub(m->node_pos0[nb], m->node_pos0[na])));
     placed[nb] = 1;
     d->seg_quat[t] = vd_quat_normalize(vd_quat_mul(rot[t], m->seg_quat0[t]));
   }
@@ -728,8 +740,10 @@ static vd_status rebuild(vd_growth* g, int grown, vd_error* err) {
   for (int i = 0; i < spec->nnode; i++) g->pmap[i] = -1;
   if (g->mm) {
     int* phys = g->attach;  // flags first, then each node's attachment (read before written)
-    for (int i = 0; i < spec->nnode; i++) phys[i] = 0;
-    for (int k = 0; k < g->mm->nnode; k++) g->pmap[g->mm->node_plant[k]] = k, phys[g->mm->node_plant[k]] = 1;
+    for (int i = 0; i < spec->nnode; i++) {
+      g->pmap[i] = i < g->mm->nplant ? g->mm->plant_node[i] : -1;
+      phys[i] = g->pmap[i] >= 0;
+    }
     int* at = vd_malloc(sizeof(int) * (size_t)(spec->nnode ? spec->nnode : 1));
     if (!at) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
     for (int i = 0; i < spec->nnode; i++) at[i] = find_attach(spec, g->owner_seg, phys, i);
@@ -738,7 +752,7 @@ static vd_status rebuild(vd_growth* g, int grown, vd_error* err) {
     if ((st = map_mss(g, grown, err))) return st;
   } else {
     for (int i = 0; i < spec->nnode; i++) g->attach[i] = i;
-    map_rods(g);
+    if (g->rm) map_rods(g);
   }
   return VD_OK;
 }
@@ -750,12 +764,12 @@ static vd_status rebuild(vd_growth* g, int grown, vd_error* err) {
 static void read_physics(vd_growth* g) {
   const vd_plant_spec* s = g->spec;
   if (g->mm) {
-    const vd_mss_model* m = g->mm;
     const vd_mss_data* d = g->md;
-    for (int k = 0; k < m->nnode; k++) {
-      int n = m->node_plant[k];
-      g->pos[n] = d->pos[k];
-      g->vel[n] = d->vel[k];
+    for (int i = 0; i < s->nnode; i++) {
+      int k = g->pmap[i];
+      if (k < 0) continue;
+      g->pos[i] = d->pos[k];
+      g->vel[i] = d->vel[k];
     }
     // the rest follow the node they hang from
     for (int i = 0; i < s->nnode; i++) {
@@ -767,6 +781,7 @@ static void read_physics(vd_growth* g) {
     }
     return;
   }
+  if (!g->rm) return;  // no rods: the plant stays where it is
   vd_sim_to_plant(g->rm, g->rd, g->plant, g->rpd);
   for (int i = 0; i < s->nnode; i++) {
     g->pos[i] = vd_v3(g->rpd->node_pos[3 * i], g->rpd->node_pos[3 * i + 1], g->rpd->node_pos[3 * i + 2]);
@@ -787,7 +802,8 @@ static vd_status carry_out(vd_growth* g, vd_error* err) {
     g->c.parent[i] = g->owner_seg[i] >= 0 ? s->seg[g->owner_seg[i]].node0 : -1;
     g->c.stiff[i] = g->owner_seg[i] >= 0 ? seg_stiffness(g, s, g->owner_seg[i]) : 0;
     int k = g->pmap[i];
-    if (k >= 0 && g->md && !g->md->removed[k]) {
+    // the node's own plant node carries it (not the aliases of a shared base)
+    if (k >= 0 && g->md && g->mm && !g->md->removed[k] && g->mm->node_plant[k] == i) {
       g->c.mass[i] = g->md->mass[k];
       g->c.rigid[i] = g->md->rigid[k];
       g->c.body[i] = g->md->body[k];
@@ -987,7 +1003,8 @@ static vd_status end_mss(vd_growth* g, vd_error* err) {
     }
     vd_mss_bastien(m, d, 1.0, g->def.bastien_substeps, rest);
     memcpy(old, g->rest, sizeof(vd_vec3) * (size_t)g->spec->nnode);
-    for (int k = 0; k < m->nnode; k++) g->rest[m->node_plant[k]] = rest[k];
+    for (int i = 0; i < g->spec->nnode; i++)
+      if (g->pmap[i] >= 0) g->rest[i] = rest[g->pmap[i]];
     for (int i = 0; i < g->spec->nnode; i++) {
       int a = g->attach[i];
       if (g->pmap[i] >= 0 || a < 0) continue;
@@ -1031,7 +1048,7 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
   for (int k = 0; k < g->def.substeps; k++) {
     if (g->mm) {
       vd_mss_step(g->mm, g->md);
-    } else {
+    } else if (g->rm) {
       if (vd_sim_step(g->rm, g->rd)) g->unstable++;
       vd_sim_soil_update(g->rm, g->rd, g->soil);
     }
@@ -1041,9 +1058,11 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
     g->time = g->md->time;
     collect_events(g);
     if ((st = end_mss(g, err))) return st;
-  } else {
+  } else if (g->rm) {
     g->time = g->rd->time;
     rods_breaking(g);
+  } else {
+    g->time += g->def.substeps * g->def.rod_opt.dt;
   }
   if ((st = carry_out(g, err))) return st;
   // broken branches leave the L-string, and the plant is rebuilt without them
@@ -1162,9 +1181,10 @@ vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err
     if (g->mm) {
       const vd_mss_model* m = g->mm;
       const vd_mss_data* d = g->md;
-      for (int k = 0; k < m->nnode; k++) ns[m->node_plant[k]] = d->node_stress[k];
+      for (int i = 0; i < s->nnode; i++)
+        if (g->pmap[i] >= 0) ns[i] = d->node_stress[g->pmap[i]];
       for (int q = 0; q < m->ninter; q++) ss[m->spring_plant[q]] = d->spring_stress[q];
-    } else {
+    } else if (g->rm) {
       vd_sim_plant_stress(g->rm, g->rd, g->plant, ss);
       for (int j = 0; j < s->nseg; j++) {
         if (!isfinite(ss[j])) continue;

@@ -51,6 +51,27 @@ vd_status vd_plant_set_stress(vd_plant_spec* s, const double* node, const double
   return VD_OK;
 }
 
+int vd_plant_join_bases(vd_plant_spec* s) {
+  int joined = 0;
+  for (int j = 0; j < s->nseg; j++) {
+    if (s->seg[j].parent >= 0) continue;
+    int n = s->seg[j].node0;
+    for (int k = 0; k < j; k++) {
+      if (s->seg[k].parent >= 0) continue;
+      int b = s->seg[k].node0;
+      if (b == n) break;
+      vd_vec3 x = s->node[n], y = s->node[b];
+      if (x.x == y.x && x.y == y.y && x.z == y.z) {
+        // n stays in the node list (indices of everything else are kept), unused by this segment
+        s->seg[j].node0 = b;
+        joined++;
+        break;
+      }
+    }
+  }
+  return joined;
+}
+
 int vd_plant_has_stress(const vd_plant_spec* s) {
   return s->node_stress && s->seg_stress && s->nstress_node == (s->nnode ? s->nnode : 1) &&
          s->nstress_seg == (s->nseg ? s->nseg : 1);

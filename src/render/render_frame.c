@@ -210,8 +210,8 @@ static void draw_legend(vd_renderer* r, int w, int h, int k) {
     rows = 1;
     width = text_width(con, title);
   } else {
-    snprintf(title, sizeof title, "%s (%s)",
-             r->color_by == VD_COLOR_STRESS ? "stress" : "displacement", unit);
+    snprintf(title, sizeof title, "%s (%s%s)",
+             r->color_by == VD_COLOR_STRESS ? "stress" : "displacement", unit, r->log_scale ? ", log" : "");
     snprintf(lo_txt, sizeof lo_txt, "%.3g", r->range_min);
     snprintf(hi_txt, sizeof hi_txt, "%.3g", r->range_max);
     rows = 3;

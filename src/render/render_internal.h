@@ -106,6 +106,7 @@ struct vd_renderer {
   vd_palette palette;          // its label colours
   int nadded;                  // plants and clouds added
   double range_min, range_max; // colour scale of the last value-coloured plant
+  int log_scale;               // ... logarithmic
   vd_vec3 lo, hi;              // bounds of everything added
   int has_bounds;
   vd_vec3 lo_up, hi_up; // bounds of what is above the floor (z >= 0)

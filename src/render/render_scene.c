@@ -145,6 +145,7 @@ void vd_render_clear(vd_renderer* r) {
   r->nadded = 0;
   r->has_bounds = r->has_bounds_up = 0;
   r->range_min = r->range_max = 0;
+  r->log_scale = 0;
 }
 
 // check a style for a plant (nseg segments) or a cloud (nseg < 0)
@@ -266,15 +267,27 @@ static void prim_attached(const vd_model* m, const vd_data* d, unsigned char* at
 // colour scale of values (nseg + nsphere + nmesh; NaN: none) over the attached primitives (the
 // whole plant when none of them has a value); 0, 0 when nothing has one
 static void value_range(const vd_model* m, const double* val, const unsigned char* att, double* lo,
-                        double* hi) {
+                        double* hi, int log_scale) {
   int n = m->nseg + m->nsphere + m->nmesh;
   for (int pass = 0; pass < 2; pass++) {
     *lo = INFINITY, *hi = -INFINITY;
     for (int i = 0; i < n; i++)
-      if (isfinite(val[i]) && (pass || att[i])) *lo = fmin(*lo, val[i]), *hi = fmax(*hi, val[i]);
-    if (*hi >= *lo) return;
+      if (isfinite(val[i]) && (pass || att[i]) && (!log_scale || val[i] > 0))
+        *lo = fmin(*lo, val[i]), *hi = fmax(*hi, val[i]);
+    if (*hi >= *lo) {
+      if (log_scale) *lo = fmax(*lo, *hi * 1e-4);  // four decades: round-off sits near zero
+      return;
+    }
   }
   *lo = *hi = 0;
+}
+
+// position of a value on the colour scale lo..hi, linear or logarithmic, in [0, 1]
+static double scale_pos(double v, double lo, double hi, int log_scale) {
+  if (!(hi > lo)) return 0;
+  if (!log_scale) return (v - lo) / (hi - lo);
+  if (!(v > 0) || !(lo > 0)) return 0;
+  return (log(v) - log(lo)) / (log(hi) - log(lo));
 }
 
 vd_status vd_render_value_range(const vd_model* m, const vd_data* d, const vd_render_style* style,
@@ -291,7 +304,7 @@ vd_status vd_render_value_range(const vd_model* m, const vd_data* d, const vd_re
   if (val && att && stack) {
     prim_values(m, d, &s, val, val + m->nseg, val + m->nseg + m->nsphere);
     prim_attached(m, d, att, stack);
-    value_range(m, val, att, lo, hi);
+    value_range(m, val, att, lo, hi, s.log_scale);
   } else {
     st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
@@ -531,12 +544,13 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
         goto done;
       }
       prim_attached(m, d, att, stack);
-      value_range(m, val, att, &lo, &hi);
+      value_range(m, val, att, &lo, &hi, s.log_scale);
       vd_free(att, nval);
       vd_free(stack, sizeof(int) * ((size_t)m->nseg + 1));
     }
     r->range_min = lo;
     r->range_max = hi;
+    r->log_scale = s.log_scale;
   }
   for (size_t t = 0; t < nt; t++) {
     int prim = mesh.tri_prim[t], kind = mesh.tri_kind[t];
@@ -547,7 +561,7 @@ vd_status vd_render_add_plant(vd_renderer* r, const vd_model* m, const vd_data* 
                : kind == VD_PRIM_SPHERE ? vsph[prim]
                                         : vmsh[prim];
     if (isfinite(v))
-      render_colormap(hi > lo ? (v - lo) / (hi - lo) : 0, tri_rgb + 3 * t);
+      render_colormap(scale_pos(v, lo, hi, s.log_scale), tri_rgb + 3 * t);
     else
       memcpy(tri_rgb + 3 * t, no_value_rgb, sizeof no_value_rgb);
   }

@@ -63,6 +63,7 @@ vd_mss_opt vd_mss_opt_default(void) {
   o.soil = 1;
   o.breaking = 1;
   o.strain_limit = 1e-4;
+  o.rigid_release = 1;
   return o;
 }
 
@@ -185,11 +186,38 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
       ninter++;
       has_roots |= is_root(p, j);
     }
+  // axes that start at one point without a parent segment (roots and trunk from an axiom, where
+  // the turtle starts a node per branch) share that point's node: an alias is marked -2 - target
+  for (int j = 0; j < nps; j++) {
+    if (!structural(p, j) || p->seg_parent[j] >= 0) continue;
+    int n = p->seg_node[2 * j];
+    if (map[n] != 0) continue;
+    vd_vec3 x = rest_at(p, rest, n);
+    for (int k = 0; k < j; k++) {
+      if (!structural(p, k) || p->seg_parent[k] >= 0) continue;
+      int b = p->seg_node[2 * k];
+      if (b == n || map[b] != 0) continue;
+      vd_vec3 y = rest_at(p, rest, b);
+      if (fabs(x.x - y.x) <= 1e-9 && fabs(x.y - y.y) <= 1e-9 && fabs(x.z - y.z) <= 1e-9) {
+        map[n] = -2 - b;
+        break;
+      }
+    }
+  }
   int nn = 0;
   for (int i = 0; i < npn; i++)
     if (map[i] == 0) map[i] = nn++;
+  // aliases take their point's node; the node's plant node is the one that was numbered
+  unsigned char* alias = vd_calloc((size_t)(npn ? npn : 1), 1);
+  if (!alias) {
+    vd_free(map, sizeof(int) * (size_t)(npn ? npn : 1));
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  for (int i = 0; i < npn; i++)
+    if (map[i] <= -2) map[i] = map[-2 - map[i]], alias[i] = 1;
   if (nn > def->max_nodes) {
     vd_free(map, sizeof(int) * (size_t)(npn ? npn : 1));
+    vd_free(alias, (size_t)(npn ? npn : 1));
     return vd_error_set(err, VD_ERR_LIMIT, "", 0, 0, "the mass-spring model would have %d nodes, more than %d", nn,
                         def->max_nodes);
   }
@@ -242,6 +270,7 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
   int nspring = ninter + nalt;
   layout L = {0};
   size_t o_model = lay(&L, sizeof(vd_mss_model));
+  size_t o_pmap = lay(&L, sizeof(int) * (size_t)(npn ? npn : 1));
   size_t o_nplant = lay(&L, sizeof(int) * (size_t)nn), o_nparent = lay(&L, sizeof(int) * (size_t)nn),
          o_nowner = lay(&L, sizeof(int) * (size_t)nn), o_nflags = lay(&L, sizeof(unsigned) * (size_t)nn),
          o_nrest = lay(&L, sizeof(vd_vec3) * (size_t)nn), o_nmass = lay(&L, sizeof(double) * (size_t)nn),
@@ -262,6 +291,9 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
   vd_mss_model* m = (vd_mss_model*)(blk + o_model);
   m->nbytes = L.n;
   m->nnode = nn, m->ninter = ninter, m->nspring = nspring, m->nhinge = nhinge;
+  m->nplant = npn;
+  m->plant_node = (int*)(blk + o_pmap);
+  memcpy(m->plant_node, map, sizeof(int) * (size_t)npn);
   m->opt = vd_mss_opt_default();
   m->springs = def->springs;
   m->rigid_age = def->rigid_age;
@@ -280,7 +312,7 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
   m->hinge_p0 = (vd_vec3*)(blk + o_hp), m->hinge_q0 = (vd_vec3*)(blk + o_hq);
   // nodes
   for (int i = 0; i < npn; i++)
-    if (map[i] >= 0) {
+    if (map[i] >= 0 && !alias[i]) {
       int k = map[i];
       m->node_plant[k] = i;
       m->node_rest[k] = rest_at(p, rest, i);
@@ -358,10 +390,12 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
       if (!nchild[i]) m->node_flags[i] |= VD_MSS_TIP;
       double z = m->node_rest[i].z, depth = soil->ground - z;
       int base = owner[i] < 0;
-      int in_soil = has_roots && (((m->node_flags[i] & VD_MSS_ROOT) && depth > 0) ||
-                                  (base && z <= soil->ground + def->fix_height));
-      // clamped: in a clamping soil, or a stem base at the ground of a plant without roots
-      int clamp = (in_soil && soil->method == VD_SOIL_CLAMP) || (!has_roots && base && z <= soil->ground + def->fix_height);
+      // in the soil: root nodes below the ground (a base at the ground holds through its roots)
+      int in_soil = has_roots && (m->node_flags[i] & VD_MSS_ROOT) && depth > 0;
+      // clamped: in a clamping soil (with the stem's base there, a pot), or a stem base at the
+      // ground of a plant without roots
+      int at_ground = base && z <= soil->ground + def->fix_height;
+      int clamp = (in_soil && soil->method == VD_SOIL_CLAMP) || (at_ground && (!has_roots || soil->method == VD_SOIL_CLAMP));
       if (clamp) {
         m->node_flags[i] |= VD_MSS_FIXED;
         nfixed++;
@@ -514,6 +548,7 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
   *out = m;
 done:
   vd_free(map, sizeof(int) * (size_t)(npn ? npn : 1));
+  vd_free(alias, (size_t)(npn ? npn : 1));
   vd_free(seg_of, sizeof(int) * (size_t)(ninter ? ninter : 1));
   vd_free(owner, sizeof(int) * (size_t)(nn ? nn : 1));
   vd_free(nchild, sizeof(int) * (size_t)(nn ? nn : 1));
@@ -1153,6 +1188,14 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
         if (d->rigid[i] && (m->node_flags[i] & VD_MSS_SOIL)) d->yielded[i] = 1;
     }
   }
+  // a body nothing holds, stepped explicitly against stiff springs, is unstable (h^2 k / M of
+  // hundreds): released, its nodes go on with the springs at the velocities they have
+  if (!held && m->opt.rigid_release) {
+    for (int i = 0; i < m->nnode; i++) d->rigid[i] = 0;
+    memset(b, 0, sizeof *b);
+    b->q = vd_quat_identity();
+    return 0;
+  }
   if (!held) vd_rigid_step(b, f, tau, m->opt.dt);
   mss_rigid_sync(m, d);
   // reactions for the stress: the soil takes the wrench's force in proportion to capacity
@@ -1264,12 +1307,17 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     d->acc[i] = d->rigid[i] && rb_held ? vd_v3(0, 0, 0) : vd_scale(vd_sub(d->vel[i], w->vel0[i]), 1.0 / h);
   d->time += h;
   d->nstep++;
-  // uprooting: the base tilted beyond the limit after roots gave way
-  if (!d->uprooted && m->base >= 0) {
-    int gave = 0;
-    for (int i = 0; i < nn && !gave; i++) gave = d->yielded[i];
-    double tilt = gave ? tilt_of(m, d) : 0;
-    if (gave && tilt > d->uproot_tilt) {
+  // uprooting: soil nodes holding more than half the root system's resistance gave way, and the
+  // stem's base tilted beyond the limit
+  if (!d->uprooted && m->base >= 0 && m->opt.soil) {
+    double total = 0, gave = 0;
+    for (int i = 0; i < nn; i++)
+      if ((m->node_flags[i] & VD_MSS_SOIL) && !d->removed[i]) {
+        total += m->node_soil[i];
+        if (d->yielded[i]) gave += m->node_soil[i];
+      }
+    double tilt = total > 0 && gave > 0.5 * total ? tilt_of(m, d) : 0;
+    if (tilt > d->uproot_tilt) {
       d->uprooted = 1;
       vd_mss_event e = {VD_MSS_UPROOT, d->time, m->base, -1, tilt, d->uproot_tilt, 0};
       mss_event(d, &e);

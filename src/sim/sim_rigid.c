@@ -214,6 +214,35 @@ void vd_mss_rigid_join(const vd_mss_model* m, vd_mss_data* d, const unsigned cha
   rebody(m, d, c, mass);
 }
 
+void vd_mss_rigid_refit(const vd_mss_model* m, vd_mss_data* d, vd_vec3 omega) {
+  vd_rigid* b = &d->rb;
+  double mass = 0;
+  vd_vec3 mx = vd_v3(0, 0, 0), p = vd_v3(0, 0, 0);
+  int n = 0;
+  for (int i = 0; i < m->nnode; i++) {
+    if (!d->rigid[i] || d->removed[i]) continue;
+    mass += d->mass[i];
+    mx = vd_madd(mx, d->pos[i], d->mass[i]);
+    p = vd_madd(p, d->vel[i], d->mass[i]);
+    n++;
+  }
+  if (!n || mass <= 0) {
+    memset(b, 0, sizeof *b);
+    b->q = vd_quat_identity();
+    return;
+  }
+  vd_vec3 c = vd_scale(mx, 1.0 / mass), l = vd_v3(0, 0, 0);
+  for (int i = 0; i < m->nnode; i++) {
+    if (!d->rigid[i] || d->removed[i]) continue;
+    double rad = m->node_radius[i];
+    l = vd_add(l, vd_cross(vd_sub(d->pos[i], c), vd_scale(d->vel[i], d->mass[i])));
+    l = vd_madd(l, omega, 0.4 * d->mass[i] * rad * rad);  // the members' own spheres spin too
+  }
+  b->p = p;
+  b->L = l;
+  rebody(m, d, c, mass);
+}
+
 void vd_mss_rigid_update(const vd_mss_model* m, vd_mss_data* d) {
   vd_rigid* b = &d->rb;
   if (b->n <= 0) return;
