@@ -38,6 +38,14 @@ static vd_status derive_text(const char* src, int steps, char* buf, size_t cap, 
     CHECK_STR(b_, expected);                                                                       \
   } while (0)
 
+#define PY_DERIVES(src, steps, expected)                                                           \
+  do {                                                                                             \
+    char b_[4096];                                                                                 \
+    vd_error e_ = {0};                                                                             \
+    CHECK_STATUS(derive_engine(src, VD_LSYS_PYTHON, steps, b_, sizeof b_, &e_), VD_OK, e_);        \
+    CHECK_STR(b_, expected);                                                                       \
+  } while (0)
+
 // the status of parsing and deriving src; the message is left in *e
 static vd_status run_status(const char* src, vd_error* e) {
   char b[256];
@@ -214,6 +222,8 @@ TEST(lpy, discard_new_string) {
       "Axiom: A\nderivation length: 3\nproduction:\nA :\n  if getIterationNb() == 1: DiscardNewString()\n"
       "  produce A B\n";
   DERIVES(src, -1, "ABB");
+  // the same in the Python engine, whose __lpyfuture__ provides the EndEach that discards
+  PY_DERIVES(src, -1, "ABB");
 }
 
 TEST(lpy, query_modules_filled_before_each_step) {
@@ -274,13 +284,6 @@ TEST(lpy, absent_or_empty_axiom_and_spacing) {
   DERIVES("Axiom: A(u'\xc3\xa9') \xc3\xa9\nproduction:\n\xc3\xa9 --> B\n", 1, "A('\xc3\xa9')B");
 }
 
-#define PY_DERIVES(src, steps, expected)                                                           \
-  do {                                                                                             \
-    char b_[4096];                                                                                 \
-    vd_error e_ = {0};                                                                             \
-    CHECK_STATUS(derive_engine(src, VD_LSYS_PYTHON, steps, b_, sizeof b_, &e_), VD_OK, e_);        \
-    CHECK_STR(b_, expected);                                                                       \
-  } while (0)
 
 TEST(lpy, argument_lists_in_patterns_python_engine) {
   // *args, **kwds (the names of `module A(x, t)`, the last parameters) and x(...) variables
@@ -357,4 +360,34 @@ TEST(lpy, turtle_warnings_name_the_file_line) {
   CHECK(strstr(logged, "t.lpy:4: turtle: module 3 '_': negative width") != NULL);
   CHECK(strstr(logged, "t.lpy:4: turtle: module 4 'F': negative radius") != NULL);
   CHECK(strstr(logged, "t.lpy:4: turtle: module 1 '[': 1 '[' not closed") != NULL);
+}
+
+// grow src with an engine; the end of the last segment in *end
+static vd_status grow_end(const char* src, vd_lsys_engine engine, vd_vec3* end, vd_error* e) {
+  vd_lsystem* ls;
+  memset(e, 0, sizeof *e);
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "t.lpy", engine, &ls, e);
+  if (st) return st;
+  vd_plant_spec* P = vd_plant_spec_create();
+  st = vd_lsys_grow(ls, NULL, NULL, P, e);
+  if (!st && P->nseg) *end = P->node[P->seg[P->nseg - 1].node1];
+  vd_plant_spec_destroy(P);
+  vd_lsys_destroy(ls);
+  return st;
+}
+
+TEST(lpy, turtle_angle_increment_of_the_file) {
+  // context.turtle.setAngleIncrement(90) makes + turn 90 degrees (it was ignored: 60)
+  vd_vec3 b = {0, 0, 0};
+  vd_error e;
+  CHECK_STATUS(grow_end("Axiom: F(1) + F(1)\n###### INITIALISATION ######\ndef __initialiseContext__(context):\n"
+                        "\tcontext.turtle.setAngleIncrement(90)\n",
+                        VD_LSYS_NATIVE, &b, &e),
+               VD_OK, e);
+  CHECK_NEAR(b.y, -1, 1e-9);
+  CHECK_NEAR(b.z, 1, 1e-9);
+  CHECK_STATUS(grow_end("context().turtle.setAngleIncrement(90)\nAxiom: F(1) + F(1)\n", VD_LSYS_PYTHON, &b, &e), VD_OK,
+               e);
+  CHECK_NEAR(b.y, -1, 1e-9);
+  CHECK_NEAR(b.z, 1, 1e-9);
 }

@@ -646,6 +646,11 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
 
 const char* lsys_file(const vd_lsystem* ls) { return ls->file; }
 
+int lsys_turtle_angle(const vd_lsystem* ls, double* angle) {
+  if (ls->has_turtle_angle) *angle = ls->turtle_angle;
+  return ls->has_turtle_angle;
+}
+
 int lsys_trace_lines(vd_lsystem* ls, const vd_lstring* s, const int64_t* idx, int n, int* lines) {
   for (int k = 0; k < n; k++) lines[k] = 0;
   if (!ls->has_last_def || ls->track_lines) return 0;

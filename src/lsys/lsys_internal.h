@@ -288,6 +288,8 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int opt_module_matching;      // 0 simple, 1 with *args, 2 with value constraints (default)
   int opt_axiom_decomposition;  // 1: the axiom is decomposed before the first step
   int has_bases;                // a module declaration names base modules (inheritance)
+  double turtle_angle;          // context.turtle.setAngleIncrement(a): the turtle's default angle (degrees)
+  int has_turtle_angle;         // the file set it
   // parameter names declared with `module A(x, t)` (**kwds patterns): symbol, names (string ids)
   int npdecl, cappdecl;
   struct pdecl {
@@ -456,6 +458,11 @@ vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
 // not): the derivation runs again keeping lines; 1 when s is that string (lines[k] is 0 where
 // unknown), 0 otherwise.
 int lsys_trace_lines(vd_lsystem* ls, const vd_lstring* s, const int64_t* idx, int n, int* lines);
+// Apply an L-Py option by name (Early return when no matching, String matching, Module matching,
+// Module inheritance, Axiom decomposition); refuses what the engines cannot honour.
+vd_status lsys_set_option(vd_lsystem* ls, const char* name, int nlen, long v, int line);
+// The turtle's default angle set by the file (context.turtle.setAngleIncrement); 0 when not set.
+int lsys_turtle_angle(const vd_lsystem* ls, double* angle);
 // The file name of an lsystem ("" when parsed from text without one).
 const char* lsys_file(const vd_lsystem* ls);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.

@@ -2501,9 +2501,32 @@ static int parse_scalar_value(const char* s, int len, value* v) {
   return 1;
 }
 
+// Apply one L-Py option (the trailer's or a run-time context.options.setSelection): the options
+// that change results; those the engines cannot honour are refused (line for the message)
+vd_status lsys_set_option(vd_lsystem* ls, const char* name, int nlen, long v, int line) {
+  if (name_is(name, nlen, "Early return when no matching")) {
+    ls->opt_early_return = v != 0;
+  } else if (name_is(name, nlen, "Axiom decomposition")) {
+    ls->opt_axiom_decomposition = v != 0;
+  } else if (name_is(name, nlen, "Module matching")) {
+    ls->opt_module_matching = (int)v;
+  } else if (name_is(name, nlen, "String matching")) {
+    if (v == 2 || v == 3)
+      return perr(ls, VD_ERR_UNSUPPORTED, line, 1,
+                  "unsupported: option 'String matching' = %s (multi-level and multiscale matching)",
+                  v == 2 ? "As Multi-level AxialTree" : "As Multiscale AxialTree");
+    ls->opt_string_matching = v != 0;
+  } else if (name_is(name, nlen, "Module inheritance")) {
+    if (v != 0 && ls->has_bases)
+      return perr(ls, VD_ERR_UNSUPPORTED, line, 1, "unsupported: option 'Module inheritance' (modules with bases)");
+  }
+  return VD_OK;
+}
+
 // context.options.setSelection('NAME', VALUE) lines of the trailer: the L-Py options that change
 // results are applied; those the native engine cannot honour are refused
 static vd_status parse_options(vd_lsystem* ls, const char* s, size_t len, int line0) {
+  vd_status st;
   static const char key[] = "options.setSelection(";
   size_t kl = strlen(key);
   for (size_t i = 0; i + kl <= len; i++) {
@@ -2529,21 +2552,25 @@ static vd_status parse_options(vd_lsystem* ls, const char* s, size_t len, int li
     long v = strtol(buf, &end, 10);
     while (*end && isspace((unsigned char)*end)) end++;
     if (end == buf || *end) continue;  // a value computed at run time: not an option we read
-    if (name_is(name, nlen, "Early return when no matching")) {
-      ls->opt_early_return = v != 0;
-    } else if (name_is(name, nlen, "Axiom decomposition")) {
-      ls->opt_axiom_decomposition = v != 0;
-    } else if (name_is(name, nlen, "Module matching")) {
-      ls->opt_module_matching = (int)v;
-    } else if (name_is(name, nlen, "String matching")) {
-      if (v == 2 || v == 3)
-        return perr(ls, VD_ERR_UNSUPPORTED, line, 1,
-                    "unsupported: option 'String matching' = %s (multi-level and multiscale matching)",
-                    v == 2 ? "As Multi-level AxialTree" : "As Multiscale AxialTree");
-      ls->opt_string_matching = v != 0;
-    } else if (name_is(name, nlen, "Module inheritance")) {
-      if (v != 0 && ls->has_bases)
-        return perr(ls, VD_ERR_UNSUPPORTED, line, 1, "unsupported: option 'Module inheritance' (modules with bases)");
+    if ((st = lsys_set_option(ls, name, nlen, v, line))) return st;
+  }
+  // context.turtle.setAngleIncrement(a): the turtle's default angle for this file
+  {
+    static const char tkey[] = "turtle.setAngleIncrement(";
+    size_t tl = strlen(tkey);
+    for (size_t i = 0; i + tl <= len; i++) {
+      if (memcmp(s + i, tkey, tl) != 0) continue;
+      char buf[32];
+      size_t bl = 0, p = i + tl;
+      while (p < len && bl < sizeof buf - 1 && s[p] != ')' && s[p] != '\n') buf[bl++] = s[p++];
+      buf[bl] = 0;
+      char* end;
+      double a = strtod(buf, &end);
+      while (*end && isspace((unsigned char)*end)) end++;
+      if (end != buf && !*end && isfinite(a)) {
+        ls->turtle_angle = a;
+        ls->has_turtle_angle = 1;
+      }
     }
   }
   return VD_OK;

@@ -923,6 +923,29 @@ static PyObject* vd_frame_displayed(PyObject* self, PyObject* noarg) {
   return ls ? PyBool_FromLong(ls->frame_displayed) : NULL;
 }
 
+// context().options.setSelection(name, value) at run time: the options that change results
+static PyObject* vd_set_option(PyObject* self, PyObject* args) {
+  (void)self;
+  vd_lsystem* ls = current();
+  const char* name;
+  long v;
+  if (!ls || !PyArg_ParseTuple(args, "sl", &name, &v)) return NULL;
+  if (lsys_set_option(ls, name, (int)strlen(name), v, 0)) return vd_abort();
+  return py_none();
+}
+
+// context().turtle.setAngleIncrement(a): the turtle's default angle for this file
+static PyObject* vd_set_turtle_angle(PyObject* self, PyObject* arg) {
+  (void)self;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  double a = PyFloat_AsDouble(arg);
+  if (a == -1.0 && PyErr_Occurred()) return NULL;
+  ls->turtle_angle = a;
+  ls->has_turtle_angle = 1;
+  return py_none();
+}
+
 // the 'Module matching' option (PatternModule.matchingMethod)
 static PyObject* vd_module_matching(PyObject* self, PyObject* noarg) {
   (void)self, (void)noarg;
@@ -955,6 +978,8 @@ static PyMethodDef vd_methods[] = {
     {"is_backward", vd_is_backward, METH_NOARGS, "not isForward()"},
     {"frame_displayed", vd_frame_displayed, METH_NOARGS, "isFrameDisplayed"},
     {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
+    {"set_option", vd_set_option, METH_VARARGS, "context().options.setSelection"},
+    {"set_turtle_angle", vd_set_turtle_angle, METH_O, "context().turtle.setAngleIncrement"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef vd_module_def = {PyModuleDef_HEAD_INIT, "_verdant_lsys", "verdant's L-system engine", -1,
@@ -1607,12 +1632,11 @@ vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, i
     int* ti = ok ? vd_malloc(sizeof(int) * (size_t)b) : NULL;
     double nvert = (double)(a - a % 3) / 3.0;  // vertices (a is a multiple of 3 here)
     int bad = 0;
-    if (ti)
-      for (int i = 0; i < b && !bad; i++) {
-        bad = !(t[i] >= 0 && t[i] < nvert);
-        if (!bad) ti[i] = (int)t[i];
-      }
-    if (bad) {
+    for (int i = 0; ti && i < b && !bad; i++) {
+      bad = !(t[i] >= 0 && t[i] < nvert);
+      if (!bad) ti[i] = (int)t[i];
+    }
+    if (ti && bad) {
       vd_free(ti, sizeof(int) * (size_t)b);
       ti = NULL;
     }

@@ -590,6 +590,7 @@ def _future_module():
     def EndEach():
         pass
 
+    # by name: EndEach is the decorator's wrapper, whose own __name__ is "wrapped"
     for name, f in (("DiscardNewString", DiscardNewString), ("enable_string_discard", enable_string_discard),
                     ("pushString", pushString), ("popString", popString),
                     ("enable_string_pushpop", enable_string_pushpop), ("EndEach", EndEach)):
@@ -609,6 +610,8 @@ class _Options:
 
     def setSelection(self, name, value):
         self.values[name] = value
+        if isinstance(value, int):
+            _vd.set_option(name, value)  # the options that change results act at once
 
     def selection(self, name):
         return self.values.get(name)
@@ -638,6 +641,11 @@ class _TurtleSettings:
 
     def clearColorList(self):
         self.materials.clear()
+
+    def setAngleIncrement(self, a):
+        """The default angle of + - & ^ / \\ for this file (degrees)."""
+        self.settings["setAngleIncrement"] = (a,)
+        _vd.set_turtle_angle(float(a))
 
     def __getattr__(self, name):
         if name.startswith("__"):

@@ -1817,7 +1817,10 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
   memset(&T, 0, sizeof T);
   T.query = query;
   T.def = def ? *def : vd_turtle_def_default();
-  // the file's own turtle settings (context().turtle.setAngleIncrement(90) ...) are its defaults
+  // the file's own default angle (context.turtle.setAngleIncrement, as L-Py's turtle takes it)
+  double fa;
+  if (ls && lsys_turtle_angle(ls, &fa)) T.def.angle = fa;
+  // the Python engine's other settings of the file (setWidthIncrement, setScaleMultiplier, ...)
   if (ls && ls->py) lsys_py_turtle_def(ls, &T.def);
   vd_status st = check_def(&T.def, err);
   if (st) return st;
