@@ -551,6 +551,8 @@ vd_status lsys_obj_guide(const vd_lsystem* ls, double v, int m, double* length, 
 // A function of x: its range and its n samples at equal steps (QuantisedFunction).
 vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* lx, double** val, int* n, char* why,
                             size_t cap);
+// A 3D vector (Vector3, a sequence of three numbers) as c[0..2].
+vd_status lsys_obj_vec3(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap);
 // A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
 vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
                         char* why, size_t cap);

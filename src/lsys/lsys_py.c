@@ -1529,6 +1529,26 @@ static double* doubles(PyObject* seq, int* n) {
 
 static void free_doubles(double* a, int n) { vd_free(a, sizeof(double) * (size_t)(n ? n : 1)); }
 
+vd_status lsys_obj_vec3(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* r = obj_query(mls, v, "_vd_vec3", NULL, why, cap);
+  int k = 0;
+  double* p = r ? doubles(r, &k) : NULL;
+  if (p && k == 3 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
+    memcpy(c, p, sizeof(double) * 3);
+    st = VD_OK;
+  } else if (r) {
+    snprintf(why, cap, "a vector that is not three finite numbers");
+  }
+  if (p) free_doubles(p, k);
+  Py_XDECREF(r);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+  return st;
+}
+
 vd_status lsys_obj_points(const vd_lsystem* ls, double v, double** p, int* n, int* dim, char* why, size_t cap) {
   vd_lsystem* mls = (vd_lsystem*)ls;
   *p = NULL;
