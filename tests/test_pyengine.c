@@ -659,3 +659,16 @@ TEST(pyengine, nurbs_volume_maps_the_cube) {
       "Axiom: R(round(p.x, 12), round(p.y, 12), round(p.z, 12), q.z)\n";
   CHECK_PY(src, 0, "R(0.5,0.5,2.4,0.75)");
 }
+
+TEST(pyengine, point_set_directions) {
+  if (!python_here()) return;
+  // pointset_mean_direction: the normed mean of the unit directions (not of the offsets: a far
+  // point counts as much as a near one); findClosestFromSubset among a group or all points
+  const char* src =
+      "P = [Vector3(10, 0, 0), Vector3(0, 1, 0), Vector3(0, 0, 5), Vector3(1, 1, 0)]\n"
+      "d = pointset_mean_direction(Vector3(0, 0, 0), P, [0, 1])\n"
+      "a = pointset_mean_direction((0, 0, 0), P)\n"
+      "c = findClosestFromSubset(Vector3(0.9, 0.9, 0), P, [0, 2])\n"
+      "Axiom: R(round(d.x, 12), round(d.y, 12), round(norm(a), 12), c[0], findClosestFromSubset((1, 1, 0.1), P)[0])\n";
+  CHECK_PY(src, 0, "R(0.707106781187,0.707106781187,1,2,3)");
+}

@@ -2478,6 +2478,48 @@ class Point2Grid(_PointGrid):
     _vec = Vector2
 
 
+def _group_points(points, group):
+    pts = [_vec(points[i]) for i in group] if group else [_vec(p) for p in points]
+    return pts
+
+
+def pointset_directions(origin, points, group=()):
+    """The unit directions from origin to the points (those of group when given)."""
+    o = _vec(origin)
+    return Point3Array([direction(p - o) for p in _group_points(points, group)])
+
+
+def pointset_mean_direction(origin, points, group=()):
+    """PlantGL's pointset_mean_direction: the normed mean of the unit directions from origin to
+    the points (those of group when given)."""
+    d = pointset_directions(origin, points, group)
+    if not d:
+        return Vector3(0, 0, 0)
+    s = Vector3(0, 0, 0)
+    for v in d:
+        s += v
+    return (s / len(d)).normed()
+
+
+def findClosestFromSubset(origin, points, group=()):
+    """(index, distance) of the point nearest origin (among group when given; the first of equals)."""
+    o = _vec(origin)
+    ids = list(group) if group else range(len(points))
+    best = None
+    for i in ids:
+        dist = norm(_vec(points[i]) - o)
+        if best is None or dist < best[1]:
+            best = (i, dist)
+    return best
+
+
+class PointSet(_Geometry):
+    """Points (PlantGL's PointSet): no surface, so @g of it draws nothing (with a warning)."""
+
+    def __init__(self, pointList=(), colorList=None, width=1, **kw):
+        self.pointList, self.colorList, self.width = Point3Array(pointList), colorList, width
+
+
 class Discretizer:
     """PlantGL's Discretizer action: geometry.apply(d) puts the geometry's discrete form in
     d.result: a Polyline2D/Polyline of a curve's stride + 1 points, a TriangleSet of a surface
@@ -2647,6 +2689,7 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "Polyline2D", "Polyline", "Curve2D", "QuantisedFunction", "Sphere", "Cylinder", "Cone", "Frustum",
                "Disc", "Box", "Mesh", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
                "BezierPatch", "Paraboloid", "NurbsPatch3D", "Point2Grid", "Point3Grid", "Discretizer",
+               "PointSet", "pointset_directions", "pointset_mean_direction", "findClosestFromSubset",
                "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
