@@ -672,3 +672,17 @@ TEST(pyengine, point_set_directions) {
       "Axiom: R(round(d.x, 12), round(d.y, 12), round(norm(a), 12), c[0], findClosestFromSubset((1, 1, 0.1), P)[0])\n";
   CHECK_PY(src, 0, "R(0.707106781187,0.707106781187,1,2,3)");
 }
+
+TEST(pyengine, plantgl_names_the_shim_lacks_are_refused) {
+  if (!python_here()) return;
+  char b[256];
+  vd_error e = {0};
+  // hasattr sees an AttributeError; using the name refuses the file, naming it
+  CHECK_PY("import openalea.plantgl.all as pgl\nAxiom: R(hasattr(pgl, 'Grid3Indexing'), hasattr(pgl, 'Box'))\n", 0,
+           "R(0,1)");
+  CHECK_STATUS(derive_with("import openalea.plantgl.all as pgl\ng = pgl.Grid3Indexing((1, 1, 1))\nAxiom: A\n",
+                           VD_LSYS_PYTHON, 0, 0, b, sizeof b, &e),
+               VD_ERR_UNSUPPORTED, e);
+  CHECK(strstr(e.msg, "openalea.plantgl.all.Grid3Indexing") != NULL);
+  CHECK_INT(e.line, 2);
+}

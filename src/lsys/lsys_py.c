@@ -287,6 +287,9 @@ void lsys_py_leave(vd_lsystem* ls) {
 static vd_status status_of(PyObject* type) {
   if (PyErr_GivenExceptionMatches(type, PyExc_SyntaxError)) return VD_ERR_SYNTAX;
   if (PyErr_GivenExceptionMatches(type, PyExc_NameError)) return VD_ERR_NAME;
+  // a PlantGL / L-Py name the shim does not have (lsys_shim.py _NotInShim): a refusal
+  PyObject* nis = g_shim ? PyDict_GetItemString(g_shim, "_NotInShim") : NULL;  // borrowed
+  if (nis && PyErr_GivenExceptionMatches(type, nis)) return VD_ERR_UNSUPPORTED;
   if (PyErr_GivenExceptionMatches(type, PyExc_AttributeError)) return VD_ERR_NAME;
   if (PyErr_GivenExceptionMatches(type, PyExc_TypeError)) return VD_ERR_TYPE;
   if (PyErr_GivenExceptionMatches(type, PyExc_AssertionError)) return VD_ERR_ASSERT;

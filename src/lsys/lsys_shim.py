@@ -2718,8 +2718,27 @@ OPENALEA = {"openalea": _openalea, "openalea.plantgl": _pgl, "openalea.plantgl.a
             "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy,
             "openalea.plantgl.light": _pgl_light_pkg, "openalea.plantgl.light.light": _pgl_light,
             "openalea.lpy.parameterset": _lpy_ps, "openalea.plantgl.scenegraph.nurbspatch_nd": _pgl_nd}
+
+
+class NotInVerdant(AttributeError):
+    """A PlantGL or L-Py name the shim does not have: the engine refuses the file (unsupported),
+    naming it; hasattr() and getattr(m, name, default) still see an AttributeError."""
+
+
+def _missing_attr(modname):
+    def __getattr__(name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        raise NotInVerdant("%s.%s (verdant's PlantGL / L-Py does not have it)" % (modname, name))
+    return __getattr__
+
+
+_NotInShim = NotInVerdant
+
+
 for _m in OPENALEA.values():
     _m.__vd_shim__ = True
+    _m.__getattr__ = _missing_attr(_m.__name__)
 
 _BUILTINS = dict(_builtins.__dict__)
 _BUILTINS["__import__"] = _vd_import
