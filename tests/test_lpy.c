@@ -210,9 +210,27 @@ TEST(lpy, refusals_name_the_construct) {
   REFUSED("Axiom: A\nproduction:\nA > ?I(it) --> B\n", "'?I' pattern module");
   REFUSED("Axiom: A\nproduction:\nA(*p) --> B\n", "'*args' pattern parameter");
   REFUSED("Axiom: A\nproduction:\nA(**p) --> B\n", "'**kwds' pattern parameter");
-  REFUSED("Axiom: A\nproduction:\n*(n in 'AB') --> B\n", "condition on the pattern parameter 'n'");
+  REFUSED("Axiom: A\nproduction:\n*(n in 'AB') --> B\n", "'in' operator");  // native: the Python engine takes it
   REFUSED("Axiom: A\nproduction:\nx(A) --> B\n", "x(...) or or(...) in a strict predecessor");
   REFUSED("@decorate\ndef f(): pass\nAxiom: A\n", "decorator");
+}
+
+TEST(lpy, conditions_on_pattern_parameters) {
+  // L-Py's value constraints: a parameter written `x > 1` matches when the condition holds on it
+  const char* src = "Axiom: A(1) B(2) A(3) B(4)\nproduction:\nA(x) < B(y > 2) --> Y(x, y)\n"
+                    "A(x == 1) > B(y) --> X(y)\n";
+  DERIVES(src, 1, "X(2)B(2)A(3)Y(3,4)");
+  PY_DERIVES(src, 1, "X(2)B(2)A(3)Y(3,4)");
+  // on the name of `*(...)` and any parameter; `in` is Python (the Python engine)
+  PY_DERIVES("Axiom: A(1) B(2) S(3) U(4)\nproduction:\n*(n in 'SU', x) --> X(x)\nB(x > 1) --> Y(x)\n", 1,
+             "A(1)Y(2)X(3)X(4)");
+  // in a repetition (its variables bind lists: the Python engine): only the modules that pass count
+  PY_DERIVES("Axiom: I(1) I(2) I(0) A\nproduction:\nx(I(l > 0), 2) < A --> B\n", 1, "I(1)I(2)I(0)A");
+  PY_DERIVES("Axiom: I(0) I(1) I(2) A\nproduction:\nx(I(l > 0), 2) < A --> B\n", 1, "I(0)I(1)I(2)B");
+  // a condition that fails to evaluate is an error with its line, not a silent mismatch
+  vd_error e;
+  CHECK_STATUS(run_status("Axiom: A(1)\nproduction:\nA(x > zz) --> B\n", &e), VD_ERR_NAME, e);
+  CHECK(e.line == 3);
 }
 
 TEST(lpy, discard_new_string) {

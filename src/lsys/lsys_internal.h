@@ -146,6 +146,13 @@ typedef struct pmod {
   int line, col;
 } pmod;
 
+// A condition on a pattern parameter (`*(n in 'AB', x > 0)`, L-Py's value constraints): a native
+// expression over the rule's frame, or (Python engine) the index of a one-argument function.
+typedef struct pcond {
+  expr* e;   // native: the condition, its variable bound in the frame (NULL: no condition)
+  int pyfn;  // Python engine: chunk index of `lambda name: condition`, -1 none
+} pcond;
+
 // What a few pattern elements need beyond a module.
 typedef struct pext {
   int args_slot;   // PK_MOD / PK_ANY: slot of a trailing `*args` (a list), -1 none
@@ -156,6 +163,8 @@ typedef struct pext {
   struct pstr* sub;  // PK_REP: the repeated pattern (sub[0]); PK_OR: the alternatives
   int nsub;
   int rmin, rmax;  // PK_REP: repetitions allowed
+  pcond* cond;     // conditions per parameter (nparam), NULL when none has one
+  pcond name_cond; // PK_ANY: condition on the name (meaningful only when cond is set)
 } pext;
 
 // A pattern: a string of pattern elements.
@@ -484,6 +493,8 @@ int builtin_find(const char* name, int len);
 int builtin_in_ns(int ns, const char* name, int len);
 value ns_constant(int ns, const char* name, int len, int* found);
 int value_truthy(value v);
+// does the pattern condition c hold on v (bound in frame)? 1 or 0; -1 on an error (ls->err set)
+int lsys_cond_holds(vd_lsystem* ls, const pcond* c, value v, value* frame);
 vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col);
 value param_to_value(double d);
 
@@ -513,6 +524,9 @@ vd_status lsys_py_rule(vd_lsystem* ls, rule* r, const char* const* names, const 
 vd_status lsys_py_axiom(vd_lsystem* ls, const tmpl* t, const lsys_line* lines, int nline, int* li);
 // `derivation length:` text
 vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno);
+// a condition on the pattern parameter name (`name in 'AB'`): the chunk index of a function of
+// name that returns its truth, or -1 with the error set
+int lsys_py_cond(vd_lsystem* ls, const char* name, int nlen, const char* s, int len, int lineno);
 
 // run time
 void lsys_py_free(vd_lsystem* ls);
@@ -524,6 +538,8 @@ vd_status lsys_py_run_toplevel(vd_lsystem* ls, uint64_t seed);
 vd_status lsys_py_dlength_eval(vd_lsystem* ls, int* steps);
 vd_status lsys_py_emit_axiom(vd_lsystem* ls, vm_out* out);
 vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, vm_out* out);
+// call the condition function fn (lsys_py_cond) on v: *holds its truth
+vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds);
 // call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
 // the current string (an End hook may return a new one). Missing hooks are fine.
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);

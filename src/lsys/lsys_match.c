@@ -239,6 +239,19 @@ static int bind_lists(const mstate* S, const pmod* p, int32_t sym, int name, con
   return 1;
 }
 
+// the conditions of a pattern module on what it bound (L-Py's value constraints); an error
+// (set in ls->err) is no match
+static int conds_hold(const mstate* S, const pmod* p) {
+  const pext* x = p->x;
+  if (!x || !x->cond) return 1;  // no condition (name_cond is set only with cond)
+  if (p->kind == PK_ANY && x->has_name && x->name_slot >= 0 &&
+      lsys_cond_holds(S->ls, &x->name_cond, S->frame[x->name_slot], S->frame) != 1)
+    return 0;
+  for (int k = 0; x->cond && k < p->nparam; k++)
+    if (p->slot[k] >= 0 && lsys_cond_holds(S->ls, &x->cond[k], S->frame[p->slot[k]], S->frame) != 1) return 0;
+  return 1;
+}
+
 static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k) {
   int64_t j = at(v, k);
   const vd_lstring* s = v->s;
@@ -247,7 +260,8 @@ static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k
   int lists = p->x && (p->x->args_slot >= 0 || p->x->kwds_slot >= 0);
   if (p->kind == PK_MOD) {
     if (s->sym[j] != p->sym) return 0;
-    return lists ? bind_lists(S, p, s->sym[j], -1, val, np) : bind_params(p, val, np, S->frame);
+    if (!(lists ? bind_lists(S, p, s->sym[j], -1, val, np) : bind_params(p, val, np, S->frame))) return 0;
+    return conds_hold(S, p);
   }
   if (p->kind != PK_ANY) return 0;
   if (!p->x) return 1;
@@ -255,10 +269,10 @@ static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k
   const char* name = vd_lsys_symbol_name(S->ls, s->sym[j]);
   int id = str_intern(S->ls, name, (int)strlen(name));
   if (id < 0) return 0;
-  if (lists) return bind_lists(S, p, s->sym[j], id, val, np);
+  if (lists) return bind_lists(S, p, s->sym[j], id, val, np) && conds_hold(S, p);
   if (p->x->name_slot >= 0) S->frame[p->x->name_slot] = (value){V_STR, id};
   else if ((int)p->x->name_val.n != id) return 0;
-  return bind_params(p, val, np, S->frame);
+  return bind_params(p, val, np, S->frame) && conds_hold(S, p);
 }
 
 // set every variable of a pattern to None (the alternatives of or(...) that did not match)

@@ -1143,6 +1143,21 @@ vd_status lsys_py_eval(vd_lsystem* ls, const expr* e, value* out) {
   return VD_OK;
 }
 
+vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds) {
+  lsys_py* py = ls->py;
+  vd_status st = need_ns(ls);
+  if (st) return st;
+  PyObject* a = value_object(ls, v);
+  if (!a) return py_error(ls);
+  PyObject* r = PyObject_CallOneArg(py->fobj[fn], a);
+  Py_DECREF(a);
+  int t = r ? PyObject_IsTrue(r) : -1;
+  Py_XDECREF(r);
+  if (t < 0) return py_error(ls);
+  *holds = t;
+  return VD_OK;
+}
+
 // number of positional parameters a hook declares (0 when unknown)
 static int arity(PyObject* f) {
   PyObject* code = PyObject_GetAttrString(f, "__code__");

@@ -644,6 +644,16 @@ vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno) {
   return VD_OK;
 }
 
+int lsys_py_cond(vd_lsystem* ls, const char* name, int nlen, const char* s, int len, int lineno) {
+  sbuf b = {0};
+  sb_printf(&b, "def __vd_c%d(", ls->py->nfn);
+  sb_put(&b, name, (size_t)nlen);
+  sb_puts(&b, "): return (\n");
+  sb_put(&b, s, (size_t)len);
+  sb_puts(&b, "\n)");
+  return finish_chunk(ls, &b, lineno - 1);
+}
+
 vd_status lsys_py_parse_end(vd_lsystem* ls, size_t init_at) {
   lsys_py* py = ls->py;
   // no Axiom: the string is empty (L-Py: a rule set, or Python code alone); the derivation then

@@ -413,6 +413,12 @@ static inline __attribute__((always_inline)) int apply_try(vd_lsystem* ls, const
       ok = fast_match(M, r, i, e, frame);
     } else {
       ok = lsys_rule_match(M, r, i, frame, &b, &e);
+      if (!ok && ls->err && ls->err->status) {
+        // a pattern condition failed to evaluate
+        *st = ls->err->status;
+        if (frame != small) vd_free(frame, sizeof(value) * (size_t)nl);
+        return -1;
+      }
     }
     int applied = 0;
     if (ok) {
