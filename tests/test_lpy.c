@@ -233,6 +233,18 @@ TEST(lpy, conditions_on_pattern_parameters) {
   CHECK(e.line == 3);
 }
 
+TEST(lpy, in_left_and_right_context) {
+  // InLeftContext / InRightContext in a rule's body read on from where the rule's contexts
+  // ended, bind the pattern's variables into the dict, and move on when they match
+  const char* src = "Axiom: C B B B A(2) D E(5)\nproduction:\nA(x) :\n  n = 0\n  while InLeftContext(B): n += 1\n"
+                    "  p = {}\n  if InRightContext(D E(y), p): produce X(n, p['y'])\n";
+  PY_DERIVES(src, 1, "CBBBX(3,5)DE(5)");
+  // after the rule's own left context; the string form, a failed match leaves the dict alone
+  PY_DERIVES("Axiom: B B B A(2) D\nproduction:\nB < A(x) :\n  n = 0\n  while inLeftContext('B'): n += 1\n"
+             "  p = {}\n  assert not inRightContext('E(y)', p) and p == {}\n  produce X(n)\n",
+             1, "BBBX(2)D");
+}
+
 TEST(lpy, discard_new_string) {
   // DiscardNewString() (L-Py's __lpyfuture__) drops the result of the step it is called in
   const char* src =

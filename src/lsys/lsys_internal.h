@@ -192,6 +192,7 @@ typedef struct rule {
   int section;    // SEC_*
   int group;      // rule group (0 = always active)
   int is_static;  // -static-> / @static: L-Py evaluates the successor once
+  int incontext;  // its body calls InLeftContext / InRightContext (Python engine): general matcher
   int line;
   int pyfn;       // Python engine: index of the rule's function (lsys_py.c), -1 native
 } rule;
@@ -243,6 +244,25 @@ typedef struct lsys_py lsys_py;
 typedef struct toplevel {
   stmt* body;  // top-level statements in file order
 } toplevel;
+
+// Where the rule being applied matched (L-Py's LstringMatcher): InLeftContext / InRightContext
+// in its body read on from there (Python engine).
+typedef struct lsys_cur {
+  const struct lsys_mctx* M;  // NULL outside a rule's body
+  const rule* r;
+  int64_t left;        // where the left context ended (the predecessor's start without one)
+  int64_t right;       // where the right context ended (after the predecessor without one)
+  int64_t rlast;       // last module matched on the right
+} lsys_cur;
+
+// A pattern of InLeftContext / InRightContext, parsed once: its text (string id), the pattern
+// and its variables' names (string ids, in slot order).
+typedef struct lsys_cpat {
+  int sid;
+  pstr p;
+  int nvar;
+  int* var;  // (nvar, arena)
+} lsys_cpat;
 
 struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields grouped by meaning; one per model
   char file[256];
@@ -333,6 +353,9 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int backward;            // derive right to left (backward()); new right contexts apply
   int frame_displayed;     // the step is the last one (L-Py draws a frame then)
   int discard_requested;   // DiscardNewString(): the step's result is dropped
+  lsys_cur cur;            // the rule being applied (Python engine: InLeftContext, InRightContext)
+  lsys_cpat* cpat;         // InLeftContext / InRightContext patterns parsed so far (ncpat)
+  int ncpat, capcpat;
   int call_depth;
   int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
@@ -475,7 +498,16 @@ int lsys_turtle_angle(const vd_lsystem* ls, double* angle);
 // The file name of an lsystem ("" when parsed from text without one).
 const char* lsys_file(const vd_lsystem* ls);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
-int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
+// With cur (nullable), where the contexts ended (InLeftContext / InRightContext go on from there).
+int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end,
+                    lsys_cur* cur);
+// InLeftContext (right = 0) / InRightContext (right = 1) in the body of the rule being applied
+// (ls->cur): match p from where the last context ended, binding its variables into frame; on a
+// match the position moves on. 1 or 0; -1 on an error (ls->err set).
+int lsys_context_match(vd_lsystem* ls, int right, const pstr* p, value* frame);
+// the pattern text s[0..len) of InLeftContext / InRightContext, parsed once per lsystem; NULL
+// with the error set (line: the rule's)
+const lsys_cpat* lsys_context_pattern(vd_lsystem* ls, const char* s, int len, int line);
 
 vd_status vm_exec_block(vd_lsystem* ls, stmt* s, value* frame, vm_out* out, int* returned,
                         value* retval);

@@ -605,7 +605,8 @@ static int pred_backward(const mstate* S, const view* v, int64_t i, const pstr* 
 // ---------------------------------------------------------------------------------------------
 // a rule
 
-int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end) {
+int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end,
+                    lsys_cur* cur) {
   mstate S = {M->ls, frame};
   M->ls->nmlist = M->ls->nmval = 0;  // lists bound by an earlier attempt are no longer referenced
   const unsigned char* ign = M->ignored[r->filter + 1];
@@ -618,8 +619,8 @@ int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, 
     e = i + 1;
     if (!pred_backward(&S, &src, i, &r->pred, &b)) return 0;
   }
-  int64_t tmp;
-  if (r->left.n && !left_match(&S, &src, b, &r->left, r->left.n - 1, &tmp, M->string_mode)) return 0;
+  int64_t tmp, lend = b;
+  if (r->left.n && !left_match(&S, &src, b, &r->left, r->left.n - 1, &lend, M->string_mode)) return 0;
   if (r->nleft.n) {
     // the string written so far, read up the tree from its end
     view dst = {M->dest, M->dest->n, 0, NULL, ign, M->nsym};
@@ -631,11 +632,32 @@ int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, 
     int64_t lm = NONE;
     if (!right_match(&S, &dst, 0, &lm, &r->nright, 0, r->nright.n, &tmp, M->string_mode)) return 0;
   }
-  if (r->right.n) {
-    int64_t lm = e - 1;
-    if (!right_match(&S, &src, e, &lm, &r->right, 0, r->right.n, &tmp, M->string_mode)) return 0;
-  }
+  int64_t rend = e, rlast = e - 1;
+  if (r->right.n && !right_match(&S, &src, e, &rlast, &r->right, 0, r->right.n, &rend, M->string_mode)) return 0;
   *first = b;
   *end = e;
+  if (cur) *cur = (lsys_cur){M, r, lend, rend, rlast};
+  return 1;
+}
+
+int lsys_context_match(vd_lsystem* ls, int right, const pstr* p, value* frame) {
+  lsys_cur* c = &ls->cur;
+  const lsys_mctx* M = c->M;
+  if (!M) return 0;
+  if (!p->n) return 1;
+  mstate S = {ls, frame};
+  const unsigned char* ign = M->ignored[c->r->filter + 1];
+  view src = {M->src, M->src->n, 0, M->match, ign, M->nsym};
+  int64_t end, lm = c->rlast;
+  int ok = right ? right_match(&S, &src, c->right, &lm, p, 0, p->n, &end, M->string_mode)
+                 : left_match(&S, &src, c->left, p, p->n - 1, &end, M->string_mode);
+  if (ls->err && ls->err->status) return -1;
+  if (!ok) return 0;
+  if (right) {
+    c->right = end;
+    c->rlast = lm;
+  } else {
+    c->left = end;
+  }
   return 1;
 }

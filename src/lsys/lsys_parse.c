@@ -2881,3 +2881,37 @@ done:
   vd_free(P.lines, (size_t)P.capline * sizeof(pline));
   return st;
 }
+
+// ---------------------------------------------------------------------------------------------
+// patterns of InLeftContext / InRightContext (Python engine, at run time)
+
+const lsys_cpat* lsys_context_pattern(vd_lsystem* ls, const char* s, int len, int line) {
+  int sid = str_intern(ls, s, len);
+  if (sid < 0) {
+    str_intern_error(ls, sid, line, 0);
+    return NULL;
+  }
+  for (int i = 0; i < ls->ncpat; i++)
+    if (ls->cpat[i].sid == sid) return &ls->cpat[i];
+  if (!vd_grow((void**)&ls->cpat, &ls->capcpat, ls->ncpat + 1, sizeof(lsys_cpat))) {
+    perr(ls, VD_ERR_NOMEM, line, 0, "out of memory");
+    return NULL;
+  }
+  lsys_cpat* c = &ls->cpat[ls->ncpat];
+  memset(c, 0, sizeof *c);
+  c->sid = sid;
+  const char* t = ls->str[sid];  // lives as long as the lsystem (names point into it)
+  scope sc = {0};
+  sc.is_function = 1;
+  int ok = parse_pstr(ls, &sc, t, 0, len, line, 1, 0, &c->p);
+  if (ok && sc.n > 64) ok = !perr(ls, VD_ERR_LIMIT, line, 0, "more than 64 variables in a context pattern");
+  if (ok && sc.n && !(c->var = aalloc(ls, sizeof(int) * (size_t)sc.n)))
+    ok = !perr(ls, VD_ERR_NOMEM, line, 0, "out of memory");
+  for (int i = 0; ok && i < sc.n; i++)
+    if ((c->var[i] = str_intern(ls, sc.names[i], sc.lens[i])) < 0) ok = !str_intern_error(ls, c->var[i], line, 0);
+  c->nvar = sc.n;
+  scope_free(&sc);
+  if (!ok) return NULL;
+  ls->ncpat++;
+  return c;
+}

@@ -427,6 +427,21 @@ def getGroup():
     return _vd.get_group()
 
 
+def inLeftContext(pattern, params=None):
+    """In a rule's body: does the pattern match left of where the rule's left context ended?
+    Its variables go into params; on a match the next call reads on from there."""
+    return _vd.in_context(0, str(pattern), params)
+
+
+def inRightContext(pattern, params=None):
+    """The same on the right of the rule's right context."""
+    return _vd.in_context(1, str(pattern), params)
+
+
+InLeftContext = inLeftContext     # the file's InLeftContext(A(x), params) is translated to a string
+InRightContext = inRightContext
+
+
 def getIterationNb():
     return _vd.iteration()
 
@@ -2051,7 +2066,7 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
-        "PatternModule"]
+        "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext"]
 
 _pgl_math = _module("openalea.plantgl.math", _MATH)
 _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
