@@ -353,8 +353,7 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     }
   }
   double t0 = cli_now();
-  if (!vd_harvest_done(h)) st = vd_harvest_run(h, on_step, &eo, &err);
-  else st = on_step(&eo, h);
+  st = vd_harvest_run(h, on_step, &eo, &err);
   double wall = cli_now() - t0;
   if (eo.progress) progress_bar(vd_harvest_sim_data(h)->time, s->duration), fputc('\n', stderr);
   if (st && !eo.write_failed) {
@@ -464,9 +463,14 @@ static vd_status make_episode(const batch* b, int k, vd_error* err) {
     st = vd_harvest_create(&s, plant, &h, err);
     if (h) st = VD_OK;
   }
-  if (!st && !vd_harvest_done(h)) st = vd_harvest_reset(h, tseed, err);
-  if (st == VD_ERR_VALUE && h && vd_harvest_done(h)) st = VD_OK;  // no reachable fruit: an outcome
-  if (!st && !vd_harvest_done(h)) st = vd_harvest_run(h, NULL, NULL, err);
+  if (!st) st = vd_harvest_reset(h, tseed, err);
+  if (st == VD_ERR_VALUE && h) {
+    // no fruit to pick (none reachable, none with that instance): an outcome, not a failure
+    vd_harvest_obs ob;
+    vd_harvest_observe(h, &ob);
+    if (!ob.target_instance) st = VD_OK;
+  }
+  if (!st) st = vd_harvest_run(h, NULL, NULL, err);
   if (!st) {
     cJSON* r = summary_json(h, -1);
     if (r) {

@@ -11,7 +11,9 @@ static const char* validate_help =
     "Run the rod physics against analytic references: cantilevers under tip load, self-weight\n"
     "and end moment (to a full circle), shear, torsion, large deflection, first frequency (with\n"
     "a fruit), buckling, fracture, contacts, and independence of iterations, time step and\n"
-    "discretisation; each in the discrete model's exact form and in continuum form.\n"
+    "discretisation; each in the discrete model's exact form and in continuum form. Then the\n"
+    "harvest cases: detachment forces per site against the tomato literature, bend against\n"
+    "pull, Gazebo Plants' bending and C_s^max runs, two-way coupling against the rod's force.\n"
     "Exit code 0 when every check passes, 1 when one fails.\n"
     "\n"
     "options:\n"
@@ -82,11 +84,13 @@ int cli_validate(int argc, char** argv) {
   int n = 0;
   double t0 = cli_now();
   st = vd_sim_validate(&def, &r, &n, &err);
-  // the mass-spring trees and growth runs (docs/validation.md) after the rods
-  for (int part = 0; part < 2 && !st; part++) {
+  // the mass-spring trees, growth runs and harvest cases (docs/validation.md) after the rods
+  for (int part = 0; part < 3 && !st; part++) {
     vd_validate_result* r2 = NULL;
     int n2 = 0;
-    st = part == 0 ? vd_mss_validate(&def, &r2, &n2, &err) : vd_growth_validate(&def, &r2, &n2, &err);
+    st = part == 0   ? vd_mss_validate(&def, &r2, &n2, &err)
+         : part == 1 ? vd_growth_validate(&def, &r2, &n2, &err)
+                     : vd_robot_validate(&def, &r2, &n2, &err);
     if (!st && n2) {
       vd_validate_result* all = vd_realloc(r, sizeof *r * (size_t)n, sizeof *r * (size_t)(n + n2));
       if (!all) {

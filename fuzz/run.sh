@@ -30,7 +30,8 @@ mkdir -p "$OUT/obj"
 newest_h=$(ls -t include/verdant/*.h src/*/*.h fuzz/*.h "$OUT/gen/lsys_shim.h" | head -1)
 objs=()
 jobs=$(nproc 2>/dev/null || echo 2)
-for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/sim/*.c; do
+# (the robot module only for its scene parser: MuJoCo is not linked)
+for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/sim/*.c src/robot/robot_scene.c; do
   obj="$OUT/obj/$(basename "${src%.c}").o"
   objs+=("$obj")
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$newest_h" -nt "$obj" ]; then

@@ -9,36 +9,6 @@
 #include "test.h"
 #include "verdant/verdant.h"
 
-// a small fruiting plant: a clamped stem 0.5 m tall, a side branch at its top (the peduncle), a
-// two-piece pedicel hanging from its end and a fruit of radius r on it
-static vd_model* truss(double r, vd_plant_spec** spec_out) {
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_vec3 p[6] = {{0, 0, -0.01}, {0, 0, 0}, {0, 0, 0.5}, {0.1, 0, 0.5}, {0.11, 0, 0.485}, {0.12, 0, 0.47}};
-  for (int k = 0; k < 6; k++) vd_plant_add_node(s, p[k]);
-  int lab[5] = {1, 1, 3, 4, 4};
-  double rad[5] = {0.006, 0.006, 0.0025, 0.0012, 0.0012};
-  int parent = -1;
-  for (int k = 0; k < 5; k++) {
-    vd_segment_spec g = vd_segment_spec_default();
-    g.node0 = k, g.node1 = k + 1, g.r0 = g.r1 = rad[k], g.label = lab[k], g.instance = 1 + (k >= 2) + (k >= 3);
-    g.up = vd_v3(0, 1, 0), g.parent = parent;
-    parent = vd_plant_add_segment(s, &g);
-  }
-  vd_sphere_spec f = vd_sphere_spec_default();
-  f.center = vd_v3(0.12 + 0.4 * r, 0, 0.47 - 0.9 * r), f.radius = r, f.parent = parent, f.label = 5, f.instance = 9;
-  vd_plant_add_sphere(s, &f);
-  vd_plant_set_label(s, 1, "stem");
-  vd_plant_set_label(s, 3, "peduncle");
-  vd_plant_set_label(s, 4, "pedicel");
-  vd_plant_set_label(s, 5, "fruit");
-  vd_model* m = NULL;
-  vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  if (spec_out) *spec_out = s;
-  else vd_plant_spec_destroy(s);
-  return m;
-}
-
 // a scene for the truss and the Lite 6 (method and extra JSON fields spliced in)
 static vd_status truss_scene(const char* method, const char* extra, vd_scene* s, vd_error* e) {
   char text[8192];
@@ -61,7 +31,7 @@ TEST(robot, lite6_kinematics) {
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
   s.base_pos = vd_v3(0, 0, 0), s.base_yaw = 0;
-  vd_model* pm = truss(0.012, NULL);
+  vd_model* pm = robot_truss(0.012);
   REQUIRE(pm);
   vd_harvest* h = NULL;
   vd_status st = vd_harvest_create(&s, pm, &h, &e);
@@ -92,7 +62,7 @@ TEST(robot, ik_reaches_targets) {
   vd_error e = {0};
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
-  vd_model* pm = truss(0.012, NULL);
+  vd_model* pm = robot_truss(0.012);
   vd_harvest* h = NULL;
   vd_harvest_create(&s, pm, &h, &e);
   REQUIRE(h);
@@ -175,7 +145,7 @@ TEST(robot, mjcf_errors) {
   vd_error e = {0};
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
-  vd_model* pm = truss(0.012, NULL);
+  vd_model* pm = robot_truss(0.012);
   vd_harvest* h = NULL;
   snprintf(s.robot_path, sizeof s.robot_path, "%s/none.xml", vdt_tmpdir());
   CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_ERR_IO, e);
@@ -199,113 +169,12 @@ TEST(robot, mjcf_errors) {
   vd_scene_free(&s);
 }
 
-// MJCF of a one-axis pusher: a sphere of radius 1 cm on a slide along y with a position servo
-// (gain kp N/m, limit fmax N) and two dummy fingers
-static void pusher_mjcf(const char* path, double kp, double fmax) {
-  FILE* f = fopen(path, "w");
-  if (!f) return;
-  fprintf(f,
-          "<mujoco><compiler autolimits=\"true\"/><option timestep=\"0.002\" gravity=\"0 0 0\"/>\n"
-          "<worldbody><body name=\"base\" pos=\"0 0 0\">\n"
-          " <body name=\"slider\"><joint name=\"y\" type=\"slide\" axis=\"0 1 0\" range=\"-1 1\" damping=\"%g\"/>\n"
-          "  <inertial pos=\"0 0 0\" mass=\"0.5\" diaginertia=\"1e-3 1e-3 1e-3\"/>\n"
-          "  <geom name=\"ball\" type=\"sphere\" size=\"0.01\" contype=\"1\" conaffinity=\"0\"/>\n"
-          "  <site name=\"tcp\"/>\n"
-          "  <body name=\"fl\" pos=\"0 0 0.2\"><joint name=\"fl\" type=\"slide\" axis=\"1 0 0\" range=\"0 0.02\"/>"
-          "<geom size=\"0.002\" contype=\"0\" conaffinity=\"0\" mass=\"0.01\"/></body>\n"
-          "  <body name=\"fr\" pos=\"0 0 0.2\"><joint name=\"fr\" type=\"slide\" axis=\"-1 0 0\" range=\"0 0.02\"/>"
-          "<geom size=\"0.002\" contype=\"0\" conaffinity=\"0\" mass=\"0.01\"/></body>\n"
-          " </body></body></worldbody>\n"
-          "<actuator><position name=\"y\" joint=\"y\" kp=\"%g\" forcelimited=\"true\" forcerange=\"%g %g\"/>\n"
-          " <position name=\"finger_l\" joint=\"fl\" kp=\"100\"/><position name=\"finger_r\" joint=\"fr\" kp=\"100\"/>\n"
-          "</actuator></mujoco>\n",
-          2 * sqrt(kp * 0.5), kp, -fmax, fmax);
-  fclose(f);
-}
-
-// a horizontal cantilever along +x from the origin, length L, radius r, no gravity
-static vd_model* rod_plant(double len, double r) {
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_plant_add_node(s, vd_v3(-0.01, 0, 0.3));
-  vd_plant_add_node(s, vd_v3(0, 0, 0.3));
-  vd_plant_add_node(s, vd_v3(len, 0, 0.3));
-  vd_segment_spec g = vd_segment_spec_default();
-  g.node0 = 0, g.node1 = 1, g.r0 = g.r1 = r, g.label = 1, g.instance = 1, g.up = vd_v3(0, 0, 1);
-  int s0 = vd_plant_add_segment(s, &g);
-  g.node0 = 1, g.node1 = 2, g.parent = s0;
-  vd_plant_add_segment(s, &g);
-  vd_plant_set_label(s, 1, "branch");
-  vd_model* m = NULL;
-  vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
-  return m;
-}
-
-// push the rod's tip sideways with the pusher for T seconds; returns the tip's displacement (m)
-// and the pusher's lag behind its command (m), the plant's reaction (N) and the servo force (N)
-static void push_rod(int two_way, double kp, double fmax, double young, double* tip, double* lag,
-                     double* reaction, double* servo, double* clamp, double* tip_mass) {
-  char path[4096];
-  snprintf(path, sizeof path, "%s/pusher.xml", vdt_tmpdir());
-  pusher_mjcf(path, kp, fmax);
-  char text[8192];
-  snprintf(text, sizeof text,
-           "{\"format\": \"verdant-scene\", \"version\": 1, \"plant\": {\"file\": \"x.lpy\"},"
-           " \"robot\": {\"mjcf\": \"%s\", \"base\": {\"pos\": [0.2, -0.015, 0.3]}},"
-           " \"sim\": {\"gravity\": [0, 0, 0], \"ground\": null, \"segment_length\": 0.02, \"drag\": false,"
-           " \"mass_damping\": 20, \"sag_free\": false},"
-           " \"materials\": {\"wood\": {\"young\": %g}}, \"target\": {\"fruit\": 1},"
-           " \"two_way\": %s, \"duration\": 30}",
-           path, young, two_way ? "true" : "false");
-  vd_error e = {0};
-  vd_scene s;
-  vd_scene_parse(text, strlen(text), NULL, &s, &e);
-  vd_model* pm = rod_plant(0.2, 0.004);
-  vd_harvest* h = NULL;
-  vd_harvest_create(&s, pm, &h, &e);  // no fruit: VD_ERR_VALUE, the handle is there
-  *tip = *lag = *reaction = *servo = *clamp = *tip_mass = NAN;
-  if (!h) {
-    vdt_fail(__FILE__, __LINE__, "create: %s", e.msg);
-    vd_model_destroy(pm);
-    vd_scene_free(&s);
-    return;
-  }
-  h->done = 0;  // no fruit to harvest: drive the pusher by hand
-  const vd_sim_model* sm = vd_harvest_sim_model(h);
-  int tipn = sm->seg_node[2 * (sm->nseg - 1) + 1];
-  // 2 cm/s along +y for 1.5 s (3 cm), then hold for 1.5 s
-  for (int k = 0; k < 300 && !vd_harvest_done(h); k++) {
-    vd_harvest_action a = {{0, k < 150 ? 0.02 : 0, 0}, {0, 0, 0}, 0};
-    if (vd_harvest_step(h, &a, &e)) break;
-  }
-  vd_harvest_obs o;
-  vd_harvest_observe(h, &o);
-  *tip = vd_norm(vd_sub(vd_harvest_sim_data(h)->node_pos[tipn], sm->node_pos0[tipn]));
-  *lag = o.cmd_pos.y - o.ee_pos.y;
-  *reaction = o.robot_force.y;
-  *servo = h->d->actuator_force[h->arm_act[0]];
-  // the rod's force on its clamp: the stretch-shear multiplier of the first free segment
-  const vd_sim_data* sd = vd_harvest_sim_data(h);
-  for (int t = 0; t < sm->nseg; t++) {
-    if ((sm->seg_flags[t] & VD_SIM_FIXED) || !sm->node_fixed[sm->seg_node[2 * t]]) continue;
-    double h2 = sm->opt.dt * sm->opt.dt;
-    const double* l = sd->seg_lambda + 6 * t;
-    vd_vec3 f = vd_quat_rotate(sd->seg_quat[t], vd_v3(l[0] / h2, l[1] / h2, l[2] / h2));
-    *clamp = f.y / sm->seg_len0[t];
-  }
-  *tip_mass = sd->node_mass[tipn];
-  vd_harvest_destroy(h);
-  vd_model_destroy(pm);
-  vd_scene_free(&s);
-}
-
 TEST(robot, coupling_one_and_two_way) {
   double tip1, lag1, r1, f1, tip2, lag2, r2, f2, c, m;
   // a soft rod (E 1e8 Pa): one-way, the pusher follows its command and bends the rod; two-way,
   // the same, feeling the rod's push back
-  push_rod(0, 2000, 100, 1e8, &tip1, &lag1, &r1, &f1, &c, &m);
-  push_rod(1, 2000, 100, 1e8, &tip2, &lag2, &r2, &f2, &c, &m);
+  robot_push_rod(0, 2000, 100, 1e8, vdt_tmpdir(), &tip1, &lag1, &r1, &f1, &c, &m);
+  robot_push_rod(1, 2000, 100, 1e8, vdt_tmpdir(), &tip2, &lag2, &r2, &f2, &c, &m);
   REQUIRE(isfinite(tip1) && isfinite(tip2));
   CHECK(tip1 > 0.01);              // the plant moved
   CHECK(fabs(lag1) < 1e-4);        // one-way: the robot does not feel it
@@ -322,7 +191,7 @@ TEST(robot, stiff_branch_stops_weak_arm) {
   // the rod's implicit step, which pass on m/h^2 / (m/h^2 + k) of the static force k * tip
   // (m the tip node's mass, h the plant's time step; docs/physics.md): checked to 3 %
   double tip, lag, r, f, clamp, m;
-  push_rod(1, 5000, 2, 1e10, &tip, &lag, &r, &f, &clamp, &m);
+  robot_push_rod(1, 5000, 2, 1e10, vdt_tmpdir(), &tip, &lag, &r, &f, &clamp, &m);
   REQUIRE(isfinite(tip));
   double k = 3 * 1e10 * (M_PI * pow(0.004, 4) / 4) / pow(0.2, 3), mh = m / 1e-6;
   CHECK(lag > 0.01);               // stopped well short of its 3 cm command
@@ -341,7 +210,7 @@ static void harvest_truss(const char* method, const char* extra, vd_harvest_summ
     vdt_fail(__FILE__, __LINE__, "scene: %s", e.msg);
     return;
   }
-  vd_model* pm = truss(0.012, NULL);
+  vd_model* pm = robot_truss(0.012);
   vd_harvest* h = NULL;
   vd_status st = vd_harvest_create(&s, pm, &h, &e);
   if (st) vdt_fail(__FILE__, __LINE__, "create: %s", e.msg);
@@ -409,10 +278,11 @@ TEST(robot, unreachable_target) {
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
   s.base_pos = vd_v3(3, 0, 0.2);
-  vd_model* pm = truss(0.012, NULL);
+  vd_model* pm = robot_truss(0.012);
   vd_harvest* h = NULL;
   CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_ERR_VALUE, e);
   REQUIRE(h);
+  CHECK_STATUS(vd_harvest_run(h, NULL, NULL, &e), VD_OK, e);
   CHECK(vd_harvest_done(h));
   vd_harvest_summarize(h, &r);
   CHECK(!r.detached);

@@ -323,6 +323,17 @@ const double* vd_harvest_qpos(const vd_harvest* h, int* nq);
 const vd_scene* vd_harvest_scene(const vd_harvest* h);
 
 // ---------------------------------------------------------------------------------------------
+// validation (docs/validation.md "Harvesting")
+
+// Run the harvest validation cases (detachment forces per site against the tomato literature,
+// bend against pull, Gazebo Plants' C_b^max = 0.31 bending run and C_s^max sweep, two-way
+// coupling against the rod's own force) on a small truss picked by a six-axis gantry written to
+// a scratch folder under $TMPDIR. def->filter, progress and user are used; *out (free with
+// vd_free(*out, *n * sizeof **out)) gets the results.
+vd_status vd_robot_validate(const vd_validate_def* def, vd_validate_result** out, int* n,
+                            vd_error* err);
+
+// ---------------------------------------------------------------------------------------------
 // inverse kinematics of a loaded robot (also used by tests and tools)
 
 // Inverse kinematics settings.

@@ -113,9 +113,14 @@ void control_action(vd_harvest* h, vd_harvest_action* a) {
     case VD_PHASE_APPROACH:  // joint space: see control_begin
       break;
     case VD_PHASE_REACH:
+      // in to the fruit where it is now (the plant sways: the gripper follows it)
+      h->grasp_pos = h->sd->node_pos[h->fruit[h->target].node];
       track(h, h->grasp_pos, h->grasp_rot, 0.5 * md->approach_speed, APPROACH_TURN, a);
       break;
     case VD_PHASE_CLOSE:
+      // the fingers close around the fruit, still followed
+      h->grasp_pos = h->sd->node_pos[h->fruit[h->target].node];
+      track(h, h->grasp_pos, h->grasp_rot, 0.5 * md->approach_speed, APPROACH_TURN, a);
       a->gripper = 1;
       break;
     case VD_PHASE_DETACH: {
@@ -168,7 +173,7 @@ void control_after_step(vd_harvest* h) {
       }
       break;
     case VD_PHASE_REACH:
-      if (arrived(h, h->grasp_pos, h->grasp_rot, 1e-3)) control_set_phase(h, VD_PHASE_CLOSE);
+      if (arrived(h, h->grasp_pos, h->grasp_rot, 2e-3)) control_set_phase(h, VD_PHASE_CLOSE);
       else if (t > PHASE_TIMEOUT) harvest_finish(h, "reach timeout");
       break;
     case VD_PHASE_CLOSE:

@@ -15,6 +15,8 @@
 
 #include "robot_internal.h"
 
+
+#define KROT 2.0  // torsion spring of the grasp: k = KROT I / h^2 (explicit; stable below 4)
 #define GRIP_SPEED 0.02  // finger target speed (m/s): closes 20 mm in a second
 
 const char* vd_harvest_phase_name(vd_harvest_phase p) {
@@ -52,7 +54,7 @@ void harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg
 void harvest_finish(vd_harvest* h, const char* reason) {
   if (h->done) return;
   h->done = 1;
-  snprintf(h->reason, sizeof h->reason, "%s", reason);
+  if (reason != h->reason) snprintf(h->reason, sizeof h->reason, "%s", reason);
   if (h->phase != VD_PHASE_EXTERNAL) control_set_phase(h, VD_PHASE_DONE);
 }
 
@@ -187,18 +189,23 @@ static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
   const vd_scene* s = &h->scene;
   h->target = -1;
   if (!h->nfruit) {
-    harvest_finish(h, "no fruit");
+    snprintf(h->reason, sizeof h->reason, "no fruit");
     return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0, "the plant has no fruit");
   }
   int random = s->target_instance < 0;
   if (s->target_instance > 0) {
     for (int f = 0; f < h->nfruit; f++)
       if (h->fruit[f].instance == s->target_instance) h->target = f;
-    if (h->target < 0)
+    if (h->target < 0) {
+      snprintf(h->reason, sizeof h->reason, "no such fruit");
       return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0,
                           "target.fruit: the plant has no fruit with instance %d",
                           s->target_instance);
-    if (!reachable(h, h->target, &h->grasp_ik_err)) harvest_finish(h, "unreachable");
+    }
+    if (!reachable(h, h->target, &h->grasp_ik_err)) {
+      snprintf(h->reason, sizeof h->reason, "unreachable");
+      h->target = -1;
+    }
     return VD_OK;
   }
   // fruits by distance from the robot's base (instance breaks ties), the reachable ones
@@ -235,7 +242,7 @@ static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
     reachable(h, h->target, &h->grasp_ik_err);
   }
   vd_free(order, (size_t)h->nfruit * sizeof(int));
-  if (h->target < 0) harvest_finish(h, "no reachable fruit");
+  if (h->target < 0) snprintf(h->reason, sizeof h->reason, "no reachable fruit");
   return VD_OK;
 }
 
@@ -289,9 +296,15 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   for (int f = 0; f < h->nfruit; f++) h->fruit[f].hit = h->fruit[f].dropped = 0;
   h->scripted = 1;
   h->phase = VD_PHASE_APPROACH;
+  // without a target the episode can still be driven from outside; the scripted run ends at
+  // once with the reason (no fruit, unreachable, no reachable fruit)
   vd_status st = choose_target(h, seed, err);
-  if (!st && !h->done) control_begin(h);
-  return st ? st : (h->target < 0 || h->done) ? vd_error_set(err, VD_ERR_VALUE, h->scene.path, 0, 0, "%s", h->reason) : VD_OK;
+  if (!st && h->target >= 0) control_begin(h);
+  if (!st && h->target < 0) {
+    h->phase = VD_PHASE_DONE;
+    st = vd_error_set(err, VD_ERR_VALUE, h->scene.path, 0, 0, "%s", h->reason);
+  }
+  return st;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -309,10 +322,10 @@ static void grasp_drive(vd_harvest* h, vd_pose e, vd_vec3* torque) {
   const robot_fruit* f = &h->fruit[h->target];
   vd_sim_data* sd = h->sd;
   sd->tie[h->tie].target = vd_add(e.pos, vd_quat_rotate(e.rot, h->hold_local));
-  // orientation: a spring on the fruit's stalk frame, stable explicitly (k h^2 / I = 0.5)
+  // orientation: a spring on the fruit's stalk frame, explicit (k h^2 / I = KROT)
   int t = f->seg;
   double ib = h->sm->seg_inertia[2 * t], it = h->sm->seg_inertia[2 * t + 1], dt = h->sm->opt.dt;
-  double inr = ib < it ? ib : it, k = 0.5 * inr / (dt * dt), c = sqrt(k * inr);
+  double inr = ib < it ? ib : it, k = KROT * inr / (dt * dt), c = sqrt(k * inr);
   vd_quat want = vd_quat_mul(e.rot, h->hold_rot);
   vd_vec3 tau = vd_sub(vd_scale(quat_log_v(vd_quat_mul(want, vd_quat_conj(sd->seg_quat[t]))), k),
                        vd_scale(sd->seg_omega[t], c));
@@ -659,6 +672,7 @@ void vd_harvest_scripted_action(vd_harvest* h, vd_harvest_action* a) {
 vd_status vd_harvest_run(vd_harvest* h, vd_status (*on_step)(void* user, const vd_harvest* h),
                          void* user, vd_error* err) {
   vd_status st = VD_OK;
+  if (h->target < 0 && h->scripted) harvest_finish(h, h->reason);
   if (on_step && (st = on_step(user, h))) return st;
   while (!h->done) {
     vd_harvest_action a;

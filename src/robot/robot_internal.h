@@ -144,6 +144,12 @@ void control_set_phase(vd_harvest* h, vd_harvest_phase p);
 void control_grasp_pose(vd_harvest* h, int f, vd_vec3* pos, vd_quat* rot, vd_vec3* approach,
                         vd_vec3* pedicel);
 
+// robot_validate.c: the validation's small truss (fruit radius r) and the two-way pusher (a
+// sphere on a slide pushing a cantilever's tip 3 cm; dir holds its MJCF for a moment)
+vd_model* robot_truss(double r);
+void robot_push_rod(int two_way, double kp, double fmax, double young, const char* dir, double* tip,
+                    double* lag, double* reaction, double* servo, double* clamp, double* tip_mass);
+
 // robot_harvest.c
 void harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg, int instance);
 void harvest_finish(vd_harvest* h, const char* reason);

@@ -59,19 +59,11 @@ void vd_scene_free(vd_scene* s) {
   s->nplant_set = 0;
 }
 
-// a copy of text on the heap (vd_free(p, strlen(p) + 1))
-static char* dup_str(const char* t) {
-  size_t n = strlen(t) + 1;
-  char* p = vd_malloc(n);
-  if (p) memcpy(p, t, n);
-  return p;
-}
-
 vd_status vd_scene_copy(const vd_scene* s, vd_scene* out, vd_error* err) {
   *out = *s;
   out->nplant_set = 0;
   for (int k = 0; k < s->nplant_set; k++) {
-    char* p = dup_str(s->plant_set[k]);
+    char* p = vd_strdup(s->plant_set[k]);
     if (!p) {
       vd_scene_free(out);
       return vd_error_set(err, VD_ERR_NOMEM, s->path, 0, 0, "out of memory");
@@ -232,7 +224,7 @@ static vd_status read_plant(rd* r, const cJSON* o, vd_scene* s) {
         return bad(r, w, "set", "at most 64 globals");
       char buf[256];
       snprintf(buf, sizeof buf, "%s=%.17g", c->string, c->valuedouble);
-      char* p = dup_str(buf);
+      char* p = vd_strdup(buf);
       if (!p) return vd_error_set(r->err, VD_ERR_NOMEM, r->file, 0, 0, "out of memory");
       s->plant_set[s->nplant_set++] = p;
     }
