@@ -245,6 +245,33 @@ TEST(lpy, in_left_and_right_context) {
              1, "BBBX(2)D");
 }
 
+TEST(lpy, scene_argument_of_the_hooks) {
+  // EndEach(lstring, scene) / End(lstring, scene): the string interpreted and drawn, one shape per
+  // primitive, its id the module that drew it (L-Py's shape ids); (lstring, scene) or the scene
+  // returned keep the string
+  PY_DERIVES("def EndEach(lstring, scene):\n  assert len(scene) == 3, len(scene)\n"
+             "  assert sorted(scene.todict().keys()) == [0, 2] and len(scene.todict()[2]) == 2\n"
+             "  return lstring, scene\n"
+             "def End(lstring, scene):\n  return scene\n"
+             "Axiom: A\nproduction:\nA --> B [ C ]\ninterpretation:\nB --> F\nC --> F @O(0.1)\n",
+             1, "B[C]");
+  // a hook that returns nothing keeps what it changed in place (L-Py hands it the string itself)
+  PY_DERIVES("def EndEach(lstring):\n  lstring[0][0] = 2\nAxiom: A(1)\nproduction:\nA(x) --> A(x)\n", 1, "A(2)");
+}
+
+TEST(lpy, vector_query_modules_python_engine) {
+  // ?P without parameters gets a Vector3 appended, ?F the four vectors of the frame (position,
+  // heading, up, left), as L-Py's turtle fills them (the native engine has no vectors: refused)
+  const char* src = "Axiom: F(2) ?P ?F\nderivation length: 2\nproduction:\n"
+                    "?P(v) > ?F(p, h, u, l) :\n  assert v == p and abs(v.z - 2) < 1e-12 and abs(h.z - 1) < 1e-12\n"
+                    "  assert abs(u.x - 1) < 1e-12 and abs(l.y + 1) < 1e-12\n  produce ?P(v) X\n";
+  char b[256];
+  vd_error e = {0};
+  CHECK_STATUS(derive_engine(src, VD_LSYS_PYTHON, -1, b, sizeof b, &e), VD_OK, e);
+  CHECK(strncmp(b, "F(2)?P(Vector3(0,0,2))X?F(", 26) == 0);
+  REFUSED(src, "?P without parameters");
+}
+
 TEST(lpy, discard_new_string) {
   // DiscardNewString() (L-Py's __lpyfuture__) drops the result of the step it is called in
   const char* src =

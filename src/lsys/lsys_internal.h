@@ -484,7 +484,15 @@ void lsys_pass_free(lsys_pass* P);
 int lsys_mlist_new(vd_lsystem* ls, int n);
 // Run the turtle over s without keeping geometry, writing the turtle's position and frame into
 // the parameters of the query modules ?P ?H ?U ?L ?R of s.
-vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
+// Frames of the query modules that take Vector3 objects (Python engine: ?F, ?P ... without
+// parameters or with an object): 13 values per module, its index in the string then the
+// turtle's position, heading, up and left.
+typedef struct lsys_qframes {
+  double* v;
+  int n, cap;  // modules recorded, capacity (modules)
+} lsys_qframes;
+// qf Nullable: without it such modules are refused
+vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err, lsys_qframes* qf);
 #define LSYS_SRC_IDENTITY (INT64_C(1) << 62)  // on a source index: the module was copied unchanged
 // File lines of the modules idx[0..n) of s, a string the last derivation made (interpreted or
 // not): the derivation runs again keeping lines; 1 when s is that string (lines[k] is 0 where
@@ -497,6 +505,11 @@ vd_status lsys_set_option(vd_lsystem* ls, const char* name, int nlen, long v, in
 int lsys_turtle_angle(const vd_lsystem* ls, double* angle);
 // The file name of an lsystem ("" when parsed from text without one).
 const char* lsys_file(const vd_lsystem* ls);
+// L-Py's scene argument of the hooks EndEach(lstring, scene) / End(lstring, scene): s interpreted
+// (interpretation rules and hooks run, as L-Py computes its scene) into geo, whose src maps back
+// to s, and drawn by the turtle into plant
+vd_status lsys_scene_of(vd_lsystem* ls, const vd_lstring* s, vd_lstring* geo, vd_plant_spec* plant,
+                        int64_t max_modules);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
 // With cur (nullable), where the contexts ended (InLeftContext / InRightContext go on from there).
 int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end,
@@ -580,6 +593,8 @@ void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)
 void lsys_py_reset_objects(vd_lsystem* ls);
 vd_status lsys_py_set_global(vd_lsystem* ls, const char* name, const char* text);
+// a Vector3(x, y, z) object as a parameter (a handle) in *out
+vd_status lsys_py_vec3(vd_lsystem* ls, double x, double y, double z, double* out);
 vd_status lsys_py_get_global(vd_lsystem* ls, const char* name, double* out);
 // What the turtle reads from object parameters (the Python engine's curves, functions and
 // geometry). Arrays are vd_malloc'd, the caller frees them (sizes from the counts). Each returns

@@ -499,7 +499,10 @@ static int right_match(const mstate* S, const view* v, int64_t start, int64_t* l
   }
   if (it >= v->n) {
     // nothing to the right: only None and repetitions that may match nothing succeed
-    if (to - from == 1 && p->m[from].kind == PK_NONE) return 1;
+    if (to - from == 1 && p->m[from].kind == PK_NONE) {
+      *end = it;
+      return 1;
+    }
     while (i < to && is_re(&p->m[i])) {
       int64_t e;
       if (!right_re(S, v, v->n, &lm, &p->m[i], &e, string_mode)) return 0;

@@ -1210,6 +1210,71 @@ static int arity(PyObject* f) {
   return k;
 }
 
+// the module of s behind a primitive (the turtle maps the interpretation's modules back to s)
+static long long shape_id(const vd_lstring* geo, int64_t m) {
+  (void)geo;
+  return m < 0 ? -1 : (long long)(m & ~LSYS_SRC_IDENTITY);
+}
+
+// a list's items appended (a new reference stolen); 0 with an exception on failure
+static int push(PyObject* list, PyObject* it) {
+  if (!it) return 0;
+  int r = PyList_Append(list, it);
+  Py_DECREF(it);
+  return r == 0;
+}
+
+// the scene of s for a hook (L-Py's PlantGL scene: one shape per primitive the turtle draws, its
+// id the module of s that drew it); NULL with the error in ls->err or a Python exception
+static PyObject* scene_object(vd_lsystem* ls, const vd_lstring* s, int64_t max_modules) {
+  vd_lstring geo = vd_lstring_empty();
+  vd_plant_spec* plant = vd_plant_spec_create();
+  if (!plant) {
+    vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    return NULL;
+  }
+  vd_status st = lsys_scene_of(ls, s, &geo, plant, max_modules);
+  PyObject* items = st ? NULL : PyList_New(0);
+  int ok = items != NULL;
+  for (int k = 0; ok && k < plant->nseg; k++) {
+    const vd_segment_spec* g = &plant->seg[k];
+    vd_vec3 a = plant->node[g->node0], b = plant->node[g->node1];
+    ok = push(items, Py_BuildValue("(Lii(ddd)(ddd)(ddd)dd)", shape_id(&geo, g->module), 0, g->label, a.x, a.y, a.z, b.x,
+                                   b.y, b.z, g->up.x, g->up.y, g->up.z, g->r0, g->r1));
+  }
+  for (int k = 0; ok && k < plant->nsphere; k++) {
+    const vd_sphere_spec* g = &plant->sphere[k];
+    ok = push(items, Py_BuildValue("(Lii(ddd)d)", shape_id(&geo, g->module), 1, g->label, g->center.x, g->center.y,
+                                   g->center.z, g->radius));
+  }
+  for (int k = 0; ok && k < plant->nmesh; k++) {
+    const vd_mesh_spec* g = &plant->mesh[k];
+    PyObject* v = PyList_New(0);
+    PyObject* t = PyList_New(0);
+    ok = v && t;
+    for (int i = 0; ok && i < g->nvert; i++) {
+      vd_vec3 p = plant->vert[g->vert_start + i];
+      ok = push(v, Py_BuildValue("(ddd)", p.x, p.y, p.z));
+    }
+    for (int i = 0; ok && i < g->ntri; i++) {
+      const int* q = plant->tri + 3 * (g->tri_start + i);
+      ok = push(t, Py_BuildValue("(iii)", q[0] - g->vert_start, q[1] - g->vert_start, q[2] - g->vert_start));
+    }
+    ok = ok && push(items, Py_BuildValue("(LiiOOi)", shape_id(&geo, g->module), 2, g->label, v, t, g->closed));
+    Py_XDECREF(v);
+    Py_XDECREF(t);
+  }
+  vd_plant_spec_destroy(plant);
+  vd_lstring_free(&geo);
+  if (!ok) {
+    Py_XDECREF(items);
+    return NULL;
+  }
+  PyObject* scene = shim_call("_vd_scene", items);
+  Py_DECREF(items);
+  return scene;
+}
+
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules) {
   lsys_py* py = ls->py;
   if (!py->ns) return VD_OK;
@@ -1226,8 +1291,11 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
     n = 1;
   }
   if (want >= 2) {
-    Py_INCREF(Py_None);
-    args[1] = Py_None;
+    args[1] = scene_object(ls, s, max_modules);
+    if (!args[1]) {
+      Py_DECREF(args[0]);
+      return ls->err && ls->err->status ? ls->err->status : py_error(ls);
+    }
     n = 2;
   }
   Py_INCREF(f);
@@ -1244,10 +1312,30 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   PyObject* r = PyObject_Vectorcall(f, args, (size_t)n, NULL);
   py->out = saved;
   Py_DECREF(f);
-  for (int i = 0; i < n; i++) Py_DECREF(args[i]);
-  if (!r) return py_error(ls);
+  PyObject* lobj = n ? args[0] : NULL;  // the string the hook was given (kept)
+  for (int i = 1; i < n; i++) Py_DECREF(args[i]);
+  if (!r) {
+    Py_XDECREF(lobj);
+    return py_error(ls);
+  }
   vd_status st = VD_OK;
-  if (r != Py_None && r != Py_True && r != Py_False) {
+  // L-Py's EndEach(lstring, scene) may return (lstring, scene), the lstring, or the scene
+  if (PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 2) {
+    PyObject* first = PyTuple_GET_ITEM(r, 0);
+    Py_INCREF(first);
+    Py_DECREF(r);
+    r = first;
+  }
+  if (r == Py_None && lobj) {
+    // nothing returned: the string it was given, changed in place or not (lstring[0][0] = 2)
+    Py_DECREF(r);
+    r = lobj;
+  } else {
+    Py_XDECREF(lobj);
+  }
+  PyObject* scene_type = PyDict_GetItemString(g_shim, "Scene");  // borrowed
+  int is_scene = scene_type && PyObject_IsInstance(r, scene_type) == 1;
+  if (r != Py_None && r != Py_True && r != Py_False && !is_scene) {
     // the hook returned a new string: it replaces the current one
     PyObject* items = shim_call("_vd_items", r);
     lstr_clear(scratch);
@@ -1262,6 +1350,15 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   }
   Py_DECREF(r);
   return st;
+}
+
+vd_status lsys_py_vec3(vd_lsystem* ls, double x, double y, double z, double* out) {
+  PyObject* c = Py_BuildValue("(ddd)", x, y, z);
+  PyObject* v = c ? shim_call("_vd_vec3", c) : NULL;
+  Py_XDECREF(c);
+  int ok = v && keep_object(ls, v, out);
+  Py_XDECREF(v);
+  return ok ? VD_OK : py_error(ls);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1962,6 +1962,13 @@ class Scene(list):
     def add(self, s):
         self.append(s)
 
+    def todict(self):
+        """{shape id: [shapes]}, as PlantGL's Scene.todict()."""
+        d = {}
+        for s in self:
+            d.setdefault(s.id, []).append(s)
+        return d
+
     def _mesh(self):
         return Group(list(self))._mesh()
 
@@ -1973,6 +1980,32 @@ def _mesh_of(g):
         return None
     f = getattr(g, "_mesh", None)
     return f() if f is not None else None
+
+
+def _vd_vec3(c):
+    """A Vector3 the turtle fills into a query module (?P, ?F ...)."""
+    return Vector3(*c)
+
+
+def _vd_scene(items):
+    """The scene argument of EndEach(lstring, scene) / End(lstring, scene): one Shape per primitive
+    the turtle drew (frustum, sphere, mesh), its id the module of the string that drew it (L-Py's
+    shape ids), its appearance the turtle's colour index."""
+    sc = Scene()
+    for it in items:
+        sid, kind, label = it[0], it[1], it[2]
+        if kind == 0:
+            a, b, up, r0, r1 = Vector3(*it[3]), Vector3(*it[4]), Vector3(*it[5]), it[6], it[7]
+            h = b - a
+            length = norm(h)
+            h = h / length if length > 0 else Vector3(0, 0, 1)
+            g = Translated(a, Oriented(up, cross(h, up), Frustum(r0, length, r1 / r0 if r0 > 0 else 1.0)))
+        elif kind == 1:
+            g = Translated(Vector3(*it[3]), Sphere(it[4]))
+        else:
+            g = TriangleSet([Vector3(*p) for p in it[3]], [tuple(t) for t in it[4]])
+        sc.add(Shape(g, label, id=sid))
+    return sc
 
 
 # ---------------------------------------------------------------------------------------------
