@@ -65,13 +65,113 @@ rl = struct.unpack_from("<H", b, 105)[0]
 n = struct.unpack_from("<Q", b, 247)[0]
 assert n == 5000 and len(b) == off + n * rl, (n, len(b), off, rl)
 classes = {b[off + i * rl + 16] for i in range(n)}
-assert classes <= {1, 2, 3, 4}, classes
+assert classes <= {65, 66, 67, 68}, classes  # user classes 64 + label (docs/formats.md)
 lines = open(t + "/d.csv").read().splitlines()
 hdr = [l for l in lines if not l.startswith("#")][0]
 assert hdr.startswith("x,y,z,nx,ny,nz,label,instance"), hdr
 assert len([l for l in lines if not l.startswith("#")]) == 5001
 PY
 then ok "las and csv layouts"; else bad "las and csv layouts"; fi
+# LAS (issue 12, item 18): label, instance and view as extra bytes, verdant's label table VLR
+if python3 - "$T/e.las" <<'PY'
+import struct, sys
+b = open(sys.argv[1], "rb").read()
+hs, off, nv = struct.unpack_from("<HII", b, 94)
+pos, names, table = hs, [], None
+for _ in range(nv):
+    user = b[pos + 2:pos + 18].rstrip(b"\0")
+    rec, ln = struct.unpack_from("<HH", b, pos + 18)
+    body = b[pos + 54:pos + 54 + ln]
+    if user == b"LASF_Spec" and rec == 4:
+        names = [body[k + 4:k + 36].rstrip(b"\0").decode() for k in range(0, ln, 192)]
+    if user == b"verdant" and rec == 1:
+        table = {struct.unpack_from("<i", body, k)[0]: (body[k + 4], body[k + 8:k + 56].rstrip(b"\0").decode())
+                 for k in range(0, ln, 56)}
+    pos += 54 + ln
+assert names[:3] == ["label", "instance", "view"], names
+assert table == {1: (65, "internode"), 2: (66, "leaf"), 3: (67, "flower"), 4: (68, "silique")}, table
+PY
+then ok "las extra bytes and label table"; else bad "las extra bytes and label table"; fi
+# XYZ and CSV that numpy's genfromtxt(names=True) names and Open3D's XYZ reader reads; scanner
+# poses in the headers and PCD's VIEWPOINT (issue 12, item 19)
+"$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 -N 3000 --seed 2 -o "$T/v1.pcd" &&
+  "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 --scanner -1,1,1 -N 3000 --seed 2 -o "$T/v2.xyz" &&
+  "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 --scanner -1,1,1 -N 3000 --seed 2 -o "$T/v2.csv"
+if python3 - "$T" <<'PY'
+import math, sys
+t = sys.argv[1]
+head = open(t + "/v1.pcd", "rb").read(3000).decode("latin-1").splitlines()
+vp = [float(x) for x in next(l for l in head if l.startswith("VIEWPOINT ")).split()[1:]]
+pose = next(l for l in head if l.startswith("# view 0 position")).split()
+target = [float(x) for x in pose[8:11]]
+assert vp[:3] == [1.5, 0.5, 0.8], vp
+w, x, y, z = vp[3:]
+assert abs(w * w + x * x + y * y + z * z - 1) < 1e-6
+# the frame's z axis (third column of the rotation) points at the target
+zc = [2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)]
+d = [target[k] - vp[k] for k in range(3)]
+dl = math.sqrt(sum(v * v for v in d))
+assert all(abs(zc[k] - d[k] / dl) < 1e-6 for k in range(3)), (zc, d)
+# its x axis is horizontal (camera right, world up +z)
+assert abs(2 * (x * z - w * y)) < 1e-6
+for f in ["v2.xyz", "v2.csv"]:
+    lines = open(t + "/" + f).read().splitlines()
+    assert sum(l.startswith("# view ") for l in lines) == 2, f
+    assert any(l.startswith("# view 1 position -1 1 1 target") for l in lines), f
+PY
+then ok "scanner poses: PCD viewpoint, view lines"; else bad "scanner poses: PCD viewpoint, view lines"; fi
+NPY=""
+for p in python3 /usr/bin/python3; do
+  if "$p" -c "import numpy" >/dev/null 2>&1; then NPY="$p"; break; fi
+done
+if [ -n "$NPY" ]; then
+  if "$NPY" - "$T" <<'PY'
+import sys, numpy as np
+t = sys.argv[1]
+x = np.genfromtxt(t + "/v2.xyz", names=True)
+c = np.genfromtxt(t + "/v2.csv", delimiter=",", names=True)
+for a in (x, c):
+    assert a.dtype.names == ("x", "y", "z", "nx", "ny", "nz", "label", "instance", "view", "range"), a.dtype.names
+    assert len(a) == 3000 and not np.isnan(a["x"]).any() and set(np.unique(a["view"])) == {0, 1}
+assert np.allclose(x["x"], c["x"]) and (x["label"] == c["label"]).all()
+PY
+  then ok "numpy genfromtxt(names=True) reads XYZ and CSV"; else bad "numpy genfromtxt(names=True) reads XYZ and CSV"; fi
+else
+  echo "skip numpy check (numpy not installed)"
+fi
+O3D=""
+for p in python3 /usr/bin/python3; do
+  if "$p" -c "import open3d" >/dev/null 2>&1; then O3D="$p"; break; fi
+done
+if [ -n "$O3D" ]; then
+  if "$O3D" - "$T" <<'PY'
+import sys, numpy as np, open3d as o3d
+t = sys.argv[1]
+pc = o3d.io.read_point_cloud(t + "/v2.xyz", format="xyz")
+ref = np.genfromtxt(t + "/v2.xyz", names=True)
+p = np.asarray(pc.points)
+assert p.shape == (3000, 3), p.shape
+assert np.allclose(p[:, 0], ref["x"]) and np.allclose(p[:, 2], ref["z"])
+PY
+  then ok "open3d reads XYZ"; else bad "open3d reads XYZ"; fi
+else
+  echo "skip Open3D XYZ check (python3-open3d not installed)"
+fi
+# PDAL reads the file (optional: Debian 12 has no pdal package; skipped without it)
+if command -v pdal >/dev/null 2>&1; then
+  if pdal info --summary "$T/e.las" >"$T/pdal.json" 2>"$T/pdal.err" && python3 - "$T/pdal.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))["summary"]
+assert s["num_points"] == 5000, s
+dims = s["dimensions"]
+dims = dims if isinstance(dims, list) else [d.strip() for d in dims.split(",")]
+for d in ["Classification", "label", "instance", "view"]:
+    assert d in dims, (d, dims)
+PY
+  then ok "pdal info reads our LAS"; else bad "pdal info reads our LAS ($(head -c 300 "$T/pdal.err"))"; fi
+else
+  echo "skip pdal check (pdal not installed)"
+fi
 
 # determinism: the same bytes with 1 and 2 threads, and run to run
 "$V" cloud "$A" -N 20000 --seed 9 --threads 1 -o "$T/t1.ply" && "$V" cloud "$A" -N 20000 --seed 9 --threads 2 -o "$T/t2.ply"

@@ -776,29 +776,107 @@ TEST(cloud, las_layout) {
   CHECK_INT(b[25], 4);
   CHECK_INT(rd(b + 94, 2), 375);
   CHECK_INT(b[104], 6);
-  CHECK_INT(rd(b + 105, 2), 50);
+  CHECK_INT(rd(b + 105, 2), 58);
   CHECK_INT(rd(b + 107, 4), 0);  // legacy count: 0 for format 6
   CHECK_INT(rd(b + 247, 8), 1000);
-  CHECK_INT(rd(b + 100, 4), 2);
+  CHECK_INT(rd(b + 100, 4), 3);
   uint64_t off = rd(b + 96, 4);
-  CHECK_INT(len, off + 1000 * 50);
-  // classification lookup then extra bytes (5 descriptors of 192 bytes)
+  CHECK_INT(len, off + 1000 * 58);
+  // classification lookup, extra bytes (7 descriptors of 192 bytes), verdant's label table
   CHECK(memcmp(b + 375 + 2, "LASF_Spec", 9) == 0);
   CHECK_INT(rd(b + 375 + 18, 2), 0);
   size_t v2 = 375 + 54 + rd(b + 375 + 20, 2);
   CHECK_INT(rd(b + v2 + 18, 2), 4);
-  CHECK_INT(rd(b + v2 + 20, 2), 5 * 192);
-  CHECK(memcmp(b + v2 + 54 + 4, "instance", 8) == 0);
-  // first point: classification = label, return 1 of 1
-  CHECK_INT(b[off + 16], c.label[0]);
+  CHECK_INT(rd(b + v2 + 20, 2), 7 * 192);
+  CHECK(memcmp(b + v2 + 54 + 4, "label", 5) == 0);
+  CHECK(memcmp(b + v2 + 54 + 192 + 4, "instance", 8) == 0);
+  size_t v3 = v2 + 54 + 7 * 192;
+  CHECK(memcmp(b + v3 + 2, "verdant", 8) == 0);
+  CHECK_INT(rd(b + v3 + 20, 2), c.nlabel * 56);
+  // first point: classification 64 + label (a user class), synthetic, return 1 of 1; the label,
+  // instance and view in extra bytes
+  CHECK_INT(b[off + 16], 64 + c.label[0]);
+  CHECK_INT(b[off + 15], 1);
   CHECK_INT(b[off + 14], 0x11);
-  CHECK_INT(rd(b + off + 30, 4), c.instance[0]);
+  CHECK_INT(rd(b + off + 30, 4), c.label[0]);
+  CHECK_INT(rd(b + off + 34, 4), c.instance[0]);
   vd_free(t, len + 1);
-  // labels above 255 do not fit a classification byte
+  // labels beyond the user classes: unclassified, the id in the extra bytes; read back whole
   c.label[0] = 300;
-  CHECK_STATUS(vd_cloud_write(&c, path, NULL, &err), VD_ERR_VALUE, err);
+  CHECK_STATUS(vd_cloud_write(&c, path, NULL, &err), VD_OK, err);
+  vd_cloud back;
+  CHECK_STATUS(vd_cloud_read(path, &back, &err), VD_OK, err);
+  CHECK_INT(back.n, c.n);
+  if (back.n == c.n) CHECK(back.label[0] == 300 && back.label[1] == c.label[1] && back.instance[5] == c.instance[5]);
+  CHECK_INT(back.nlabel, c.nlabel);
+  vd_cloud_free(&back);
   vd_cloud_free(&c);
   vd_model_destroy(m);
+}
+
+// LAS classes (issue 12, item 18): ASPRS 1 for no organ, 2 for ground, user classes 64 + id for
+// the organs, 1 beyond; the label table survives in verdant's VLR, or in an extended VLR after
+// the points when it is longer than a VLR holds
+TEST(cloud, las_classes_and_label_table) {
+  vd_error err = {0};
+  for (int big = 0; big < 2; big++) {
+    int nl = big ? 1500 : 4;
+    vd_label* labels = vd_calloc((size_t)nl, sizeof(vd_label));
+    REQUIRE(labels);
+    vd_label_init(&labels[0], 0, "none");
+    vd_label_init(&labels[1], 3, "Ground");
+    vd_label_init(&labels[2], 7, "leaf");
+    vd_label_init(&labels[3], 250, "fruit");
+    for (int i = 4; i < nl; i++) {
+      char name[32];
+      snprintf(name, sizeof name, "leaf_%d", i);
+      vd_label_init(&labels[i], 1000 + i, name);
+    }
+    vd_cloud c;
+    REQUIRE(vd_cloud_alloc(&c, nl, labels, nl, &err) == VD_OK);
+    for (int i = 0; i < nl; i++) {
+      c.pos[3 * i] = 0.01 * i, c.pos[3 * i + 1] = -0.5, c.pos[3 * i + 2] = 1;
+      c.normal[3 * i + 2] = 1;
+      c.label[i] = labels[i].id, c.instance[i] = i + 1;
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/classes%d.las", vdt_tmpdir(), big);
+    CHECK_STATUS(vd_cloud_write(&c, path, NULL, &err), VD_OK, err);
+    char* t;
+    size_t len;
+    REQUIRE(vd_file_read(path, &t, &len, &err) == VD_OK);
+    const unsigned char* b = (const unsigned char*)t;
+    uint64_t off = rd(b + 96, 4), rl = rd(b + 105, 2);
+    static const int want[4] = {1, 2, 64 + 7, 1};
+    for (int i = 0; i < 4; i++)
+      CHECK_INT(b[off + rl * (uint64_t)i + 16], want[i]);
+    if (big) {
+      CHECK_INT(b[off + rl * 4 + 16], 1);  // id 1004: no user class
+      CHECK_INT(rd(b + 243, 4), 1);        // one extended VLR: the label table
+      uint64_t ev = rd(b + 235, 8);
+      CHECK_INT(ev, off + rl * (uint64_t)nl);
+      CHECK(ev + 60 <= len && memcmp(b + ev + 2, "verdant", 8) == 0);
+      CHECK_INT(rd(b + ev + 20, 8), (uint64_t)nl * 56);
+    } else {
+      CHECK_INT(rd(b + 243, 4), 0);
+    }
+    vd_free(t, len + 1);
+    vd_cloud r;
+    CHECK_STATUS(vd_cloud_read(path, &r, &err), VD_OK, err);
+    CHECK_INT(r.nlabel, nl);
+    for (int i = 0; i < nl && i < r.nlabel; i++) {
+      CHECK_INT(r.labels[i].id, labels[i].id);
+      CHECK_STR(r.labels[i].name, labels[i].name);
+    }
+    for (int64_t i = 0; i < r.n && i < nl; i++)
+      if (r.label[i] != labels[i].id || r.instance[i] != (int)i + 1) {
+        CHECK_INT(r.label[i], labels[i].id);
+        break;
+      }
+    vd_cloud_free(&r);
+    vd_cloud_free(&c);
+    vd_free(labels, (size_t)nl * sizeof(vd_label));
+  }
 }
 
 static void write_text_file(const char* path, const char* s, size_t n) {

@@ -108,6 +108,8 @@ typedef struct vd_cloud {
   int* view;         // index of the scanner that made the point, 0 without scanners (n x 1)
   double* range;     // distance from that scanner (m), 0 without scanners (n x 1)
   int nview;         // scanners behind the cloud; 0: view and range carry nothing
+  double* view_pose; // each scanner's position and the point it looks at (m) (nview x 6);
+                     // Nullable: not known (a cloud read from a file); owned, vd_cloud_free
   int nlabel;        // entries of the label table
   vd_label* labels;  // label table: id -> name, organ kind, colour (nlabel)
   size_t nbytes;     // size of the point block

@@ -110,6 +110,7 @@ void vd_cloud_free(vd_cloud* c) {
   if (!c) return;
   vd_free(c->pos, c->nbytes);
   vd_free(c->labels, (size_t)c->nlabel * sizeof(vd_label));
+  vd_free(c->view_pose, (size_t)c->nview * 6 * sizeof(double));
   memset(c, 0, sizeof *c);
 }
 

@@ -448,7 +448,7 @@ static vd_status read_text(reader* r, const char* s, size_t len, int csv, vd_clo
   char* tok[64];
   size_t hl = 0;
   int have_hdr = 0;
-  // header: comments, then (CSV) the names line
+  // header: comments and (CSV) the names line, in any order
   size_t data_pos = 0;
   int data_line = 0;
   for (;;) {
@@ -473,15 +473,15 @@ static vd_status read_text(reader* r, const char* s, size_t len, int csv, vd_clo
       continue;
     }
     if (ll == 0) continue;
-    if (csv) {
+    if (csv && !have_hdr) {
+      // the names line; comments may follow it (verdant writes them there for numpy)
       if (ll >= sizeof hdr) return fail(r, t.line, "names line too long");
       memcpy(hdr, ls, ll);
       hl = ll;
       have_hdr = 1;
-      data_pos = t.pos, data_line = t.line;
-    } else {
-      data_pos = before, data_line = line_before;
+      continue;
     }
+    data_pos = before, data_line = line_before;
     break;
   }
   if (!have_hdr) return fail(r, t.line, "no column names line");
@@ -528,6 +528,21 @@ static double le_f64(const unsigned char* p) {
   return d;
 }
 
+// verdant's label table (a VLR or an extended VLR): per label id (int32), class (uint8), 3
+// reserved bytes, name (48 bytes)
+static vd_status las_label_table(reader* r, const unsigned char* p, unsigned len) {
+  r->nlabel = 0;
+  for (unsigned e = 0; e + 56 <= len; e += 56) {
+    if (!vd_grow((void**)&r->labels, &r->cap_label, r->nlabel + 1, sizeof(vd_label)))
+      return vd_error_set(r->err, VD_ERR_NOMEM, r->path, 0, 0, "out of memory");
+    char name[49];
+    memcpy(name, p + e + 8, 48);
+    name[48] = 0;
+    vd_label_init(&r->labels[r->nlabel++], (int)(int32_t)le(p + e, 4), name);
+  }
+  return VD_OK;
+}
+
 static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
   const unsigned char* b = (const unsigned char*)s;
   if (len < 375 || memcmp(b, "LASF", 4) != 0) return fail(r, 0, "not a LAS file (expected 'LASF')");
@@ -546,7 +561,9 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
     scale[k] = le_f64(b + 131 + 8 * k), off[k] = le_f64(b + 155 + 8 * k);
     if (!isfinite(scale[k]) || scale[k] == 0 || !isfinite(off[k])) return fail(r, 131, "bad LAS scale or offset");
   }
-  // VLRs: classification lookup (label names) and extra bytes (instance, range, normals)
+  // VLRs: classification lookup (label names), extra bytes (label, instance, view, range,
+  // normals), verdant's label table (ids and names)
+  int table = 0;
   cols cs;
   memset(&cs, 0, sizeof cs);
   size_t pos = hsize;
@@ -558,7 +575,12 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
     int spec = !memcmp(h + 2, "LASF_Spec", 9) && h[11] == 0;
     pos += 54;
     if (pos + vlen > offset) return fail(r, 0, "VLR %lld runs past the point data", (long long)v);
-    if (spec && rec == 0) {
+    if (!memcmp(h + 2, "verdant", 8) && rec == 1) {
+      // verdant's label table: it replaces the classification lookup's names
+      vd_status st = las_label_table(r, b + pos, vlen);
+      if (st) return st;
+      table = 1;
+    } else if (spec && rec == 0 && !table) {
       for (unsigned e = 0; e + 16 <= vlen; e += 16) {
         if (!vd_grow((void**)&r->labels, &r->cap_label, r->nlabel + 1, sizeof(vd_label)))
           return vd_error_set(r->err, VD_ERR_NOMEM, r->path, 0, 0, "out of memory");
@@ -590,8 +612,21 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
   int has[F_COUNT] = {0};
   for (int k = 0; k < cs.n; k++) {
     cs.field[k] = field_of(cs.name[k]);
-    if (cs.field[k] >= 0 && (cs.field[k] <= F_Z || cs.field[k] == F_LABEL || cs.field[k] == F_VIEW || has[cs.field[k]]++))
-      cs.field[k] = -1;
+    if (cs.field[k] >= 0 && (cs.field[k] <= F_Z || has[cs.field[k]]++)) cs.field[k] = -1;
+  }
+  // extended VLRs after the points: verdant's label table when it was too long for a VLR
+  uint64_t evlr = le(b + 235, 8), nevlr = le(b + 243, 4);
+  for (uint64_t v = 0; v < nevlr && evlr >= offset && evlr <= len && len - evlr >= 60; v++) {
+    const unsigned char* h = b + evlr;
+    uint64_t elen = le(h + 20, 8);
+    if (elen > len - evlr - 60) return fail(r, 0, "extended VLR %lld runs past the end of the file", (long long)v);
+    if (!memcmp(h + 2, "verdant", 8) && le(h + 18, 2) == 1) {
+      if (elen > 65535ull * 1024) return fail(r, 0, "label table of %llu bytes", (unsigned long long)elen);
+      r->nlabel = 0;
+      vd_status st = las_label_table(r, h + 60, (unsigned)elen);
+      if (st) return st;
+    }
+    evlr += 60 + elen;
   }
   if (n > (uint64_t)VD_CLOUD_MAX_POINTS || n > (len - offset) / rlen)
     return fail(r, 0, "%lld points do not fit in the file", (long long)n);

@@ -807,5 +807,18 @@ vd_status vd_cloud_sample(const vd_model* m, const vd_data* d, const vd_cloud_de
     *out = big;
   }
   sampler_free(&s);
+  // the scanners' poses, for the files (PCD VIEWPOINT, the views of the headers)
+  if (!st && out->nview > 0) {
+    out->view_pose = vd_malloc((size_t)out->nview * 6 * sizeof(double));
+    if (!out->view_pose) {
+      vd_cloud_free(out);
+      return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+    }
+    for (int v = 0; v < out->nview; v++) {
+      const vd_scanner* sc = &def.scanner[v];
+      double pose[6] = {sc->pos.x, sc->pos.y, sc->pos.z, sc->target.x, sc->target.y, sc->target.z};
+      memcpy(out->view_pose + 6 * v, pose, sizeof pose);
+    }
+  }
   return st;
 }

@@ -73,7 +73,7 @@ void control_begin(vd_harvest* h) {
   control_set_phase(h, VD_PHASE_APPROACH);
   control_grasp_pose(h, h->target, &h->grasp_pos, &h->grasp_rot, &h->approach, &h->pedicel);
   h->pre_pos = vd_madd(h->grasp_pos, h->approach, -h->scene.method.pregrasp);
-  h->progress = 0;
+  h->progress = 0, h->progress_step = 0;
   // to the pre-grasp pose in joint space (no singularity on the way, no wrist flips)
   h->joint_move = 1;
   memcpy(h->qgoal, h->qpre, sizeof h->qgoal);
@@ -130,7 +130,7 @@ void control_action(vd_harvest* h, vd_harvest_action* a) {
       double step = rate * dt;
       if (h->progress + step > goal) step = goal - h->progress;
       if (step <= 0) break;
-      h->progress += step;
+      h->progress_step = step;  // counted by control_after_step as far as the command went
       if (md->method == VD_HARVEST_PULL) {
         a->lin_vel = vd_scale(h->pedicel, step / dt);
       } else {
@@ -197,7 +197,7 @@ void control_after_step(vd_harvest* h) {
           h->axis = h->pedicel;
           h->pivot = c;
         }
-        h->progress = 0;
+        h->progress = 0, h->progress_step = 0;
         control_set_phase(h, VD_PHASE_DETACH);
       } else if (t > CLOSE_TIMEOUT) {
         harvest_finish(h, "not grasped");
@@ -205,6 +205,10 @@ void control_after_step(vd_harvest* h) {
       break;
     case VD_PHASE_DETACH: {
       double goal = md->method == VD_HARVEST_PULL ? md->distance : fabs(md->angle);
+      // the motion the command made: near a wrist singularity the joints' speed limits slow it
+      // down, and the method ends only once the whole distance or angle is done
+      h->progress += h->cmd_scale * h->progress_step;
+      h->progress_step = 0;
       if (!h->held) {
         harvest_finish(h, "slipped");
       } else if (h->progress >= goal - 1e-12) {

@@ -424,7 +424,7 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
   vd_vec3 pull = {0, 0, 0}, twist = {0, 0, 0};
   memset(force, 0, sizeof force);
   memset(torque, 0, sizeof torque);
-  int held0 = h->held;
+  int held0 = h->held, broke = 0;
   for (int s = 0; s < h->nsub; s++) {
     double a = (double)(s + 1) / h->nsub;
     for (int k = 0; k < h->ncol; k++) {
@@ -447,7 +447,10 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
       vd_vec3 fg;
       grasp_slip(h, e, &fg);
       pull = vd_add(pull, fg);
-      if (sd->nevent > nev) h->pull_at_break = vd_norm(fg);  // the force sensor at the break
+      // the force sensor: its largest value up to and with the break, and its value at the break
+      double fn = vd_norm(fg);
+      if (!h->detached && !broke && fn > h->max_pull) h->max_pull = fn;
+      if (sd->nevent > nev) h->pull_at_break = fn, broke = 1;
       twist = vd_sub(twist, tau);
       if (h->slip > h->fruit[h->target].radius) {
         harvest_event(h, VD_EV_SLIP, vd_norm(fg), -1, h->fruit[h->target].instance);
@@ -532,10 +535,6 @@ static void outcomes(vd_harvest* h) {
     h->ev[h->nev - 1].moment = e->moment;
   }
   // the target
-  if (h->held) {
-    double pf = vd_norm(h->pull_force);
-    if (!h->detached && pf > h->max_pull) h->max_pull = pf;
-  }
   int seg;
   if (h->target >= 0 && !h->detached && !fruit_attached(h, h->target, &seg)) {
     h->detached = 1;
@@ -614,6 +613,7 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_erro
     if (dq > lim && lim / dq < sc) sc = lim / dq;
   }
   for (int k = 0; k < h->narm; k++) h->qcmd[k] += sc * (q[k] - h->qcmd[k]);
+  h->cmd_scale = h->joint_move ? 1 : sc;
   if (h->joint_move || sc < 1) {
     vd_quat r;
     vd_vec3 x;
@@ -625,6 +625,7 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_erro
   if (!h->joint_move && (h->ik_err > 5e-3 || re > 5e-2)) {
     // out of reach: the command stops where the arm can be (no wind-up)
     harvest_event(h, VD_EV_IK, h->ik_err, -1, 0);
+    h->cmd_scale = 0;
     vd_quat r;
     vd_harvest_fk(h, h->qcmd, &h->xcmd, &r);
     if (h->orient) h->rcmd = r;

@@ -103,7 +103,10 @@ struct vd_harvest {
   vd_vec3 pedicel;            // pedicel axis at the fruit, calyx to fruit (unit)
   vd_vec3 pivot;              // bend pivot: the calyx (m)
   vd_vec3 axis;               // bend / twist axis (unit)
-  double progress;            // method motion done (m or rad)
+  double progress;            // method motion done (m or rad): what the command achieved
+  double progress_step;       // the method motion the last action asked for (m or rad)
+  double cmd_scale;           // fraction of the last action's motion the command took (joint
+                              // speed limits scale a step down; 0 when out of reach)
   double settle_t;            // time the command has been at its target (s)
   // outcome
   int detached;

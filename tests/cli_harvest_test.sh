@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# End-to-end tests of `verdant harvest` on the bundled tomato scenes (issue 10, "Done when"): the
+# pull grasps the target and detaches it at a named site with a pedicel force inside the published
+# 0.58-2.46 N (calyx) or 5-8 N (abscission node); bend and twist detach too, the bend with less
+# force than the pull. Frames are off (--frames none) to keep it fast.
+# Usage: cli_harvest_test.sh VERDANT_BINARY SOURCE_DIR
+source "$(dirname "$0")/cli_lib.sh" cli_harvest "$@"
+
+for m in pull bend twist; do
+  expect "harvest $m" 0 "$V" harvest "$SRC/data/scenes/tomato_$m.json" -o "$T/$m" --frames none --stats --no-progress
+  cp "$T/out" "$T/$m.json"
+done
+python3 - "$T" <<'PY' && ok "bundled scenes: sites and forces" || bad "bundled scenes: sites and forces"
+import json, sys
+t = sys.argv[1]
+r = {m: json.load(open(f"{t}/{m}.json")) for m in ("pull", "bend", "twist")}
+bad = []
+for m, d in r.items():
+    if not (d["grasped"] and d["detached"] and d["site"] in ("calyx", "abscission")):
+        bad.append(f"{m}: grasped {d['grasped']} detached {d['detached']} site {d['site']} ({d['reason']})")
+    if json.load(open(f"{t}/{m}/summary.json"))["site"] != d["site"]:
+        bad.append(f"{m}: summary.json and --stats differ")
+p = r["pull"]
+lo, hi = (0.58, 2.46) if p["site"] == "calyx" else (5.0, 8.0)
+if not lo <= p["pedicel_force"] <= hi:
+    bad.append(f"pull: pedicel force {p['pedicel_force']:.3f} N outside {lo}-{hi} N at the {p['site']}")
+if not p["max_pull_force"] >= p["pull_force"] - 1e-12:
+    bad.append(f"pull: max_pull_force {p['max_pull_force']} below pull_force {p['pull_force']}")
+if r["bend"]["detached"] and not r["bend"]["pedicel_force"] < p["pedicel_force"]:
+    bad.append(f"bend {r['bend']['pedicel_force']:.3f} N not below pull {p['pedicel_force']:.3f} N")
+print("\n".join(bad) or "pull %.3f N at the %s, bend %.3f N, twist %.3f N" % (
+    p["pedicel_force"], p["site"], r["bend"]["pedicel_force"], r["twist"]["pedicel_force"]))
+sys.exit(1 if bad else 0)
+PY
+for f in summary.json events.csv trajectory.csv; do
+  [ -s "$T/pull/$f" ] && ok "pull wrote $f" || bad "pull wrote $f"
+done
+grep -q ',detach,' "$T/pull/events.csv" && ok "events: detach" || bad "events: detach"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
