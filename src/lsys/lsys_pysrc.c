@@ -331,7 +331,8 @@ static vd_status translate_incontext(vd_lsystem* ls, const char* t, size_t n, si
   sb_put(out, t + *copied, *i - *copied);
   sb_puts(out, right ? "inRightContext('" : "inLeftContext('");
   for (size_t k = a + 1; k < pe; k++) {
-    char c = t[k] == '\n' || t[k] == '\r' ? ' ' : t[k];
+    char c = t[k];
+    if (c == '\n' || c == '\r') c = ' ';
     if (c == '\'' || c == '\\') sb_put(out, "\\", 1);
     sb_put(out, &c, 1);
   }
