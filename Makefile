@@ -36,6 +36,7 @@ bench: all
 	bash bench/cloud_bench.sh ./$(BUILD)/verdant $(BENCH_ARGS)
 	PYTHONPATH=$(BUILD)/python /usr/bin/python3 bench/python/cloud_bench.py $(BUILD) $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_sim $(BENCH_ARGS)
+	./$(BUILD)/verdant_bench_growth $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_collide --csv bench/results/collide-2core.csv
 	./$(BUILD)/verdant_bench_mujoco --csv bench/results/mujoco-chain-2core.csv
 

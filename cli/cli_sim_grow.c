@@ -362,6 +362,7 @@ static cJSON* stats_json(const vd_growth* g, const vd_growth_def* def, double wa
   cJSON_AddNumberToObject(o, "broken_branches", s.nbroken);
   cJSON_AddBoolToObject(o, "uprooted", s.uprooted);
   cJSON_AddBoolToObject(o, "collapsed", s.collapsed);
+  cJSON_AddBoolToObject(o, "diverged", s.diverged);
   cJSON_AddNumberToObject(o, "momentum_error", s.momentum_error);
   cJSON_AddNumberToObject(o, "angular_momentum_error", s.angular_error);
   cJSON_AddNumberToObject(o, "nodes", s.nnode);

@@ -68,6 +68,11 @@ cmp -s "$T/run/age_003.json" "$T/run2/age_003.json" && ok "deterministic snapsho
 # the paper's own choices, the rods, soils
 expect "grow paper ml" 0 "$V" sim "$TREE" --grow --model mss --paper --ages 3 --substeps 20 --stats
 json_check "paper ml ran" "d['ages'] == 3"
+expect "grow stress without breaking" 0 "$V" sim "$TREE" --grow --model mss --paper --ages 3 --substeps 20 --no-breaking --stats
+json_check "stress without breaking" "d['max_stress'] > 0 and d['broken_branches'] == 0 and not d['diverged']"
+# the seed's eq. 5 with eq. 3 on its own species: a new bud on a heavy node diverges (reported)
+expect "grow paper hopea diverges" 0 "$V" sim "$SRC/data/hopea.lpy" --grow --model mss --paper --species hopea-odorata --ages 3 --no-breaking --stats
+json_check "divergence reported" "d['diverged'] and d['collapsed']"
 expect "grow rods" 0 "$V" sim "$TREE" --grow --model rods --ages 3 --substeps 10 --stats
 json_check "rods grown" "d['model'] == 'rods' and d['height'] > 1.5 and not d['collapsed']"
 expect "grow soil loam" 0 "$V" sim "$TREE" --grow --model mrl --soil loam --ages 3 --substeps 10 --stats

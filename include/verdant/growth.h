@@ -106,7 +106,9 @@ typedef struct vd_growth_stats {
   double kinetic_energy;    // (J)
   int nbroken;              // branches broken so far
   int uprooted;             // 1 after uprooting
-  int collapsed;            // 1 when the height fell below half its rest height
+  int collapsed;            // 1 when the height fell below half its rest height, or diverged
+  int diverged;             // 1 when the state is not finite or the tree left its size (higher
+                            // than 1.5 x its rest height, or a node moved more than twice it)
   double momentum_error;    // largest |change of total momentum| at a growth event (eq. 1, the
                             // mass update, eqs. 6-7), relative to sum m |v| (-)
   double angular_error;     // mrl: largest |L eq. 8 - L true| at a join, relative (-)

@@ -872,6 +872,10 @@ void vd_mss_rigid_refit(const vd_mss_model* m, vd_mss_data* d, vd_vec3 omega);
 // the last substep: the subtree beyond each section is in equilibrium with the section's force N
 // and moment M, sigma = |N| / (pi r^2) + 4 |M| / (pi r^3).
 void vd_mss_stress(const vd_mss_model* m, vd_mss_data* d);
+// The same with the external loads recomputed at the present state (positions, velocities,
+// time): for a model just built or after branches were removed, whose last substep's loads are
+// gone (its accelerations are those of the last substep, zero on a new model: quasi-static).
+void vd_mss_stress_now(const vd_mss_model* m, vd_mss_data* d);
 // Total linear momentum of the free nodes and the rigid body (kg m/s).
 vd_vec3 vd_mss_momentum(const vd_mss_model* m, const vd_mss_data* d);
 // Kinetic energy (J).

@@ -1071,6 +1071,8 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
     if ((st = rebuild(g, 0, err))) return st;
     if ((st = carry_out(g, err))) return st;
   }
+  // stress of the tree as it stands now (also without breaking, and after a rebuild)
+  if (g->mm) vd_mss_stress_now(g->mm, g->md);
   return VD_OK;
 }
 
@@ -1133,7 +1135,9 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
       vd_free(st, sizeof(double) * (size_t)(g->plant->nseg ? g->plant->nseg : 1));
     }
   }
-  out->collapsed = out->height0 > 0 && out->height < 0.5 * out->height0;
+  out->diverged = !isfinite(out->height) || !isfinite(out->max_displacement) ||
+                  (out->height0 > 0 && (out->height > 1.5 * out->height0 || out->max_displacement > 2 * out->height0));
+  out->collapsed = out->diverged || (out->height0 > 0 && out->height < 0.5 * out->height0);
 }
 
 vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err) {

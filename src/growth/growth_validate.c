@@ -11,7 +11,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "growth_tree.h"  // data/tree.lpy as a string (cmake/embed.cmake)
+#include "growth_hopea_lpy.h"  // data/hopea.lpy as a string
+#include "growth_tree_lpy.h"   // data/tree.lpy as a string (cmake/embed.cmake)
 #include "verdant/growth.h"
 
 typedef struct gv {
@@ -19,13 +20,19 @@ typedef struct gv {
   vd_validate_list list;
   vd_status st;
   vd_error* err;
-  vd_lsystem* ls;
+  vd_lsystem* ls;     // data/tree.lpy
+  vd_lsystem* hopea;  // data/hopea.lpy (the seed's species, 25 years)
 } gv;
 
+// name: the case's results, separated by spaces (a filter matching any of them runs the case)
 static int want(gv* v, const char* name) {
   if (v->st) return 0;
   if (v->def->filter && !strstr(name, v->def->filter)) return 0;
-  if (v->def->progress) v->def->progress(v->def->user, name);
+  if (v->def->progress) {
+    char first[64];
+    snprintf(first, sizeof first, "%.*s", (int)strcspn(name, " "), name);
+    v->def->progress(v->def->user, first);
+  }
   return 1;
 }
 
@@ -50,12 +57,12 @@ typedef struct result {
   int ok;
 } result;
 
-static result grow(gv* v, const vd_growth_def* def, int ages) {
+static result grow_on(vd_lsystem* ls, const vd_growth_def* def, int ages) {
   result r;
   memset(&r, 0, sizeof r);
   vd_growth* g = NULL;
   vd_error e = {0};
-  if (vd_growth_create(v->ls, def, &g, &e)) return r;
+  if (!ls || vd_growth_create(ls, def, &g, &e)) return r;
   int ok = 1;
   for (int k = 0; k < ages && ok; k++) ok = vd_growth_step(g, &e) == VD_OK;
   if (ok) {
@@ -75,6 +82,8 @@ static result grow(gv* v, const vd_growth_def* def, int ages) {
   vd_growth_destroy(g);
   return r;
 }
+
+static result grow(gv* v, const vd_growth_def* def, int ages) { return grow_on(v->ls, def, ages); }
 
 static vd_growth_def base_def(vd_growth_model model, int paper) {
   vd_growth_def d = vd_growth_def_default();
@@ -103,7 +112,7 @@ static void case_momentum(gv* v) {
 // seed sec. 4.1: MRL-Tree markedly more rigid than ML-Tree under gravity
 static void case_stiffer(gv* v) {
   const char* name = "finding_mrl_stiffer";
-  if (!want(v, name)) return;
+  if (!want(v, "finding_mrl_stiffer improved_rods_sag improved_rods_standing")) return;
   vd_growth_def ml = base_def(VD_GROWTH_MSS, 1), mrl = base_def(VD_GROWTH_MRL, 1);
   result a = grow(v, &ml, 8), b = grow(v, &mrl, 8);
   double ratio = a.ok && b.ok && b.s.max_displacement > 0 ? a.s.max_displacement / b.s.max_displacement : NAN;
@@ -123,7 +132,7 @@ static void case_stiffer(gv* v) {
 
 // seed sec. 4.2: both models bend toward a light and upward under gravitropism
 static void case_tropisms(gv* v) {
-  const char* name = "finding_tropisms";
+  const char* name = "finding_tropisms finding_phototropism finding_gravitropism";
   if (!want(v, name)) return;
   for (int model = VD_GROWTH_MSS; model <= VD_GROWTH_MRL; model++) {
     vd_growth_def d0 = base_def((vd_growth_model)model, 1);
@@ -200,6 +209,68 @@ static void case_soil(gv* v) {
   finding(v, name, "move with method 1 / with method 2", disp[1] > 0 ? disp[0] / disp[1] : NAN, 1, 1, note);
 }
 
+// the seed's own tree: Hopea odorata, 25 years (data/hopea.lpy, one internode a year, the
+// seed's unit of age), the wood of the species, roots in Singapore's residual soil
+static vd_growth_def hopea_def(vd_growth_model model, int paper) {
+  vd_growth_def d = base_def(model, paper);
+  vd_wood w;
+  if (vd_wood_species("hopea-odorata", &w) == VD_OK)
+    d.mss.young_wood = w.young, d.mss.density_wood = w.density, d.mss.mor = w.mor;
+  vd_soil_preset("singapore-residual", &d.mss.soil);
+  return d;
+}
+
+static double rel_height(const result* r) {
+  return r->ok && r->s.height0 > 0 && !r->s.diverged ? r->s.height / r->s.height0 : NAN;
+}
+
+static void case_hopea(gv* v) {
+  if (!want(v, "finding_hopea_eq5_unstable finding_hopea_mrl_stiffer finding_hopea_wind_ml_collapses "
+               "finding_hopea_wind_mrl_holds improved_hopea_wind"))
+    return;
+  vd_error e = {0};
+  if (!v->hopea && vd_lsys_parse(growth_hopea_lpy, strlen(growth_hopea_lpy), "data/hopea.lpy", &v->hopea, &e)) {
+    v->st = vd_error_set(v->err, e.status ? e.status : VD_ERR_VALUE, "", 0, 0, "validate: data/hopea.lpy: %s", e.msg);
+    return;
+  }
+  char note[200];
+  // seed sec. 3.1.3: eq. 5 "not always able to achieve stability across all portions of the
+  // tree". With c sqrt(k (m1 + m2)) a new bud (the smallest mass) on a heavy node is damped far
+  // beyond critical (zeta = c (m1 + m2) / (2 sqrt(m1 m2))), and eq. 3 takes damping explicitly
+  vd_growth_def d = hopea_def(VD_GROWTH_MSS, 1);
+  result a = grow_on(v->hopea, &d, 3);
+  d.mss.damping = 0;
+  result b = grow_on(v->hopea, &d, 3);
+  snprintf(note, sizeof note, "paper settings (eq. 3, eq. 5 c = 1), 3 years: largest move %.3g m of %.2f m; with c = 0 %.3g m",
+           a.s.max_displacement, a.s.height0, b.s.max_displacement);
+  finding(v, "finding_hopea_eq5_unstable", "largest move / rest height", a.ok && a.s.height0 > 0 ? (isfinite(a.s.max_displacement) ? a.s.max_displacement / a.s.height0 : INFINITY) : NAN,
+          2, 1, note);
+  // the rest with the paper's springs, wind load, Stokes drag and eq. 8, stepped implicitly
+  vd_growth_def ml = hopea_def(VD_GROWTH_MSS, 1), mrl = hopea_def(VD_GROWTH_MRL, 1);
+  ml.opt.integrator = mrl.opt.integrator = VD_MSS_IMPLICIT;
+  result gm = grow_on(v->hopea, &ml, 25), gr = grow_on(v->hopea, &mrl, 25);
+  snprintf(note, sizeof note, "paper springs, implicit, gravity, 25 years: largest move ML %.3f m, MRL %.3f m (height %.1f m)",
+           gm.s.max_displacement, gr.s.max_displacement, gm.s.height0);
+  finding(v, "finding_hopea_mrl_stiffer", "move ML / move MRL", gm.ok && gr.ok && gr.s.max_displacement > 0 ? gm.s.max_displacement / gr.s.max_displacement : NAN, 1, 1, note);
+  // seed sec. 4.3: in wind the ML-Tree collapses where the MRL-Tree holds (wind on the
+  // internodes' projected areas and the leaves: eq. 10 on node cross-sections barely loads a tree)
+  ml.opt.wind_model = mrl.opt.wind_model = VD_MSS_WIND_AREA;
+  ml.opt.wind = mrl.opt.wind = vd_v3(15, 0, 0);
+  result wm = grow_on(v->hopea, &ml, 25), wr = grow_on(v->hopea, &mrl, 25);
+  snprintf(note, sizeof note, "paper springs, implicit, 15 m/s, 25 years: height / rest ML %.2f (%.1f of %.1f m), MRL %.2f",
+           rel_height(&wm), wm.s.height, wm.s.height0, rel_height(&wr));
+  finding(v, "finding_hopea_wind_ml_collapses", "height / rest height, ML", rel_height(&wm), 0.5, -1, note);
+  finding(v, "finding_hopea_wind_mrl_holds", "height / rest height, MRL", rel_height(&wr), 0.5, 1, note);
+  // the improved models in the same wind and soil
+  vd_growth_def mli = hopea_def(VD_GROWTH_MSS, 0), mrli = hopea_def(VD_GROWTH_MRL, 0);
+  mli.opt.wind = mrli.opt.wind = vd_v3(15, 0, 0);
+  mli.opt.breaking = mrli.opt.breaking = 1;
+  result im = grow_on(v->hopea, &mli, 25), ir = grow_on(v->hopea, &mrli, 25);
+  snprintf(note, sizeof note, "improved, 15 m/s, breaking on, 25 years: height / rest ML %.2f, MRL %.2f; tip sway ML %.2f m, MRL %.3f m",
+           rel_height(&im), rel_height(&ir), im.s.tip_displacement, ir.s.tip_displacement);
+  finding(v, "improved_hopea_wind", "smaller height / rest of ML and MRL", fmin(rel_height(&im), rel_height(&ir)), 0.5, 1, note);
+}
+
 vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** out, int* n, vd_error* err) {
   gv v;
   memset(&v, 0, sizeof v);
@@ -210,7 +281,9 @@ vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** ou
   int any = 0;
   const char* names[] = {"growth_momentum", "finding_mrl_stiffer", "improved_rods_sag", "improved_rods_standing",
                          "finding_phototropism", "finding_gravitropism", "finding_tropisms",
-                         "finding_eq3_wider_than_eq4", "improved_wind", "finding_soil_methods"};
+                         "finding_eq3_wider_than_eq4", "improved_wind", "finding_soil_methods",
+                         "finding_hopea_eq5_unstable", "finding_hopea_mrl_stiffer", "finding_hopea_wind_ml_collapses",
+                         "finding_hopea_wind_mrl_holds", "improved_hopea_wind", "finding_hopea"};
   for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) any |= !def->filter || strstr(names[k], def->filter);
   if (!any) return VD_OK;
   vd_status st = vd_lsys_parse(growth_tree_lpy, strlen(growth_tree_lpy), "data/tree.lpy", &v.ls, err);
@@ -222,8 +295,10 @@ vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** ou
     case_stability(&v);
     case_wind(&v);
     case_soil(&v);
+    case_hopea(&v);
   }
   vd_lsys_destroy(v.ls);
+  vd_lsys_destroy(v.hopea);
   if (v.st) {
     vd_free(v.list.r, (size_t)v.list.cap * sizeof(vd_validate_result));
     return v.st;

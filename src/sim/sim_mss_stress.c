@@ -130,3 +130,8 @@ void vd_mss_bastien(const vd_mss_model* m, const vd_mss_data* d, double t, int n
     }
   }
 }
+
+void vd_mss_stress_now(const vd_mss_model* m, vd_mss_data* d) {
+  mss_external(m, d, d->work);
+  vd_mss_stress(m, d);
+}
