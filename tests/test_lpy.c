@@ -281,6 +281,12 @@ TEST(lpy, discard_new_string) {
   DERIVES(src, -1, "ABB");
   // the same in the Python engine, whose __lpyfuture__ provides the EndEach that discards
   PY_DERIVES(src, -1, "ABB");
+  // importlib.reload of it (L-Py's own tests do) gives the run's module back
+  PY_DERIVES("import importlib\nimport openalea.lpy.__lpyfuture__\nimportlib.reload(openalea.lpy.__lpyfuture__)\n"
+             "from openalea.lpy.__lpyfuture__ import *\n"
+             "Axiom: A\nderivation length: 3\nproduction:\nA :\n  if getIterationNb() == 1: DiscardNewString()\n"
+             "  produce A B\n",
+             -1, "ABB");
 }
 
 TEST(lpy, query_modules_filled_before_each_step) {
@@ -447,4 +453,19 @@ TEST(lpy, turtle_angle_increment_of_the_file) {
                e);
   CHECK_NEAR(b.y, -1, 1e-9);
   CHECK_NEAR(b.z, 1, 1e-9);
+}
+
+TEST(lpy, turtle_takes_vectors_python_engine) {
+  // @M(v), @R(h, u) with vector objects or tuples, as L-Py's turtle takes them
+  vd_vec3 b = {0, 0, 0};
+  vd_error e;
+  CHECK_STATUS(grow_end("Axiom: @M(Vector3(1, 2, 3)) F(1)\n", VD_LSYS_PYTHON, &b, &e), VD_OK, e);
+  CHECK_NEAR(b.x, 1, 1e-9);
+  CHECK_NEAR(b.y, 2, 1e-9);
+  CHECK_NEAR(b.z, 4, 1e-9);
+  CHECK_STATUS(grow_end("Axiom: @R((1, 0, 0), Vector3(0, 0, 1)) F(2)\n", VD_LSYS_PYTHON, &b, &e), VD_OK, e);
+  CHECK_NEAR(b.x, 2, 1e-9);
+  CHECK_NEAR(b.z, 0, 1e-9);
+  // an object that is no vector is an error naming it
+  CHECK_STATUS(grow_end("Axiom: @M([1]) F(1)\n", VD_LSYS_PYTHON, &b, &e), VD_ERR_TYPE, e);
 }

@@ -611,6 +611,8 @@ vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* 
 // A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
 vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
                         char* why, size_t cap);
+// A vector (Vector2/3, a tuple of 2 or 3 numbers): its coordinates (z = 0 for 2).
+vd_status lsys_obj_vec(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap);
 // repr() of an object parameter into buf (cap bytes); "None" for a stale handle
 void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 

@@ -1584,6 +1584,25 @@ static double* doubles(PyObject* seq, int* n) {
 
 static void free_doubles(double* a, int n) { vd_free(a, sizeof(double) * (size_t)(n ? n : 1)); }
 
+vd_status lsys_obj_vec(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* r = obj_query(mls, v, "_vd_coords", NULL, why, cap);
+  int k = 0;
+  double* a = r ? doubles(r, &k) : NULL;
+  if (a && (k == 2 || k == 3)) {
+    c[0] = a[0];
+    c[1] = a[1];
+    c[2] = k == 3 ? a[2] : 0;
+    st = VD_OK;
+  }
+  if (a) free_doubles(a, k);
+  Py_XDECREF(r);
+  lsys_py_leave(mls);
+  return st;
+}
+
 vd_status lsys_obj_points(const vd_lsystem* ls, double v, double** p, int* n, int* dim, char* why, size_t cap) {
   vd_lsystem* mls = (vd_lsystem*)ls;
   *p = NULL;

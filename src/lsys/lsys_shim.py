@@ -90,7 +90,26 @@ _real_import = _builtins.__import__
 _local_modules = {}
 
 
+def _vd_reload(module):
+    """importlib.reload for the file: the modules verdant provides (openalea.*) are made fresh for
+    every run already, so reloading one gives it back as it is."""
+    if getattr(module, "__name__", "").startswith("openalea"):
+        return module
+    import importlib
+    return importlib.reload(module)
+
+
+def _importlib_for_files():
+    import importlib
+    m = _types.ModuleType("importlib")
+    m.__dict__.update(importlib.__dict__)
+    m.reload = _vd_reload
+    return m
+
+
 def _vd_import(name, globals=None, locals=None, fromlist=(), level=0):
+    if level == 0 and name == "importlib":
+        return _importlib_for_files()
     if level == 0 and name == "openalea.lpy.__lpyfuture__" and globals is not None:
         mod = globals.get("__vd_future")
         if mod is None:
@@ -1980,6 +1999,15 @@ def _mesh_of(g):
         return None
     f = getattr(g, "_mesh", None)
     return f() if f is not None else None
+
+
+def _vd_coords(o):
+    """A turtle argument given as a vector (@M(v), @Tp(v), @R(h, u) ...): its 2 or 3 coordinates."""
+    try:
+        c = tuple(float(x) for x in o)
+    except (TypeError, ValueError):
+        return None
+    return c if len(c) in (2, 3) else None
 
 
 def _vd_vec3(c):

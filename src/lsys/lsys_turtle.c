@@ -1297,13 +1297,27 @@ static vd_status angle_arg(turtle* T, double* deg) {
 }
 
 // a vector from up to three parameters starting at k (missing ones from dflt)
-static vd_status vec_args(turtle* T, int k, vd_vec3 dflt, vd_vec3* out) {
+// a vector from parameter k on: three numbers, or one vector object (Python engine: Vector3,
+// a tuple, as L-Py's turtle takes them); *used (Nullable) = the parameters it took
+static vd_status vec_args_n(turtle* T, int k, vd_vec3 dflt, vd_vec3* out, int* used) {
   vd_status st;
+  if (used) *used = 3;
+  if (k < T->np && isnan(T->p[k]) && !vd_lsys_value_is_str(T->p[k])) {
+    double c[3];
+    char why[160] = "";
+    if (!T->ls || lsys_obj_vec(T->ls, T->p[k], c, why, sizeof why))
+      return fail(T, VD_ERR_TYPE, "parameter %d is %s, expected numbers or a vector", k + 1, why[0] ? why : "an object");
+    *out = vd_v3(c[0], c[1], c[2]);
+    if (used) *used = 1;
+    return VD_OK;
+  }
   if ((st = num_or(T, k, dflt.x, &out->x)) || (st = num_or(T, k + 1, dflt.y, &out->y)) ||
       (st = num_or(T, k + 2, dflt.z, &out->z)))
     return st;
   return VD_OK;
 }
+
+static vd_status vec_args(turtle* T, int k, vd_vec3 dflt, vd_vec3* out) { return vec_args_n(T, k, dflt, out, NULL); }
 
 // @v(alpha): roll about H so that U comes closest to vertical (PlantGL rollToVert)
 static void roll_to_vert(turtle* T, double alpha) {
@@ -1605,10 +1619,11 @@ static vd_status step(turtle* T) {
   case VD_SYM_SETHEAD: {
     vd_vec3 u;
     if (T->np == 0) return set_head(T, vd_v3(0, 0, 1), vd_v3(1, 0, 0));
-    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = vec_args(T, 3, vd_v3(0, 0, 0), &u)))
+    int used;
+    if ((st = vec_args_n(T, 0, vd_v3(0, 0, 0), &v, &used)) || (st = vec_args(T, used, vd_v3(0, 0, 0), &u)))
       return st;
     if (vd_norm(v) < EPS) return fail(T, VD_ERR_VALUE, "zero heading");
-    if (T->np <= 3 || vd_norm(u) < EPS) {
+    if (T->np <= used || vd_norm(u) < EPS) {
       // no usable up: turn toward the heading like PinpointRel
       tend_to(T, vd_normalize(v), 1);
       return VD_OK;
