@@ -373,6 +373,7 @@ static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 // (with source index src)
 static vd_status interpretation_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src,
                                      int64_t max_modules) {
+  if (ls->py) return lsys_py_produce_hook(ls, name, out, src, max_modules);
   int fi = find_hook(ls, name);
   if (fi < 0) return VD_OK;
   func* f = ls->funcs[fi];
@@ -468,6 +469,21 @@ static vd_status query_objects(vd_lsystem* ls, vd_lstring* s, const vd_lstring* 
   vd_lstring_free(s);
   *s = t;
   return VD_OK;
+}
+
+vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant) {
+  lsys_pass P;
+  memset(&P, 0, sizeof P);
+  P.max_modules = INT64_MAX / 64;
+  vd_lstring geo = vd_lstring_empty();
+  vd_status st = interpret_into(ls, s, &geo, &P);
+  if (!st) {
+    vd_turtle_def td = vd_turtle_def_default();
+    st = vd_turtle_run(ls, &geo, &td, plant, ls->err);
+  }
+  vd_lstring_free(&geo);
+  lsys_pass_free(&P);
+  return st;
 }
 
 // L-Py's environmental programs: before a step whose rules read query modules, the turtle
@@ -705,18 +721,6 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
 
 const char* lsys_file(const vd_lsystem* ls) { return ls->file; }
 
-vd_status lsys_scene_of(vd_lsystem* ls, const vd_lstring* s, vd_lstring* geo, vd_plant_spec* plant,
-                        int64_t max_modules) {
-  lsys_pass P;
-  memset(&P, 0, sizeof P);
-  P.max_modules = max_modules;
-  if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
-  vd_status st = interpret_into(ls, s, geo, &P);
-  lsys_pass_free(&P);
-  if (st) return st;
-  vd_turtle_def d = vd_turtle_def_default();
-  return vd_turtle_run(ls, geo, &d, plant, ls->err);
-}
 
 int lsys_turtle_angle(const vd_lsystem* ls, double* angle) {
   if (ls->has_turtle_angle) *angle = ls->turtle_angle;

@@ -505,11 +505,6 @@ vd_status lsys_set_option(vd_lsystem* ls, const char* name, int nlen, long v, in
 int lsys_turtle_angle(const vd_lsystem* ls, double* angle);
 // The file name of an lsystem ("" when parsed from text without one).
 const char* lsys_file(const vd_lsystem* ls);
-// L-Py's scene argument of the hooks EndEach(lstring, scene) / End(lstring, scene): s interpreted
-// (interpretation rules and hooks run, as L-Py computes its scene) into geo, whose src maps back
-// to s, and drawn by the turtle into plant
-vd_status lsys_scene_of(vd_lsystem* ls, const vd_lstring* s, vd_lstring* geo, vd_plant_spec* plant,
-                        int64_t max_modules);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
 // With cur (nullable), where the contexts ended (InLeftContext / InRightContext go on from there).
 int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end,
@@ -588,6 +583,12 @@ vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds);
 // call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
 // the current string (an End hook may return a new one). Missing hooks are fine.
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
+// call hook name (StartInterpretation, EndInterpretation) with what it produces appended to out,
+// recorded as coming from module src; a hook that declares a parameter gets the turtle (None)
+vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules);
+// the plant the string s draws (interpretation with its hooks, then the turtle), for the scene
+// a Python hook receives (EndEach(lstring, lscene))
+vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant);
 // drop objects that no module of s refers to any more (after a step)
 void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)
@@ -608,11 +609,14 @@ vd_status lsys_obj_guide(const vd_lsystem* ls, double v, int m, double* length, 
 // A function of x: its range and its n samples at equal steps (QuantisedFunction).
 vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* lx, double** val, int* n, char* why,
                             size_t cap);
+// A 3D vector (Vector3, a sequence of three numbers) as c[0..2].
+vd_status lsys_obj_vec3(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap);
 // A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
 vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
                         char* why, size_t cap);
-// A vector (Vector2/3, a tuple of 2 or 3 numbers): its coordinates (z = 0 for 2).
-vd_status lsys_obj_vec(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap);
+// The turtle settings the file made through context().turtle (setAngleIncrement,
+// setWidthIncrement, setScaleMultiplier, setElasticity) applied over td (Python engine).
+void lsys_py_turtle_def(const vd_lsystem* ls, vd_turtle_def* td);
 // repr() of an object parameter into buf (cap bytes); "None" for a stale handle
 void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 

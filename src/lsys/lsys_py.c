@@ -288,6 +288,9 @@ void lsys_py_leave(vd_lsystem* ls) {
 static vd_status status_of(PyObject* type) {
   if (PyErr_GivenExceptionMatches(type, PyExc_SyntaxError)) return VD_ERR_SYNTAX;
   if (PyErr_GivenExceptionMatches(type, PyExc_NameError)) return VD_ERR_NAME;
+  // a PlantGL / L-Py name the shim does not have (lsys_shim.py _NotInShim): a refusal
+  PyObject* nis = g_shim ? PyDict_GetItemString(g_shim, "_NotInShim") : NULL;  // borrowed
+  if (nis && PyErr_GivenExceptionMatches(type, nis)) return VD_ERR_UNSUPPORTED;
   if (PyErr_GivenExceptionMatches(type, PyExc_AttributeError)) return VD_ERR_NAME;
   if (PyErr_GivenExceptionMatches(type, PyExc_TypeError)) return VD_ERR_TYPE;
   if (PyErr_GivenExceptionMatches(type, PyExc_AssertionError)) return VD_ERR_ASSERT;
@@ -811,6 +814,65 @@ static PyObject* vd_append(PyObject* self, PyObject* arg) {
   return py_none();
 }
 
+static PyObject* vec_tuple(vd_vec3 v) { return Py_BuildValue("(ddd)", v.x, v.y, v.z); }
+
+// a primitive of the hook's scene: (kind, module, parent, ...) as _vd_build_scene reads it
+static PyObject* scene_prims(const vd_plant_spec* p) {
+  PyObject* list = PyList_New(0);
+  for (int i = 0; list && i < p->nseg; i++) {
+    const vd_segment_spec* g = &p->seg[i];
+    PyObject* it = Py_BuildValue("(sLiNNddN)", "seg", (long long)g->module, g->parent, vec_tuple(p->node[g->node0]),
+                                 vec_tuple(p->node[g->node1]), g->r0, g->r1, vec_tuple(g->up));
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  for (int i = 0; list && i < p->nsphere; i++) {
+    const vd_sphere_spec* g = &p->sphere[i];
+    PyObject* it =
+        Py_BuildValue("(sLiNd)", "sph", (long long)g->module, g->parent, vec_tuple(g->center), g->radius);
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  for (int i = 0; list && i < p->nmesh; i++) {
+    const vd_mesh_spec* m = &p->mesh[i];
+    PyObject* v = PyList_New(m->nvert);
+    PyObject* t = PyList_New(m->ntri);
+    for (int k = 0; v && k < m->nvert; k++) PyList_SET_ITEM(v, k, vec_tuple(p->vert[m->vert_start + k]));
+    for (int k = 0; t && k < m->ntri; k++) {
+      const int* q = &p->tri[3 * (m->tri_start + k)];
+      PyList_SET_ITEM(t, k, Py_BuildValue("(iii)", q[0], q[1], q[2]));
+    }
+    PyObject* it = v && t ? Py_BuildValue("(sLiNNi)", "mesh", (long long)m->module, m->parent, v, t, m->closed) : NULL;
+    if (!it) {
+      Py_XDECREF(v);
+      Py_XDECREF(t);
+    }
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  return list;
+}
+
+// _vd.scene(): the primitives the hook's string draws
+static PyObject* vd_scene(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  if (!ls->py->hook_s) {
+    PyErr_SetString(PyExc_RuntimeError, "the scene is only known inside a hook");
+    return NULL;
+  }
+  vd_plant_spec* p = vd_plant_spec_create();
+  if (!p) return PyErr_NoMemory();
+  vm_out* saved = ls->py->out;
+  vd_status st = lsys_scene(ls, ls->py->hook_s, p);
+  ls->py->out = saved;
+  PyObject* r = st ? NULL : scene_prims(p);
+  vd_plant_spec_destroy(p);
+  if (st) return vd_abort();
+  return r;
+}
+
 static PyObject* vd_use_group(PyObject* self, PyObject* arg) {
   (void)self;
   vd_lsystem* ls = current();
@@ -945,6 +1007,7 @@ static PyMethodDef vd_methods[] = {
     {"mk", (PyCFunction)(void (*)(void))vd_mk, METH_FASTCALL, "the items of a template"},
     {"parse", vd_parse, METH_O, "modules of an L-string text"},
     {"append", vd_append, METH_O, "append (name, params) items to the production"},
+    {"scene", vd_scene, METH_NOARGS, "the primitives the hook's string draws"},
     {"use_group", vd_use_group, METH_O, "useGroup"},
     {"get_group", vd_get_group, METH_NOARGS, "getGroup"},
     {"iteration", vd_iteration, METH_NOARGS, "getIterationNb"},
@@ -1210,69 +1273,17 @@ static int arity(PyObject* f) {
   return k;
 }
 
-// the module of s behind a primitive (the turtle maps the interpretation's modules back to s)
-static long long shape_id(const vd_lstring* geo, int64_t m) {
-  (void)geo;
-  return m < 0 ? -1 : (long long)(m & ~LSYS_SRC_IDENTITY);
-}
-
-// a list's items appended (a new reference stolen); 0 with an exception on failure
-static int push(PyObject* list, PyObject* it) {
-  if (!it) return 0;
-  int r = PyList_Append(list, it);
-  Py_DECREF(it);
-  return r == 0;
-}
-
-// the scene of s for a hook (L-Py's PlantGL scene: one shape per primitive the turtle draws, its
-// id the module of s that drew it); NULL with the error in ls->err or a Python exception
-static PyObject* scene_object(vd_lsystem* ls, const vd_lstring* s, int64_t max_modules) {
-  vd_lstring geo = vd_lstring_empty();
-  vd_plant_spec* plant = vd_plant_spec_create();
-  if (!plant) {
-    vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
-    return NULL;
-  }
-  vd_status st = lsys_scene_of(ls, s, &geo, plant, max_modules);
-  PyObject* items = st ? NULL : PyList_New(0);
-  int ok = items != NULL;
-  for (int k = 0; ok && k < plant->nseg; k++) {
-    const vd_segment_spec* g = &plant->seg[k];
-    vd_vec3 a = plant->node[g->node0], b = plant->node[g->node1];
-    ok = push(items, Py_BuildValue("(Lii(ddd)(ddd)(ddd)dd)", shape_id(&geo, g->module), 0, g->label, a.x, a.y, a.z, b.x,
-                                   b.y, b.z, g->up.x, g->up.y, g->up.z, g->r0, g->r1));
-  }
-  for (int k = 0; ok && k < plant->nsphere; k++) {
-    const vd_sphere_spec* g = &plant->sphere[k];
-    ok = push(items, Py_BuildValue("(Lii(ddd)d)", shape_id(&geo, g->module), 1, g->label, g->center.x, g->center.y,
-                                   g->center.z, g->radius));
-  }
-  for (int k = 0; ok && k < plant->nmesh; k++) {
-    const vd_mesh_spec* g = &plant->mesh[k];
-    PyObject* v = PyList_New(0);
-    PyObject* t = PyList_New(0);
-    ok = v && t;
-    for (int i = 0; ok && i < g->nvert; i++) {
-      vd_vec3 p = plant->vert[g->vert_start + i];
-      ok = push(v, Py_BuildValue("(ddd)", p.x, p.y, p.z));
-    }
-    for (int i = 0; ok && i < g->ntri; i++) {
-      const int* q = plant->tri + 3 * (g->tri_start + i);
-      ok = push(t, Py_BuildValue("(iii)", q[0] - g->vert_start, q[1] - g->vert_start, q[2] - g->vert_start));
-    }
-    ok = ok && push(items, Py_BuildValue("(LiiOOi)", shape_id(&geo, g->module), 2, g->label, v, t, g->closed));
-    Py_XDECREF(v);
-    Py_XDECREF(t);
-  }
-  vd_plant_spec_destroy(plant);
-  vd_lstring_free(&geo);
-  if (!ok) {
-    Py_XDECREF(items);
-    return NULL;
-  }
-  PyObject* scene = shim_call("_vd_scene", items);
-  Py_DECREF(items);
-  return scene;
+vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules) {
+  lsys_py* py = ls->py;
+  if (!py->ns) return VD_OK;
+  PyObject* f = PyDict_GetItemString(py->ns, name);  // borrowed
+  if (!f || !PyCallable_Check(f)) return VD_OK;
+  PyObject* args[1] = {Py_None};
+  vm_out vo = {out, src, max_modules, 0, 0};
+  Py_INCREF(f);
+  vd_status st = call_rule(ls, f, args, arity(f) >= 1 ? 1 : 0, &vo);
+  Py_DECREF(f);
+  return st;
 }
 
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules) {
@@ -1291,10 +1302,10 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
     n = 1;
   }
   if (want >= 2) {
-    args[1] = scene_object(ls, s, max_modules);
+    args[1] = shim_call("_vd_lazy_scene", NULL);  // made from s when the hook reads it
     if (!args[1]) {
       Py_DECREF(args[0]);
-      return ls->err && ls->err->status ? ls->err->status : py_error(ls);
+      return py_error(ls);
     }
     n = 2;
   }
@@ -1308,34 +1319,32 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   }
   lstr_clear(scratch);
   vm_out* saved = py->out;
+  const vd_lstring* saved_s = py->hook_s;
   py->out = &vo;  // an nproduce in a hook has nowhere to go but is not an error
+  py->hook_s = s;
   PyObject* r = PyObject_Vectorcall(f, args, (size_t)n, NULL);
   py->out = saved;
+  py->hook_s = saved_s;
   Py_DECREF(f);
-  PyObject* lobj = n ? args[0] : NULL;  // the string the hook was given (kept)
-  for (int i = 1; i < n; i++) Py_DECREF(args[i]);
-  if (!r) {
-    Py_XDECREF(lobj);
-    return py_error(ls);
+  // a hook that changed the L-string it was given in place (lstring[0][0] = 2) and returned
+  // nothing: the changed string is the result, as the hook saw L-Py's own string
+  if (r == Py_None && n >= 1) {
+    Py_DECREF(r);
+    Py_INCREF(args[0]);
+    r = args[0];
   }
+  for (int i = 0; i < n; i++) Py_DECREF(args[i]);
+  if (!r) return py_error(ls);
   vd_status st = VD_OK;
-  // L-Py's EndEach(lstring, scene) may return (lstring, scene), the lstring, or the scene
+  // a hook may return (lstring, scene): the string counts
   if (PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 2) {
     PyObject* first = PyTuple_GET_ITEM(r, 0);
     Py_INCREF(first);
     Py_DECREF(r);
     r = first;
   }
-  if (r == Py_None && lobj) {
-    // nothing returned: the string it was given, changed in place or not (lstring[0][0] = 2)
-    Py_DECREF(r);
-    r = lobj;
-  } else {
-    Py_XDECREF(lobj);
-  }
   PyObject* scene_type = PyDict_GetItemString(g_shim, "Scene");  // borrowed
-  int is_scene = scene_type && PyObject_IsInstance(r, scene_type) == 1;
-  if (r != Py_None && r != Py_True && r != Py_False && !is_scene) {
+  if (r != Py_None && r != Py_True && r != Py_False && !(scene_type && PyObject_IsInstance(r, scene_type) == 1)) {
     // the hook returned a new string: it replaces the current one
     PyObject* items = shim_call("_vd_items", r);
     lstr_clear(scratch);
@@ -1354,7 +1363,7 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
 
 vd_status lsys_py_vec3(vd_lsystem* ls, double x, double y, double z, double* out) {
   PyObject* c = Py_BuildValue("(ddd)", x, y, z);
-  PyObject* v = c ? shim_call("_vd_vec3", c) : NULL;
+  PyObject* v = c ? shim_call("_vd_make_vec3", c) : NULL;
   Py_XDECREF(c);
   int ok = v && keep_object(ls, v, out);
   Py_XDECREF(v);
@@ -1584,21 +1593,22 @@ static double* doubles(PyObject* seq, int* n) {
 
 static void free_doubles(double* a, int n) { vd_free(a, sizeof(double) * (size_t)(n ? n : 1)); }
 
-vd_status lsys_obj_vec(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap) {
+vd_status lsys_obj_vec3(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap) {
   vd_lsystem* mls = (vd_lsystem*)ls;
   lsys_py_enter(mls);
   vd_status st = VD_ERR_TYPE;
-  PyObject* r = obj_query(mls, v, "_vd_coords", NULL, why, cap);
+  PyObject* r = obj_query(mls, v, "_vd_vec3", NULL, why, cap);
   int k = 0;
-  double* a = r ? doubles(r, &k) : NULL;
-  if (a && (k == 2 || k == 3)) {
-    c[0] = a[0];
-    c[1] = a[1];
-    c[2] = k == 3 ? a[2] : 0;
+  double* p = r ? doubles(r, &k) : NULL;
+  if (p && k == 3 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
+    memcpy(c, p, sizeof(double) * 3);
     st = VD_OK;
+  } else if (r) {
+    snprintf(why, cap, "a vector that is not three finite numbers");
   }
-  if (a) free_doubles(a, k);
+  if (p) free_doubles(p, k);
   Py_XDECREF(r);
+  PyErr_Clear();
   lsys_py_leave(mls);
   return st;
 }
@@ -1730,4 +1740,23 @@ vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, i
   PyErr_Clear();
   lsys_py_leave(mls);
   return st;
+}
+
+void lsys_py_turtle_def(const vd_lsystem* ls, vd_turtle_def* td) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  if (!ls || !ls->py || !ls->py->ns || g_state != 1) return;
+  lsys_py_enter(mls);
+  PyObject* d = shim_call("_vd_turtle_settings", ls->py->ns);
+  static const char* names[] = {"setAngleIncrement", "setWidthIncrement", "setScaleMultiplier", "setElasticity"};
+  double* fields[] = {&td->angle, &td->width_inc, &td->scale_factor, &td->elasticity};
+  for (int k = 0; d && PyDict_Check(d) && k < 4; k++) {
+    PyObject* a = PyDict_GetItemString(d, names[k]);  // borrowed: the arguments' tuple
+    if (!a || !PyTuple_Check(a) || PyTuple_GET_SIZE(a) < 1) continue;
+    double v = PyFloat_AsDouble(PyTuple_GET_ITEM(a, 0));
+    if (!PyErr_Occurred() && isfinite(v)) *fields[k] = v;
+    PyErr_Clear();
+  }
+  Py_XDECREF(d);
+  PyErr_Clear();
+  lsys_py_leave(mls);
 }
