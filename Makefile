@@ -39,6 +39,7 @@ bench: all
 	./$(BUILD)/verdant_bench_growth $(BENCH_ARGS)
 	./$(BUILD)/verdant_bench_collide --csv bench/results/collide-2core.csv
 	./$(BUILD)/verdant_bench_mujoco --csv bench/results/mujoco-chain-2core.csv
+	./$(BUILD)/verdant_bench_harvest $(BENCH_ARGS)
 
 demo: all
 	@bash scripts/demo.sh ./$(BUILD)/verdant

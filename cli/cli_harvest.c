@@ -534,7 +534,7 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
   double* force = vd_malloc(sizeof(double) * (size_t)n * 2);
   double* pforce = force ? force + n : NULL;
   int nf = 0, ndet[VD_HARVEST_METHOD_COUNT] = {0}, nep[VD_HARVEST_METHOD_COUNT] = {0};
-  int nsite[VD_SITE_COUNT] = {0}, ndetached = 0, ngrasp = 0;
+  int nsite[VD_SITE_COUNT] = {0}, ndetached = 0, ngrasp = 0, nharvest = 0;
   if (!st && !force) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   if (!st) {
     fputs("episode,plant_seed,target_instance,method,speed,distance,angle_deg,grip_force,grasped,detached,site,"
@@ -556,12 +556,15 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
       int gr = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(r, "grasped"));
       const char* site = str_of(r, "site");
       nep[mi]++;
-      ndet[mi] += det;
+      // a success is a harvest: the fruit came off while the gripper held it (a fruit knocked
+      // off without a grasp counts as detached, not as harvested)
+      ndet[mi] += det && gr;
+      nharvest += det && gr;
       ndetached += det;
       ngrasp += gr;
       for (int i = 0; i < VD_SITE_COUNT; i++)
         if (!strcmp(site, vd_harvest_site_name((vd_harvest_site)i))) nsite[i]++;
-      if (det) force[nf] = num_of(r, "pull_force"), pforce[nf] = num_of(r, "pedicel_force"), nf++;
+      if (det && gr) force[nf] = num_of(r, "pull_force"), pforce[nf] = num_of(r, "pedicel_force"), nf++;
       fprintf(f.fp, "%d,%.0f,%.0f,%s,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%.6f,%.6g,%.6g,%.6g,%.6g,%.0f,%.0f,%s\n", k,
               num_of(r, "plant_seed"), num_of(r, "target_instance"), method, num_of(r, "speed"),
               num_of(r, "distance"), num_of(r, "angle_deg"), num_of(r, "grip_force"), gr, det, site,
@@ -583,13 +586,14 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
     cJSON_AddNumberToObject(o, "episodes", n);
     cJSON_AddNumberToObject(o, "grasped", ngrasp);
     cJSON_AddNumberToObject(o, "detached", ndetached);
-    cJSON_AddNumberToObject(o, "success_rate", n ? (double)ndetached / n : 0);
+    cJSON_AddNumberToObject(o, "harvested", nharvest);
+    cJSON_AddNumberToObject(o, "success_rate", n ? (double)nharvest / n : 0);
     cJSON* pm = cJSON_AddObjectToObject(o, "per_method");
     for (int i = 0; i < VD_HARVEST_METHOD_COUNT; i++) {
       if (!nep[i]) continue;
       cJSON* e = cJSON_AddObjectToObject(pm, vd_harvest_method_name((vd_harvest_method)i));
       cJSON_AddNumberToObject(e, "episodes", nep[i]);
-      cJSON_AddNumberToObject(e, "detached", ndet[i]);
+      cJSON_AddNumberToObject(e, "harvested", ndet[i]);
       cJSON_AddNumberToObject(e, "success_rate", (double)ndet[i] / nep[i]);
     }
     cJSON* ps = cJSON_AddObjectToObject(o, "sites");
@@ -613,6 +617,9 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
     return EXIT_FAIL;
   }
   if (text) puts(text);
+  else
+    fprintf(stderr, "verdant harvest: %d episodes: success rate %.3f (%d harvested, %d detached, %d grasped); %s\n",
+            n, n ? (double)nharvest / n : 0, nharvest, ndetached, ngrasp, path);
   free(text);
   return EXIT_OK;
 }

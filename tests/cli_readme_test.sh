@@ -37,7 +37,8 @@ def run(cmd, timeout=600):
 
 # sizes cut for the test: the README's commands as written, smaller
 SCALE = [(r"--count 1000\b", "--count 2"), (r"--count 100\b", "--count 2"), (r"--images 4\b", "--images 1"),
-         (r"--points 1000000\b", "--points 20000"), (r"--points 100000\b", "--points 5000")]
+         (r"--points 1000000\b", "--points 20000"), (r"--points 100000\b", "--points 5000"),
+         (r"--episodes 20\b", "--episodes 2")]
 
 blocks = re.findall(r"^```([a-z]*)\n(.*?)^```", readme, re.S | re.M)
 report(len(blocks) >= 8, "README has its code blocks", str(len(blocks)))

@@ -202,7 +202,9 @@ TEST(robot, stiff_branch_stops_weak_arm) {
 }
 
 // run the scripted method on the truss; summary out
-static void harvest_truss(const char* method, const char* extra, vd_harvest_summary* out, uint64_t* hash) {
+// stepwise: one vd_harvest_step_scripted at a time instead of vd_harvest_run
+static void harvest_truss_by(const char* method, const char* extra, vd_harvest_summary* out, uint64_t* hash,
+                             int stepwise) {
   vd_error e = {0};
   vd_scene s;
   memset(out, 0, sizeof *out);
@@ -214,7 +216,8 @@ static void harvest_truss(const char* method, const char* extra, vd_harvest_summ
   vd_harvest* h = NULL;
   vd_status st = vd_harvest_create(&s, pm, &h, &e);
   if (st) vdt_fail(__FILE__, __LINE__, "create: %s", e.msg);
-  if (!st) st = vd_harvest_run(h, NULL, NULL, &e);
+  if (!st && !stepwise) st = vd_harvest_run(h, NULL, NULL, &e);
+  while (!st && stepwise && !vd_harvest_done(h)) st = vd_harvest_step_scripted(h, &e);
   if (st) vdt_fail(__FILE__, __LINE__, "run: %s", e.msg);
   if (h) vd_harvest_summarize(h, out);
   if (h && getenv("VDT_VERBOSE")) {
@@ -240,6 +243,10 @@ static void harvest_truss(const char* method, const char* extra, vd_harvest_summ
   vd_harvest_destroy(h);
   vd_model_destroy(pm);
   vd_scene_free(&s);
+}
+
+static void harvest_truss(const char* method, const char* extra, vd_harvest_summary* out, uint64_t* hash) {
+  harvest_truss_by(method, extra, out, hash, 0);
 }
 
 TEST(robot, pull_detaches_at_calyx) {
@@ -269,6 +276,32 @@ TEST(robot, deterministic) {
   harvest_truss("\"name\": \"pull\", \"speed\": 0.04, \"distance\": 0.1", NULL, &b, &hb);
   CHECK(ha == hb);
   CHECK(a.time == b.time && a.pull_force == b.pull_force);
+  // the scripted controller one step at a time (an observer between steps): the same episode
+  vd_harvest_summary c;
+  uint64_t hc = 2;
+  harvest_truss_by("\"name\": \"pull\", \"speed\": 0.04, \"distance\": 0.1", NULL, &c, &hc, 1);
+  CHECK(hc == ha);
+  CHECK(c.detached && c.time == a.time && c.steps == a.steps);
+}
+
+TEST(robot, scripted_steps_refused_after_external) {
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  vd_model* pm = robot_truss(0.012);
+  vd_harvest* h = NULL;
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
+  REQUIRE(h);
+  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_OK, e);
+  CHECK_INT(h->phase, VD_PHASE_APPROACH);
+  vd_harvest_action a = {{0, 0, 0}, {0, 0, 0}, 0};
+  CHECK_STATUS(vd_harvest_step(h, &a, &e), VD_OK, e);
+  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_ERR_ARG, e);
+  CHECK_STATUS(vd_harvest_reset(h, 0, &e), VD_OK, e);
+  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_OK, e);
+  vd_harvest_destroy(h);
+  vd_model_destroy(pm);
+  vd_scene_free(&s);
 }
 
 TEST(robot, unreachable_target) {

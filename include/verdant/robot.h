@@ -299,8 +299,14 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err);
 // Advance one control step under action a (external control: the scripted controller is off
 // until the next reset). VD_ERR_VALUE when MuJoCo or the plant failed (the episode is done).
 vd_status vd_harvest_step(vd_harvest* h, const vd_harvest_action* a, vd_error* err);
-// The scripted controller's action for the current state (and its phase bookkeeping).
+// The scripted controller's action for the current state (stepping with it through
+// vd_harvest_step turns the scripted controller off; vd_harvest_step_scripted keeps it on).
 void vd_harvest_scripted_action(vd_harvest* h, vd_harvest_action* a);
+// Advance one control step under the scene's scripted controller, with its phase bookkeeping:
+// a caller can observe between steps and the episode is the same, byte for byte, as
+// vd_harvest_run's. VD_ERR_ARG when the episode is over or vd_harvest_step has driven it since
+// the last reset; VD_ERR_VALUE when MuJoCo or the plant failed (the episode is done).
+vd_status vd_harvest_step_scripted(vd_harvest* h, vd_error* err);
 // Run the scene's scripted method to the end (detached and held, failed, or duration).
 // on_step (Nullable) is called once before the first control step and after every one (for
 // outputs and progress); a status it returns stops the run and is returned.

@@ -670,16 +670,31 @@ void vd_harvest_scripted_action(vd_harvest* h, vd_harvest_action* a) {
   control_action(h, a);
 }
 
+// one control step of the scripted controller: its action, the step, its phase bookkeeping
+static vd_status scripted_step(vd_harvest* h, vd_error* err) {
+  vd_harvest_action a;
+  control_action(h, &a);
+  vd_status st = control_step(h, &a, err);
+  if (!st) control_after_step(h);
+  return st;
+}
+
+vd_status vd_harvest_step_scripted(vd_harvest* h, vd_error* err) {
+  if (!h->scripted)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        "the scripted controller is off (vd_harvest_step drove this episode): reset it");
+  if (h->target < 0) harvest_finish(h, h->reason);  // nothing to pick: over at once
+  if (h->done) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the episode is over (reset it)");
+  return scripted_step(h, err);
+}
+
 vd_status vd_harvest_run(vd_harvest* h, vd_status (*on_step)(void* user, const vd_harvest* h),
                          void* user, vd_error* err) {
   vd_status st = VD_OK;
   if (h->target < 0 && h->scripted) harvest_finish(h, h->reason);
   if (on_step && (st = on_step(user, h))) return st;
   while (!h->done) {
-    vd_harvest_action a;
-    control_action(h, &a);
-    if ((st = control_step(h, &a, err))) return st;
-    control_after_step(h);
+    if ((st = scripted_step(h, err))) return st;
     if (on_step && (st = on_step(user, h))) return st;
   }
   return VD_OK;
