@@ -37,6 +37,8 @@ typedef struct cli_plant_opts {
   double curve_distance;   // --curve-distance (m), < 0: the file's or the default
   int engine;              // --engine auto|native|python (vd_lsys_engine), VD_LSYS_AUTO by default
   const char* lstring_out; // --lstring FILE: the derived L-string as JSON (.lpy files), NULL: none
+  int instances;           // --instances: a vd_instance_mode, or -1 (default): organs for .lpy
+                           // files, a plant file's own numbering
 } cli_plant_opts;
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
@@ -96,6 +98,17 @@ void cli_unwatch(int slot);
 
 // Monotonic seconds.
 double cli_now(void);
+// A progress bar on stderr: "\rWHAT [####    ] TEXT" (frac in [0, 1]); the caller ends it with
+// a newline. Callers show it only when stderr is a terminal (cli_plant_opts.progress).
+void cli_progress_bar(const char* what, double frac, const char* text);
+// When to redraw a bar: at the first call, then at most ten times a second; off when on is 0.
+typedef struct cli_progress {
+  int on, shown;
+  double last;  // cli_now() of the last redraw
+} cli_progress;
+int cli_progress_due(cli_progress* p);
+// End a bar that was shown (a newline).
+void cli_progress_end(cli_progress* p);
 // Does path end with ext (case-insensitive, ext with the dot)?
 int cli_has_ext(const char* path, const char* ext);
 

@@ -254,6 +254,24 @@ int cli_cloud_check(const cli_cloud_opts* o, const char* cmd) {
 // ---------------------------------------------------------------------------------------------
 // the pipeline: load, compile, scanners, sample, relabel, write
 
+// progress bars of the sampling (chunks) and the writing (points)
+typedef struct cloud_bar {
+  cli_progress bar;
+  const char* what;
+  int64_t best;  // chunks may finish out of order: the bar never goes back
+} cloud_bar;
+
+static void cloud_progress(void* user, int64_t done, int64_t total) {
+  cloud_bar* b = user;
+  if (!b->bar.on) return;
+  if (done > b->best) b->best = done;
+  if (!cli_progress_due(&b->bar) && b->best < total) return;
+  char text[64];
+  snprintf(text, sizeof text, "%3d%%", total > 0 ? (int)(100.0 * (double)b->best / (double)total) : 100);
+  cli_progress_bar(b->what, total > 0 ? (double)b->best / (double)total : 1, text);
+  b->bar.shown = 1;
+}
+
 vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, const char* out,
                          cli_cloud_result* res, vd_error* err) {
   memset(res, 0, sizeof *res);
@@ -306,7 +324,11 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
     def.seed = co->has_cloud_seed ? co->cloud_seed : po->seed;
     def.nscanner = n + nfile;
     def.scanner = sc;
+    cloud_bar bar = {{po->progress, 0, 0}, "sampling", 0};
+    def.progress = cloud_progress;
+    def.progress_user = &bar;
     st = vd_cloud_sample(m, NULL, &def, &cloud, &res->stats, err);
+    cli_progress_end(&bar.bar);
   }
   vd_free(sc, (size_t)(n + nfile) * sizeof *sc);
   vd_model_destroy(m);
@@ -321,9 +343,13 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
              co->labels_instance ? "instance" : "semantic");
     wd.comment = comment;
     wd.threads = co->def.threads;
+    cloud_bar bar = {{po->progress, 0, 0}, "writing ", 0};
+    wd.progress = cloud_progress;
+    wd.progress_user = &bar;
     int w = cli_watch(out);
     st = vd_cloud_write(&cloud, out, &wd, err);
     cli_unwatch(w);
+    cli_progress_end(&bar.bar);
     if (st) res->write_failed = 1;
   }
   double t4 = cli_now();

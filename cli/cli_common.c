@@ -163,6 +163,9 @@ const char* cli_plant_help =
     "      --curve-distance M\n"
     "                        curves files: segment length, sigma_distance (m; default 0.02);\n"
     "                        the file's \"settings\" replace the defaults, these flags the file's\n"
+    "      --instances MODE  what an instance is: organs (default for .lpy files: one per organ\n"
+    "                        as a botanist names it, a pedicel with its knuckle is one) or\n"
+    "                        modules (one per L-string module); plant files keep theirs unless given\n"
     "      --no-progress     no progress bar (it shows only when stderr is a terminal)\n";
 
 void cli_plant_opts_init(cli_plant_opts* o) {
@@ -172,6 +175,7 @@ void cli_plant_opts_init(cli_plant_opts* o) {
   o->max_modules = 50000000;
   o->progress = isatty(2);
   o->curve_step = o->curve_connect = o->curve_distance = -1;
+  o->instances = -1;
 }
 
 int cli_parse_num(const char* s, double* out) {
@@ -306,7 +310,41 @@ int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int
     o->progress = 0;
     return 1;
   }
+  if (!strcmp(a, "--instances")) {
+    CLI_TAKE();
+    if (!strcmp(val, "organs")) o->instances = VD_INSTANCE_ORGANS;
+    else if (!strcmp(val, "modules")) o->instances = VD_INSTANCE_MODULES;
+    else {
+      cli_usage_error(cmd, "--instances expects organs or modules, got '%s'", val);
+      return -1;
+    }
+    return 1;
+  }
   return 0;
+}
+
+void cli_progress_bar(const char* what, double frac, const char* text) {
+  int w = 30, fill = (int)(frac * w + 1e-6);
+  if (!(fill >= 0)) fill = 0;
+  if (fill > w) fill = w;
+  char bar[64];
+  for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
+  bar[w] = 0;
+  fprintf(stderr, "\r%s [%s] %s", what, bar, text);
+  fflush(stderr);
+}
+
+int cli_progress_due(cli_progress* p) {
+  if (!p->on) return 0;
+  double now = cli_now();
+  if (p->shown && now - p->last < 0.1) return 0;
+  p->shown = 1, p->last = now;
+  return 1;
+}
+
+void cli_progress_end(cli_progress* p) {
+  if (p->shown) fputc('\n', stderr);
+  p->shown = 0;
 }
 
 // progress bar on stderr: only when it is a terminal
@@ -373,6 +411,8 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
       const char* eq = strchr(o->label[i], '=');
       st = vd_plant_set_label(*out, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
     }
+    if (!st && o->instances >= 0 && (st = vd_plant_set_instances(*out, (vd_instance_mode)o->instances)))
+      vd_error_set(err, st, o->path, 0, 0, "out of memory");
     return st;
   }
   if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0)
@@ -421,6 +461,9 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
     st = vd_plant_set_label(plant, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
   }
   if (!st) st = vd_plant_complete_labels(plant);
+  // instances: organs unless --instances modules (the turtle numbers them by module)
+  if (!st && (st = vd_plant_set_instances(plant, o->instances < 0 ? VD_INSTANCE_ORGANS : (vd_instance_mode)o->instances)))
+    vd_error_set(err, st, o->path, 0, 0, "out of memory");
   if (!st) {
     // module counts by symbol for --stats
     info->modules = derived.n;

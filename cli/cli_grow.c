@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // verdant grow: L-system (or plant file) → plant JSON, OBJ or PLY, with --stats.
 #include <cjson/cJSON.h>
+#include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,7 +19,12 @@ static const char* grow_help =
     "  -o, --output OUT      output file; the extension picks the format: .json .obj .ply\n"
     "      --ascii           write PLY as ASCII instead of binary little-endian\n"
     "      --stats           print a JSON summary on stdout (modules, module_counts, segments,\n"
-    "                        spheres, leaves, labels, bbox_min, bbox_max (m), total_length (m))\n";
+    "                        spheres, leaves, labels (instances per label), organs (per label:\n"
+    "                        count, length, area, volume, mean diameter), bbox_min, bbox_max (m),\n"
+    "                        total_length (m))\n"
+    "      --traits FILE     per-instance traits as CSV: instance, label, label_name, organ,\n"
+    "                        segments, spheres, meshes, length_m, area_m2, diameter_m, volume_m3,\n"
+    "                        bbox (m)\n";
 
 static int cmp_u64(const void* a, const void* b) {
   uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
@@ -51,12 +58,61 @@ static cJSON* label_counts(const vd_plant_spec* p) {
   return obj;
 }
 
+// per label: how many instances and their traits summed (the mean diameter)
+static cJSON* organ_summary(const vd_plant_spec* p, const vd_organ_traits* t, int nt) {
+  cJSON* obj = cJSON_CreateObject();
+  if (!obj) return NULL;
+  for (int l = 0; l < p->nlabel; l++) {
+    int count = 0;
+    double len = 0, area = 0, vol = 0, dia = 0;
+    for (int i = 0; i < nt; i++) {
+      if (t[i].label != p->label[l].id) continue;
+      count++, len += t[i].length, area += t[i].area, vol += t[i].volume, dia += t[i].diameter;
+    }
+    if (!count) continue;
+    cJSON* o = cJSON_AddObjectToObject(obj, p->label[l].name);
+    cJSON_AddNumberToObject(o, "count", count);
+    cJSON_AddNumberToObject(o, "length_m", len);
+    cJSON_AddNumberToObject(o, "area_m2", area);
+    cJSON_AddNumberToObject(o, "volume_m3", vol);
+    cJSON_AddNumberToObject(o, "diameter_m_mean", dia / count);
+  }
+  return obj;
+}
+
+// the traits CSV, under a temporary name renamed when complete
+static vd_status write_traits(const char* path, const vd_plant_spec* p, const vd_organ_traits* t, int nt,
+                              vd_error* err) {
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (st) return st;
+  fputs("instance,label,label_name,organ,segments,spheres,meshes,length_m,area_m2,diameter_m,volume_m3,"
+        "xmin,ymin,zmin,xmax,ymax,zmax\n",
+        f.fp);
+  for (int i = 0; i < nt; i++) {
+    const vd_organ_traits* o = &t[i];
+    if (o->nseg + o->nsphere + o->nmesh == 0) continue;
+    const vd_label* l = vd_plant_find_label(p, o->label);
+    char name[VD_LABEL_NAME_MAX];
+    size_t k = 0;
+    for (const char* c = l ? l->name : ""; *c && k + 1 < sizeof name; c++)  // a CSV field: no commas, quotes or breaks
+      name[k++] = (char)((*c == ',' || *c == '"' || (unsigned char)*c < 0x20) ? '_' : *c);
+    name[k] = 0;
+    fprintf(f.fp, "%d,%d,%s,%s,%d,%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", o->instance, o->label, name,
+            vd_organ_name(o->organ), o->nseg, o->nsphere, o->nmesh, o->length, o->area, o->diameter, o->volume,
+            o->bbox_min.x, o->bbox_min.y, o->bbox_min.z, o->bbox_max.x, o->bbox_max.y, o->bbox_max.z);
+  }
+  st = vd_outfile_commit(&f, err);
+  vd_outfile_abort(&f);
+  return st;
+}
+
 static cJSON* vec_json(vd_vec3 v) {
   double a[3] = {v.x, v.y, v.z};
   return cJSON_CreateDoubleArray(a, 3);
 }
 
-static int print_stats(const vd_plant_spec* p, const cli_grow_info* info) {
+static int print_stats(const vd_plant_spec* p, const cli_grow_info* info, const vd_organ_traits* tr, int ntr) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return 0;
   vd_plant_stats ps;
@@ -74,6 +130,8 @@ static int print_stats(const vd_plant_spec* p, const cli_grow_info* info) {
   cJSON_AddNumberToObject(root, "instances", p->ninstance);
   cJSON* labels = label_counts(p);
   if (labels) cJSON_AddItemToObject(root, "labels", labels);
+  cJSON* organs = organ_summary(p, tr, ntr);
+  if (organs) cJSON_AddItemToObject(root, "organs", organs);
   cJSON_AddItemToObject(root, "bbox_min", vec_json(ps.bbox_min));
   cJSON_AddItemToObject(root, "bbox_max", vec_json(ps.bbox_max));
   cJSON_AddNumberToObject(root, "total_length", ps.total_length);
@@ -95,6 +153,7 @@ int cli_grow(int argc, char** argv) {
   cli_plant_opts po;
   cli_plant_opts_init(&po);
   const char* out = NULL;
+  const char* traits = NULL;
   int stats = 0, ascii = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
@@ -111,6 +170,10 @@ int cli_grow(int argc, char** argv) {
       out = argv[++i];
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--traits")) {
+      if (i + 1 >= argc) return cli_usage_error("grow", "%s needs a file name", a);
+      if (traits) return cli_usage_error("grow", "--traits given 2 times");
+      traits = argv[++i];
     } else if (!strcmp(a, "--ascii")) {
       ascii = 1;
     } else if (a[0] == '-' && a[1]) {
@@ -122,32 +185,45 @@ int cli_grow(int argc, char** argv) {
     }
   }
   if (!po.path) return cli_usage_error("grow", "missing PLANT (an .lpy or plant .json file)");
-  if (!out && !stats) return cli_usage_error("grow", "nothing to do: give -o OUT and/or --stats");
+  if (!out && !stats && !traits) return cli_usage_error("grow", "nothing to do: give -o OUT, --traits FILE and/or --stats");
   if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
     return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
   if (ascii && !(out && cli_has_ext(out, ".ply")))
     return cli_usage_error("grow", "--ascii applies to a .ply output (plant JSON and OBJ are text already)");
   char files[2][4200];
-  const char* outs[2] = {files[0], files[1]};
+  const char* outs[3] = {files[0], files[1], NULL};
   int nf = out ? cli_plant_files(out, files) : 0;
+  if (traits) outs[nf++] = traits;
   if (cli_check_outputs("grow", outs, nf, (const char* const[]){po.path}, 1)) return EXIT_USAGE;
   vd_error err = {0};
   vd_plant_spec* plant;
   cli_grow_info info;
   vd_status st = cli_load_plant(&po, &plant, &info, &err);
   if (st) return cli_report("grow", &err, st);
-  // the file and its material library: together or not at all
-  cli_outset set;
-  if (out && (st = cli_outset_begin(&set, outs, nf, NULL, &err))) {
+  // per-instance traits (--stats, --traits)
+  vd_organ_traits* tr = NULL;
+  int ntr = 0;
+  if ((stats || traits) && (st = vd_plant_traits(plant, &tr, &ntr))) {
     vd_plant_spec_destroy(plant);
     cli_grow_info_free(&info);
+    vd_error_set(&err, st, "", 0, 0, "out of memory");
+    return cli_report("grow", &err, st);
+  }
+  // the file, its material library and the traits: together or not at all
+  cli_outset set;
+  if (nf && (st = cli_outset_begin(&set, outs, nf, NULL, &err))) {
+    vd_plant_spec_destroy(plant);
+    cli_grow_info_free(&info);
+    vd_free(tr, (size_t)ntr * sizeof *tr);
     cli_report("grow", &err, st);
     return EXIT_FAIL;
   }
   if (out) st = cli_write_plant(plant, out, ascii, &err);
-  if (out) cli_outset_end(&set, st == VD_OK);
+  if (!st && traits) st = write_traits(traits, plant, tr, ntr, &err);
+  if (nf) cli_outset_end(&set, st == VD_OK);
   cli_blame_input(&err, po.path);  // a plant that does not compile (output errors name the output)
-  if (!st && stats && !print_stats(plant, &info)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (!st && stats && !print_stats(plant, &info, tr, ntr)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  vd_free(tr, (size_t)ntr * sizeof *tr);
   vd_plant_spec_destroy(plant);
   cli_grow_info_free(&info);
   if (st) {

@@ -442,14 +442,24 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   return 1;
 }
 
-static void progress_bar(double t, double total) {
-  int w = 30, fill = total > 0 ? (int)(t / total * w) : w;
-  if (fill > w) fill = w;
-  char bar[64];
-  for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
-  bar[w] = 0;
-  fprintf(stderr, "\rsimulating [%s] %.2f / %.2f s", bar, t, total);
-  fflush(stderr);
+static void progress_bar(double t, double total, int64_t steps, double wall) {
+  char text[128];
+  snprintf(text, sizeof text, "%.3f / %.3f s simulated, step %lld, %.1f s", t, total, (long long)steps, wall);
+  cli_progress_bar("simulating", total > 0 ? t / total : 1, text);
+}
+
+// settling: the share of its budget (10 s simulated or 400 static steps) used so far
+typedef struct settle_bar {
+  cli_progress bar;
+  double t0;
+} settle_bar;
+
+static void settle_progress(void* user, double frac, int steps) {
+  settle_bar* b = user;
+  if (!cli_progress_due(&b->bar)) return;
+  char text[96];
+  snprintf(text, sizeof text, "step %d, %.1f s (stops when still)", steps, cli_now() - b->t0);
+  cli_progress_bar("settling", frac, text);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -831,13 +841,21 @@ int cli_sim(int argc, char** argv) {
       vd_sim_settle_def sd = vd_sim_settle_def_default();
       sd.statics = o.statics;
       sd.ke_tol = o.ke_tol;
-      if (o.po.progress) fprintf(stderr, "settling...\n");
+      settle_bar sb = {{o.po.progress, 0, 0}, cli_now()};
+      sd.progress = settle_progress;
+      sd.user = &sb;
       st = vd_sim_settle(m, d, &sd, &settled, &settle_steps);
+      if (sb.bar.shown) {
+        char text[96];
+        snprintf(text, sizeof text, "%d steps, %.1f s, %s", settle_steps, cli_now() - sb.t0, settled ? "still" : "not still");
+        cli_progress_bar("settling", 1, text);
+        cli_progress_end(&sb.bar);
+      }
     }
     // the timed run with probes and pulls
     double start = d->time, total = o.duration, next_frame = start;
     double ramp = o.ramp_set ? o.ramp : total;
-    int show = o.po.progress && total / m->opt.dt > 2000;
+    cli_progress bar = {o.po.progress, 0, 0};
     double frames_s = 0;
     if (out.frames_open) cli_frames_write(&out, m, d), next_frame += 1.0 / o.fps;
     for (int64_t step = 0; !st && step < (int64_t)nsteps; step++) {
@@ -863,9 +881,9 @@ int cli_sim(int argc, char** argv) {
         if (o.profile) frames_s += cli_now() - tf;
         next_frame += 1.0 / o.fps;
       }
-      if (show && d->nstep % 100 == 0) progress_bar(d->time - start, total);
+      if (cli_progress_due(&bar)) progress_bar(d->time - start, total, d->nstep, cli_now() - t0);
     }
-    if (show) progress_bar(total, total), fputc('\n', stderr);
+    if (bar.shown) progress_bar(d->time - start, total, d->nstep, cli_now() - t0), cli_progress_end(&bar);
     double wall = cli_now() - t0;
     if (st) {
       vd_error_set(&err, st, "", 0, 0,

@@ -332,5 +332,20 @@ expect "bad vary" 2 "$V" dataset "$A" --count 5 -o "$E" --vary X=3:1
 expect "vary unknown global" 2 "$V" dataset "$A" --count 1 -N 100 -o "$T/ds3" --vary NOPE=1:2
 expect_err "unknown --vary named" "[-]-vary NOPE"
 
+# progress bars where the time goes (issue 12, item 21): sampling and writing, on a terminal
+# only (util-linux's script gives the run one)
+if command -v script >/dev/null 2>&1; then
+  script -qc "'$V' cloud '$A' -N 200000 -o '$T/bar.ply'" /dev/null >"$T/tty" 2>&1
+  if grep -aq "sampling \[#*\] 100%" "$T/tty" && grep -aq "writing  \[#*\] 100%" "$T/tty" && [ -s "$T/bar.ply" ]; then
+    ok "cloud progress bars on a terminal"
+  else
+    bad "cloud progress bars on a terminal ($(tr '\r' '\n' <"$T/tty" | tail -c 300))"
+  fi
+  "$V" cloud "$A" -N 20000 -o "$T/bar2.ply" 2>"$T/err"
+  if [ -s "$T/err" ]; then bad "no progress bar off a terminal ($(head -c 200 "$T/err"))"; else ok "no progress bar off a terminal"; fi
+else
+  echo "skip progress bar checks (no script)"
+fi
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -106,5 +106,53 @@ fi
 printf 'Axiom: A\nproduction:\nA --> F(1e308 * 10)\n' >"$T/bad.lpy"
 if "$V" grow "$T/bad.lpy" -o "$T/bad.json" 2>&1 | grep -q "bad.lpy:3: turtle: module 0 'F'"; then ok "turtle error names the line"; else bad "turtle error names the line"; fi
 
+# instances a phenotyper counts (issue 12, item 20): one per organ (a tomato pedicel with its
+# knuckle is one pedicel, a truss rachis one peduncle), module pieces with --instances modules;
+# per-organ traits in --stats and --traits FILE
+TOMATO="$SRC/data/tomato.lpy"
+expect "grow organs" 0 "$V" grow "$TOMATO" --stats --traits "$T/traits.csv" -o "$T/organs.json"
+cp "$T/out" "$T/organs_stats.json"
+expect "grow modules" 0 "$V" grow "$TOMATO" --stats --instances modules -o "$T/modules.json"
+cp "$T/out" "$T/modules_stats.json"
+expect "bad --instances" 2 "$V" grow "$TOMATO" --stats --instances leaves
+expect "--instances on a plant file" 0 "$V" grow "$T/modules.json" --instances organs -o "$T/organs2.json"
+if python3 - "$T" <<'PY'
+import csv, json, math, sys
+t = sys.argv[1]
+so, sm = json.load(open(t + "/organs_stats.json")), json.load(open(t + "/modules_stats.json"))
+po, pm = json.load(open(t + "/organs.json")), json.load(open(t + "/modules.json"))
+# organs: one pedicel per fruit (each drawn as pedicel, knuckle, pedicel), one peduncle per truss
+fruits = so["labels"]["fruit"] + so["labels"]["flower"]
+assert so["labels"]["pedicel"] == fruits, so["labels"]
+assert sm["labels"]["pedicel"] == 3 * so["labels"]["pedicel"], (sm["labels"], so["labels"])
+assert sm["labels"]["peduncle"] > so["labels"]["peduncle"] >= 1
+assert so["labels"]["stem"] == 1 and sm["labels"]["stem"] > 1
+assert so["instances"] < sm["instances"]
+# the same geometry, only the instance ids differ
+assert po["nodes"] == pm["nodes"] and po["segments"]["label"] == pm["segments"]["label"]
+# the plant file's instances made organs again give the same file
+assert json.load(open(t + "/organs2.json"))["segments"]["instance"] == po["segments"]["instance"]
+# traits: one row per instance, lengths add up to the plant's, fruit diameter = its sphere's
+rows = list(csv.DictReader(open(t + "/traits.csv")))
+assert len(rows) == so["instances"], (len(rows), so["instances"])
+assert [int(r["instance"]) for r in rows] == list(range(1, len(rows) + 1))
+assert abs(sum(float(r["length_m"]) for r in rows) - so["total_length"]) < 1e-9 * max(1, so["total_length"])
+sp = po["spheres"]
+for r in rows:
+    if r["label_name"] == "fruit":
+        i = int(r["instance"])
+        radii = [sp["radius"][k] for k in range(len(sp["radius"])) if sp["instance"][k] == i]
+        assert len(radii) == 1 and abs(float(r["diameter_m"]) - 2 * radii[0]) < 1e-9, (r, radii)
+        assert abs(float(r["volume_m3"]) - 4 / 3 * math.pi * radii[0] ** 3) < 1e-12
+    if r["label_name"] == "leaf":
+        assert float(r["area_m2"]) > 0 and r["organ"] == "leaf"
+    if r["label_name"] == "pedicel":
+        assert int(r["segments"]) == 3, r
+org = so["organs"]
+assert org["pedicel"]["count"] == so["labels"]["pedicel"] and org["leaf"]["area_m2"] > 0
+assert abs(org["leaf"]["area_m2"] - sum(float(r["area_m2"]) for r in rows if r["label_name"] == "leaf")) < 1e-9
+PY
+then ok "organ instances and traits"; else bad "organ instances and traits"; fi
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -642,3 +642,69 @@ TEST(plant, spec_copy) {
   }
   vd_plant_spec_destroy(s);
 }
+
+// Organ instances (issue 12, item 20): a stem of two internodes with a lateral branch, a pedicel
+// drawn as pedicel + knuckle + pedicel (three modules), its fruit, and a leaf of two modules
+// (petiole, blade)
+TEST(plant, organ_instances_and_traits) {
+  vd_plant_spec* s = vd_plant_spec_create();
+  REQUIRE(s);
+  CHECK_STATUS(vd_plant_set_label(s, 1, "stem"), VD_OK, (vd_error){0});
+  vd_plant_set_label(s, 2, "pedicel");
+  vd_plant_set_label(s, 3, "fruit");
+  vd_plant_set_label(s, 4, "leaf");
+  vd_vec3 p[7] = {vd_v3(0, 0, 0), vd_v3(0, 0, 0.1), vd_v3(0, 0, 0.2), vd_v3(0.1, 0, 0.2), vd_v3(0, 0.02, 0.1),
+                  vd_v3(0, 0.03, 0.1), vd_v3(0, 0.05, 0.1)};
+  for (int i = 0; i < 7; i++) vd_plant_add_node(s, p[i]);
+  // segment: nodes, parent, label, axis, module
+  int seg[7][6] = {{0, 1, -1, 1, 0, 10}, {1, 2, 0, 1, 0, 11}, {2, 3, 1, 1, 1, 12},  // stem, stem, branch
+                   {1, 4, 0, 2, 2, 13},  {4, 5, 3, 2, 2, 14},  {5, 6, 4, 2, 2, 15},   // pedicel, knuckle, pedicel
+                   {1, 4, 0, 4, 3, 16}};                                           // petiole
+  for (int i = 0; i < 7; i++) {
+    vd_segment_spec g = vd_segment_spec_default();
+    g.node0 = seg[i][0], g.node1 = seg[i][1], g.parent = seg[i][2], g.label = seg[i][3], g.axis = seg[i][4];
+    g.module = seg[i][5], g.instance = i + 1, g.r0 = g.r1 = 0.01;
+    vd_plant_add_segment(s, &g);
+  }
+  vd_sphere_spec f = vd_sphere_spec_default();
+  f.center = vd_v3(0, 0.05, 0.09), f.radius = 0.01, f.parent = 5, f.node = 6, f.label = 3, f.module = 17, f.instance = 8;
+  vd_plant_add_sphere(s, &f);
+  // the blade: a unit-area square from another module, hung from the petiole
+  vd_mesh_spec m = {0};
+  m.node = 4, m.parent = 6, m.label = 4, m.module = 18, m.instance = 9;
+  vd_vec3 v[4] = {vd_v3(0, 0, 0), vd_v3(1, 0, 0), vd_v3(1, 1, 0), vd_v3(0, 1, 0)};
+  int tri[6] = {0, 1, 2, 0, 2, 3};
+  vd_plant_add_mesh(s, &m, v, 4, tri, 2);
+  s->ninstance = 9;
+  CHECK_INT(vd_plant_set_instances(s, VD_INSTANCE_ORGANS), VD_OK);
+  // stem 1 (both internodes), branch 2, pedicel 3 (three pieces), leaf 4 (petiole and blade),
+  // fruit 5
+  int want[7] = {1, 1, 2, 3, 3, 3, 4};
+  for (int i = 0; i < 7; i++) CHECK_INT(s->seg[i].instance, want[i]);
+  CHECK_INT(s->sphere[0].instance, 5);
+  CHECK_INT(s->mesh[0].instance, 4);
+  CHECK_INT(s->ninstance, 5);
+  vd_organ_traits* t;
+  int n;
+  CHECK_INT(vd_plant_traits(s, &t, &n), VD_OK);
+  CHECK_INT(n, 5);
+  if (n == 5) {
+    CHECK_NEAR(t[0].length, 0.2, 1e-12);
+    CHECK_NEAR(t[0].volume, VD_PI * 0.01 * 0.01 * 0.2, 1e-12);
+    CHECK_NEAR(t[0].diameter, 0.02, 1e-12);
+    CHECK_INT(t[2].nseg, 3);
+    CHECK_NEAR(t[2].length, 0.05, 1e-12);
+    CHECK_NEAR(t[3].area, 1.0, 1e-12);
+    CHECK_INT(t[3].organ, VD_ORGAN_LEAF);
+    CHECK_NEAR(t[4].diameter, 0.02, 1e-12);
+    CHECK_NEAR(t[4].volume, 4.0 / 3.0 * VD_PI * 1e-6, 1e-15);
+  }
+  vd_free(t, (size_t)n * sizeof *t);
+  // modules: one per producing module again
+  CHECK_INT(vd_plant_set_instances(s, VD_INSTANCE_MODULES), VD_OK);
+  for (int i = 0; i < 7; i++) CHECK_INT(s->seg[i].instance, i + 1);
+  CHECK_INT(s->sphere[0].instance, 8);
+  CHECK_INT(s->mesh[0].instance, 9);
+  CHECK_INT(s->ninstance, 9);
+  vd_plant_spec_destroy(s);
+}

@@ -91,6 +91,10 @@ typedef struct vd_cloud_def {
                              // beyond is VD_ERR_LIMIT before anything is allocated; default 2e9
   int64_t max_attempts;      // most draws for one point, and a hundredth of it per point on
                              // average over a chunk, before giving up (>= 1); default 100000
+  void (*progress)(void* user, int64_t done, int64_t total);  // Nullable: called as chunks of
+                             // points are made (done of total chunks), from one thread at a time;
+                             // default NULL
+  void* progress_user;       // passed to progress; default NULL
 } vd_cloud_def;
 
 // Defaults: points 100000, seed 0, uniform sensor, inverse-square law, no table, no noise
@@ -179,6 +183,9 @@ typedef struct vd_cloud_write_def {
                           // (Nullable); default NULL
   int threads;            // threads converting binary records, 0 = all cores; the bytes do not
                           // depend on it; default 0
+  void (*progress)(void* user, int64_t done, int64_t total);  // Nullable: called as points are
+                          // written (done of total); default NULL
+  void* progress_user;    // passed to progress; default NULL
 } vd_cloud_write_def;
 
 // Defaults: format from the extension, binary, no property prefix, no comment, all cores.

@@ -177,6 +177,43 @@ typedef struct vd_plant_stats {
 void vd_plant_spec_stats(const vd_plant_spec* s, vd_plant_stats* out);
 
 // ---------------------------------------------------------------------------------------------
+// organ instances and traits
+
+// What an instance id names.
+typedef enum vd_instance_mode {
+  VD_INSTANCE_MODULES = 0,  // one per producing L-string module (the turtle's numbering; elements
+                            // without a module keep their instance)
+  VD_INSTANCE_ORGANS = 1,   // one per organ as a botanist names it: the module pieces of one
+                            // label joined with their parent segment's organ when it has the same
+                            // label (a pedicel drawn as pedicel, knuckle, pedicel is one pedicel,
+                            // a truss rachis one peduncle, a compound leaf one leaf), except that
+                            // a stem or root segment on another axis than its parent's (a lateral
+                            // branch or root) starts its own
+} vd_instance_mode;
+
+// Renumber the instances of s as mode says, 1..K in the order the elements come (segments,
+// spheres, meshes); sets ninstance = K. VD_ERR_NOMEM leaves s unchanged.
+vd_status vd_plant_set_instances(vd_plant_spec* s, vd_instance_mode mode);
+
+// What a phenotyper measures on one instance (at the spec's shape).
+typedef struct vd_organ_traits {
+  int instance;                // instance id (1..)
+  int label;                   // label of its first element, -1 when it has none
+  vd_organ organ;              // organ kind of that label
+  int nseg, nsphere, nmesh;    // its elements
+  double length;               // segments' lengths summed (m)
+  double area;                 // one-sided area of its thin meshes (leaf blades, petals) (m^2)
+  double diameter;             // the largest sphere's diameter or closed mesh's largest extent (a
+                               // fruit), else its thickest segment's diameter (m)
+  double volume;               // frustums, spheres and closed meshes (m^3)
+  vd_vec3 bbox_min, bbox_max;  // bounds including radii (m); 0 when it has no geometry
+} vd_organ_traits;
+
+// Traits of every instance 1..s->ninstance: *out (vd_free with *n * sizeof **out) holds
+// instance i at index i - 1 (*out NULL and *n 0 when the plant has none).
+vd_status vd_plant_traits(const vd_plant_spec* s, vd_organ_traits** out, int* n);
+
+// ---------------------------------------------------------------------------------------------
 // compiled model and state
 
 // The flat, read-only plant. Arrays live in one block; shapes are given as (rows x cols).

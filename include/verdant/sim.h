@@ -373,10 +373,13 @@ typedef struct vd_sim_settle_def {
   double max_time;       // dynamics: give up after this much simulated time (s)
   int max_steps;         // statics: give up after this many steps
   double extra_damping;  // dynamics: mass damping rate added while settling (1/s)
+  void (*progress)(void* user, double frac, int steps);  // Nullable: called after each step with
+                         // the share of the budget used (max_time or max_steps) and the steps
+  void* user;            // passed to progress
 } vd_sim_settle_def;
 
 // Defaults: statics 0, ke_tol 1e-9 J, disp_tol 1e-9 m, max_time 10 s, max_steps 400,
-// extra_damping 5 1/s.
+// extra_damping 5 1/s, no progress.
 vd_sim_settle_def vd_sim_settle_def_default(void);
 // Settle the state under the current loads. *converged (Nullable) tells whether the tolerance
 // was met; *steps (Nullable) the steps taken. Fractures may happen on the way.

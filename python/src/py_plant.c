@@ -34,6 +34,7 @@ typedef struct grow_args {
   char (*label_name)[VD_LABEL_NAME_MAX];  // --label names
   double curve[3];       // curve step, connect, distance (m), < 0: file's or default
   vd_lsys_engine engine; // who runs the file's Python (--engine)
+  int module_instances;  // instances="modules": the turtle's numbering (0: one per organ)
 } grow_args;
 
 // What grow() made.
@@ -122,6 +123,9 @@ static vd_status grow_lsys(const grow_args* a, vd_lsystem* ls, const char* name,
   }
   if (!st) st = apply_labels(a, out->spec);
   if (!st) st = vd_plant_complete_labels(out->spec);
+  // one instance per organ, as the command line (instances="modules": per module)
+  if (!st && (st = vd_plant_set_instances(out->spec, a->module_instances ? VD_INSTANCE_MODULES : VD_INSTANCE_ORGANS)))
+    vd_error_set(err, st, name, 0, 0, "out of memory");
   if (!st) {
     out->modules = derived.n;
     out->nsym = vd_lsys_symbol_count(ls);
@@ -240,7 +244,7 @@ static PyObject* set_text(PyObject* v, const char* name) {
 
 PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   static const char* const names[] = {"seed", "steps", "set", "labels", "max_modules", "max_ops",
-                                      "curve_step", "curve_connect", "curve_distance", "engine", NULL};
+                                      "curve_step", "curve_connect", "curve_distance", "engine", "instances", NULL};
   PyObject* source;
   if (!PyArg_ParseTuple(args, "O:grow", &source) || !vdpy_kw_check(kw, "grow", names)) return NULL;
   grow_args a;
@@ -287,6 +291,12 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
     else if (!strcmp(e, "native")) a.engine = VD_LSYS_NATIVE;
     else if (!strcmp(e, "python")) a.engine = VD_LSYS_PYTHON;
     else return vdpy_arg_error("engine expects 'auto', 'native' or 'python', got '%s'", e);
+  }
+  if ((o = vdpy_kw(kw, "instances"))) {
+    char e[16];
+    if (!vdpy_str(o, "instances", e, sizeof e)) return NULL;
+    if (!strcmp(e, "modules")) a.module_instances = 1;
+    else if (strcmp(e, "organs")) return vdpy_arg_error("instances expects 'organs' or 'modules', got '%s'", e);
   }
   const char* curve_names[3] = {"curve_step", "curve_connect", "curve_distance"};
   for (int k = 0; k < 3; k++)
@@ -460,6 +470,26 @@ static PyObject* plant_seed(vdpy_plant* p, void* c) {
 }
 static PyObject* plant_source(vdpy_plant* p, void* c) { return Py_NewRef(p->source); }
 static PyObject* plant_info(vdpy_plant* p, void* c) { return PyDict_Copy(p->info); }
+// per-instance traits (vd_plant_traits), as `verdant grow --traits` writes them
+static PyObject* plant_traits(vdpy_plant* p, void* c) {
+  vd_organ_traits* t;
+  int n;
+  if (vd_plant_traits(p->spec, &t, &n)) return PyErr_NoMemory();
+  PyObject* list = PyList_New(0);
+  for (int i = 0; list && i < n; i++) {
+    const vd_organ_traits* o = &t[i];
+    if (o->nseg + o->nsphere + o->nmesh == 0) continue;
+    PyObject* d = Py_BuildValue("{s:i,s:i,s:s,s:i,s:i,s:i,s:d,s:d,s:d,s:d,s:(ddd),s:(ddd)}", "instance", o->instance,
+                                "label", o->label, "organ", vd_organ_name(o->organ), "segments", o->nseg, "spheres",
+                                o->nsphere, "meshes", o->nmesh, "length_m", o->length, "area_m2", o->area, "diameter_m",
+                                o->diameter, "volume_m3", o->volume, "bbox_min", o->bbox_min.x, o->bbox_min.y,
+                                o->bbox_min.z, "bbox_max", o->bbox_max.x, o->bbox_max.y, o->bbox_max.z);
+    if (!d || PyList_Append(list, d) < 0) Py_CLEAR(list);
+    Py_XDECREF(d);
+  }
+  vd_free(t, (size_t)n * sizeof *t);
+  return list;
+}
 static PyObject* plant_geometry(vdpy_plant* p, void* c) {
   vd_plant_stats s;
   vd_plant_spec_stats(p->spec, &s);
@@ -497,6 +527,10 @@ static PyGetSetDef plant_getset[] = {
     {"seed", (getter)plant_seed, NULL, "growth seed (also the default seed of its clouds)", NULL},
     {"source", (getter)plant_source, NULL, "the file it came from, or '<string>'", NULL},
     {"_info", (getter)plant_info, NULL, "derivation summary: modules, module_counts, seconds", NULL},
+    {"traits", (getter)plant_traits, NULL,
+     "per-instance traits (one dict per instance: instance, label, organ, segments, spheres, meshes, length_m, "
+     "area_m2, diameter_m, volume_m3, bbox_min, bbox_max), as `verdant grow --traits`",
+     NULL},
     {"_geometry", (getter)plant_geometry, NULL, "counts, bounding box (m), total length (m)", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };

@@ -57,6 +57,10 @@ def test_stats_equal_cli(cli):
     for k in ref:
         if k in ("bbox_min", "bbox_max"):
             assert got[k] == pytest.approx(ref[k], abs=1e-12)
+        elif k == "organs":  # cJSON prints 15 digits when they read back within DBL_EPSILON
+            assert list(got[k]) == list(ref[k])
+            for name in ref[k]:
+                assert got[k][name] == pytest.approx(ref[k][name], rel=1e-14), name
         else:
             assert got[k] == ref[k], k
 
@@ -163,3 +167,18 @@ def test_python_engine_in_threads():
     for t in ts:
         t.join()
     assert len(out) == 3 and all(np.array_equal(o, ref) for o in out)
+
+
+def test_organ_instances_and_traits(tmp_path, cli):
+    # one instance per organ by default, as the command line; instances="modules" per module
+    organs = verdant.grow(data("tomato.lpy"), seed=3)
+    modules = verdant.grow(data("tomato.lpy"), seed=3, instances="modules")
+    so, sm = organs.stats, modules.stats
+    assert so["labels"]["pedicel"] == so["labels"]["fruit"] + so["labels"]["flower"]
+    assert sm["labels"]["pedicel"] == 3 * so["labels"]["pedicel"]
+    cli("grow", data("tomato.lpy"), "--seed", "3", "--traits", tmp_path / "t.csv")
+    rows = (tmp_path / "t.csv").read_text().splitlines()[1:]
+    assert len(rows) == len(organs.traits) == so["instances"]
+    assert [int(r.split(",")[0]) for r in rows] == [t["instance"] for t in organs.traits]
+    with pytest.raises(verdant.ArgumentError):
+        verdant.grow(data("tomato.lpy"), instances="leaves")

@@ -119,8 +119,9 @@ class Plant(_verdant.Plant):
     @property
     def stats(self):
         """The summary of `verdant grow --stats`: engine (.lpy only), modules, module_counts, nodes, segments,
-        spheres, leaves, meshes, instances, labels (organ instances per label name), bbox_min,
-        bbox_max (m), total_length (m)."""
+        spheres, leaves, meshes, instances, labels (organ instances per label name), organs (per
+        label name: count, length_m, area_m2, volume_m3, diameter_m_mean), bbox_min, bbox_max (m),
+        total_length (m)."""
         import numpy as np
 
         info, geo = self._info, self._geometry
@@ -131,6 +132,16 @@ class Plant(_verdant.Plant):
                              (self.mesh_labels, self.mesh_instances))])
         per_label = np.unique(np.unique(keys) >> 32, return_counts=True)
         count = dict(zip(per_label[0].tolist(), per_label[1].tolist()))
+        organs = {}
+        traits = self.traits
+        for e in self.label_table:
+            mine = [t for t in traits if t["label"] == e["id"]]
+            if mine:
+                organs[e["name"]] = {
+                    "count": len(mine), "length_m": sum(t["length_m"] for t in mine),
+                    "area_m2": sum(t["area_m2"] for t in mine),
+                    "volume_m3": sum(t["volume_m3"] for t in mine),
+                    "diameter_m_mean": sum(t["diameter_m"] for t in mine) / len(mine)}
         return {
             **({"engine": info["engine"]} if info.get("engine") else {}),
             "modules": info.get("modules", 0),
@@ -138,6 +149,7 @@ class Plant(_verdant.Plant):
             "nodes": geo["nodes"], "segments": geo["segments"], "spheres": geo["spheres"],
             "leaves": geo["leaves"], "meshes": geo["meshes"], "instances": geo["instances"],
             "labels": {e["name"]: count.get(e["id"], 0) for e in self.label_table},
+            "organs": organs,
             "bbox_min": list(geo["bbox_min"]), "bbox_max": list(geo["bbox_max"]),
             "total_length": geo["total_length"],
         }
@@ -314,7 +326,7 @@ from .env import HarvestEnv  # noqa: E402  (needs Plant and Renderer above)
 
 
 def grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=None, max_ops=None,
-         curve_step=None, curve_connect=None, curve_distance=None, engine=None):
+         curve_step=None, curve_connect=None, curve_distance=None, engine=None, instances=None):
     """Grow a plant: derive an L-Py file (.lpy), read a plant file (.json), build one from a
     curves file (.json with "format": "verdant-curves"), or take the text itself (a str with a
     newline: L-Py, or JSON when it starts with '{').
@@ -327,13 +339,15 @@ def grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=None,
     curve_step, curve_connect, curve_distance: curves files' sampling (m).
     engine: who runs the file's Python: 'auto' (default: the native subset interpreter when the
         file stays within it, else embedded CPython, as L-Py would), 'native' or 'python'.
+    instances: L-Py sources: 'organs' (default: one instance per organ as a botanist names it, a
+        pedicel with its knuckle is one) or 'modules' (one per L-string module).
 
     The same plant as `verdant grow SOURCE --seed SEED ...`. Raises ParseError, FileError, ...
     (verdant.Error subclasses with file, line, column, message). The GIL is released.
     """
     kw = dict(seed=seed, steps=steps, set=set, labels=labels, max_modules=max_modules,
               max_ops=max_ops, curve_step=curve_step, curve_connect=curve_connect,
-              curve_distance=curve_distance, engine=engine)
+              curve_distance=curve_distance, engine=engine, instances=instances)
     return _verdant.grow(source, **{k: v for k, v in kw.items() if v is not None})
 
 

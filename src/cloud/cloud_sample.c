@@ -764,7 +764,7 @@ vd_status vd_cloud_sample(const vd_model* m, const vd_data* d, const vd_cloud_de
 #endif
   stats->threads = threads;
   int failed = 0;
-  int64_t nchunk = s.nchunk;
+  int64_t nchunk = s.nchunk, ndone = 0;
   const sampler* cs = &s;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
   for (int64_t c = 0; c < nchunk; c++) {
@@ -777,6 +777,14 @@ vd_status vd_cloud_sample(const vd_model* m, const vd_data* d, const vd_cloud_de
     } else if (!sample_chunk(cs, c, &s.per_chunk[c])) {
 #pragma omp atomic write
       failed = 1;
+    }
+    // progress: chunks done, reported by one thread at a time (it never changes the points)
+    if (def.progress) {
+      int64_t done;
+#pragma omp atomic capture
+      done = ++ndone;
+#pragma omp critical(vd_cloud_progress)
+      def.progress(def.progress_user, done, nchunk);
     }
   }
   double t3 = cloud_now();

@@ -124,7 +124,13 @@ static void put_record(unsigned char* r, const vd_cloud* c, int64_t i, int views
 
 // the binary PLY/PCD records, a buffer at a time; large buffers are filled by several threads
 // (each record is converted alone, so the bytes do not depend on the thread count)
-static void write_records(FILE* fp, const vd_cloud* c, int views, wbuf* wb, int threads) {
+// progress of the writing, every 64 Ki points and at the end
+static void wrote(const vd_cloud_write_def* def, int64_t done, int64_t total) {
+  if (def->progress && (done % 65536 == 0 || done == total)) def->progress(def->progress_user, done, total);
+}
+
+static void write_records(FILE* fp, const vd_cloud* c, int views, wbuf* wb, const vd_cloud_write_def* def) {
+  int threads = def->threads;
   int64_t rec = views ? 40 : 32, per = (int64_t)sizeof wb->data / rec;
   int le = host_le();
 #ifdef _OPENMP
@@ -139,6 +145,7 @@ static void write_records(FILE* fp, const vd_cloud* c, int views, wbuf* wb, int 
     for (int64_t i = a; i < b; i++)
       put_record(data + (i - a) * rec, c, i, views, le);
     fwrite(data, (size_t)rec, (size_t)(b - a), fp);
+    if (def->progress) def->progress(def->progress_user, b, c->n);
   }
 }
 
@@ -201,10 +208,11 @@ static void write_ply(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def
               c->label[i], c->instance[i]);
       if (views) fprintf(fp, " %d %.9g", c->view[i], (double)(float)c->range[i]);
       fputc('\n', fp);
+      wrote(def, i + 1, c->n);
     }
     return;
   }
-  write_records(fp, c, views, wb, def->threads);
+  write_records(fp, c, views, wb, def);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -266,10 +274,11 @@ static void write_pcd(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def
               (unsigned)c->label[i], (unsigned)c->instance[i]);
       if (views) fprintf(fp, " %u %.9g", (unsigned)c->view[i], (double)(float)c->range[i]);
       fputc('\n', fp);
+      wrote(def, i + 1, c->n);
     }
     return;
   }
-  write_records(fp, c, views, wb, def->threads);
+  write_records(fp, c, views, wb, def);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -292,6 +301,7 @@ static void write_text(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* de
             sep, n[1], sep, n[2], sep, c->label[i], sep, c->instance[i]);
     if (views) fprintf(fp, "%c%d%c%.9g", sep, c->view[i], sep, c->range[i]);
     fputc('\n', fp);
+    wrote(def, i + 1, c->n);
   }
 }
 
@@ -369,7 +379,6 @@ static void vlr_header(unsigned char* p, const char* user, int record, unsigned 
 
 static vd_status write_las(FILE* fp, const vd_cloud* c, const vd_cloud_write_def* def,
                            wbuf* wb, const char* path, vd_error* err) {
-  (void)def;
   if (c->nview > 65535)
     return vd_error_set(err, VD_ERR_VALUE, path, 0, 0, "LAS point source id holds 65536 views");
   // bounds, offset (the centre in whole metres) and a power-of-ten scale from 1 um up that keeps
@@ -508,6 +517,7 @@ static vd_status write_las(FILE* fp, const vd_cloud* c, const vd_cloud_write_def
     put_f32(r + 42, c->range[i]);
     for (int k = 0; k < 3; k++)
       put_f32(r + 46 + 4 * k, c->normal[3 * i + k]);
+    wrote(def, i + 1, c->n);
   }
   wb_flush(wb);
   vd_free(ids, (size_t)(c->nlabel ? c->nlabel : 1) * sizeof *ids);

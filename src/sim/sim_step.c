@@ -391,6 +391,8 @@ vd_sim_settle_def vd_sim_settle_def_default(void) {
   s.max_time = 10;
   s.max_steps = 400;
   s.extra_damping = 5;
+  s.progress = NULL;
+  s.user = NULL;
   return s;
 }
 
@@ -414,6 +416,7 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
       d->nstep++;
       if (w->strain > VD_SIM_MAX_STRAIN) sim_warn(d, VD_SIM_WARN_STRETCHED);
       n++;
+      if (s->progress) s->progress(s->user, (d->time - t0) / s->max_time, n);
       calm = vd_sim_kinetic_energy(m, d) < s->ke_tol ? calm + m->opt.dt : 0;
       if (calm >= 0.25) {
         ok = 1;
@@ -440,6 +443,7 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
       if (fail) sim_warn(d, kind);
       else d->nstep++;
       n++;
+      if (s->progress) s->progress(s->user, (double)n / s->max_steps, n);
       double e1 = fail ? INFINITY : potential_energy(m, d, w) - torque_work(m, d, w);
       // largest move of a node, or of a segment end by its rotation
       double mv = fail ? INFINITY : 0;
