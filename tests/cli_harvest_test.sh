@@ -3,7 +3,7 @@
 # End-to-end tests of `verdant harvest` on the bundled tomato scenes (issue 10, "Done when"): the
 # pull grasps the target and detaches it at a named site with a pedicel force inside the published
 # 0.58-2.46 N (calyx) or 5-8 N (abscission node); bend and twist detach too, the bend with less
-# force than the pull. Frames are off (--frames none) to keep it fast.
+# force than the pull; the second robot (the gantry) pulls. Frames are off (--frames none).
 # Usage: cli_harvest_test.sh VERDANT_BINARY SOURCE_DIR
 source "$(dirname "$0")/cli_lib.sh" cli_harvest "$@"
 
@@ -11,6 +11,10 @@ for m in pull bend twist; do
   expect "harvest $m" 0 "$V" harvest "$SRC/data/scenes/tomato_$m.json" -o "$T/$m" --frames none --stats --no-progress
   cp "$T/out" "$T/$m.json"
 done
+# the second robot (a three-axis gantry, data/robots/gantry3.xml) pulls too
+expect "harvest gantry" 0 "$V" harvest "$SRC/data/scenes/gantry_pull.json" --frames none --stats --no-progress
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(not (d['grasped'] and d['detached'] and d['site'] == 'calyx' and 0.58 <= d['pedicel_force'] <= 2.46))" "$T/out" &&
+  ok "gantry: calyx in the published range" || bad "gantry: calyx in the published range ($(head -c 400 "$T/out"))"
 python3 - "$T" <<'PY' && ok "bundled scenes: sites and forces" || bad "bundled scenes: sites and forces"
 import json, sys
 t = sys.argv[1]
