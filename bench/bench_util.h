@@ -16,6 +16,17 @@ static inline double bench_wall(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+// the machine's 1-minute load average (/proc/loadavg; -1 when unknown), written beside timings
+static inline double bench_load1(void) {
+  double l = -1;
+  FILE* f = fopen("/proc/loadavg", "r");
+  if (f) {
+    if (fscanf(f, "%lf", &l) != 1) l = -1;
+    fclose(f);
+  }
+  return l;
+}
+
 // CPU seconds of the whole process (all threads)
 static inline double bench_cpu(void) {
   struct timespec ts;

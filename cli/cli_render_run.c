@@ -267,13 +267,14 @@ static vd_status begin_outputs(const cli_render_opts* o, const cli_run* run, con
   return st;
 }
 
-// the colliders of a frame as solids (planes are the floor's business)
+// the colliders of a frame as solids (planes are the floor's business, meshes are not drawn)
 static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int ncol,
                                vd_error* err) {
   vd_status st = VD_OK;
   for (int c = 0; c < ncol && !st; c++) {
     const vd_sim_collider* k = &col[c];
-    if (k->shape == VD_SIM_PLANE) continue;
+    // a mesh collider's distance grid is not in the run (and its size is 0): not drawn
+    if (k->shape == VD_SIM_PLANE || k->shape == VD_SIM_MESH) continue;
     vd_render_shape s = {k->shape == VD_SIM_SPHERE    ? VD_RENDER_SPHERE
                          : k->shape == VD_SIM_CAPSULE ? VD_RENDER_CAPSULE
                                                       : VD_RENDER_BOX,

@@ -96,7 +96,8 @@ then ok "las extra bytes and label table"; else bad "las extra bytes and label t
 # poses in the headers and PCD's VIEWPOINT (issue 12, item 19)
 "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 -N 3000 --seed 2 -o "$T/v1.pcd" &&
   "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 --scanner -1,1,1 -N 3000 --seed 2 -o "$T/v2.xyz" &&
-  "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 --scanner -1,1,1 -N 3000 --seed 2 -o "$T/v2.csv"
+  "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 --scanner -1,1,1 -N 3000 --seed 2 -o "$T/v2.csv" &&
+  "$V" cloud "$TOM" --sensor distance --scanner 1.5,0.5,0.8 --scanner -1,1,1 -N 3000 --seed 2 -o "$T/v2.ply"
 if python3 - "$T" <<'PY'
 import math, sys
 t = sys.argv[1]
@@ -118,6 +119,10 @@ for f in ["v2.xyz", "v2.csv"]:
     lines = open(t + "/" + f).read().splitlines()
     assert sum(l.startswith("# view ") for l in lines) == 2, f
     assert any(l.startswith("# view 1 position -1 1 1 target") for l in lines), f
+# PLY: the per-view table in the header comments
+ply = open(t + "/v2.ply", "rb").read(4000).split(b"end_header")[0].decode().splitlines()
+views = [l.split() for l in ply if l.startswith("comment view ")]
+assert [v[2] for v in views] == ["0", "1"] and views[0][4:7] == ["1.5", "0.5", "0.8"], views
 PY
 then ok "scanner poses: PCD viewpoint, view lines"; else bad "scanner poses: PCD viewpoint, view lines"; fi
 NPY=""

@@ -109,16 +109,6 @@ static void row(FILE* csv, const char* kase, const char* model, int ages, int su
   fflush(csv);
 }
 
-static double load1(void) {
-  double l = -1;
-  FILE* f = fopen("/proc/loadavg", "r");
-  if (f) {
-    if (fscanf(f, "%lf", &l) != 1) l = -1;
-    fclose(f);
-  }
-  return l;
-}
-
 int main(int argc, char** argv) {
   const char* csv_path = NULL;
   int ages = 25, rods = 1;
@@ -154,13 +144,13 @@ int main(int argc, char** argv) {
   run r;
   vd_plant_spec* final = NULL;
   vd_growth_def d = bench_def(VD_GROWTH_MSS, ages);
-  if (grow(ls, &d, &r, NULL)) row(csv, "grow", "mss", ages, d.substeps, &r, load1());
+  if (grow(ls, &d, &r, NULL)) row(csv, "grow", "mss", ages, d.substeps, &r, bench_load1());
   d = bench_def(VD_GROWTH_MRL, ages);
-  if (grow(ls, &d, &r, &final)) row(csv, "grow", "mrl", ages, d.substeps, &r, load1());
+  if (grow(ls, &d, &r, &final)) row(csv, "grow", "mrl", ages, d.substeps, &r, bench_load1());
   if (rods) {
-    if (final && rods_on(final, &d, d.substeps, &r)) row(csv, "final_tree", "rods", ages, d.substeps, &r, load1());
+    if (final && rods_on(final, &d, d.substeps, &r)) row(csv, "final_tree", "rods", ages, d.substeps, &r, bench_load1());
     d = bench_def(VD_GROWTH_RODS, ages);
-    if (grow(ls, &d, &r, NULL)) row(csv, "grow", "rods", ages, d.substeps, &r, load1());
+    if (grow(ls, &d, &r, NULL)) row(csv, "grow", "rods", ages, d.substeps, &r, bench_load1());
   }
   vd_plant_spec_destroy(final);
   fclose(csv);

@@ -36,16 +36,6 @@ static double children_cpu(void) {
          1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
-// the 1-minute load average (-1 when unknown)
-static double load1(void) {
-  double l = -1;
-  FILE* f = fopen("/proc/loadavg", "r");
-  if (f) {
-    if (fscanf(f, "%lf", &l) != 1) l = -1;
-    fclose(f);
-  }
-  return l;
-}
 
 // the scene's plant grown (seed and derivation steps of the scene), placed and compiled
 static vd_model* scene_plant(const vd_scene* s) {
@@ -229,7 +219,7 @@ int main(int argc, char** argv) {
   double duration = quick ? 6 : 10;
   episode_out e;
   if (!run_episode(&s, plant, duration, &e)) return 1;
-  double robot_dt = 0, l = load1();
+  double robot_dt = 0, l = bench_load1();
   printf("pull episode, full tomato (%d segments, plant dt %.4g s): %.2f s simulated in %.2f CPU s: %.2fx real "
          "time; detached %d at the %s (%.2f N)\n",
          e.nseg, e.plant_dt, e.sim, e.cpu, e.sim / e.cpu, e.detached, e.site, e.force);
@@ -241,7 +231,7 @@ int main(int argc, char** argv) {
            "(the plant costs %.1fx the arm)\n",
            acpu, e.sim / acpu, e.cpu / acpu);
     fprintf(csv, "arm_alone,lite6 MuJoCo only,%.3f,%.5f,%.2f,1,1,,,0,,%.6g,%.6g,,,,%.2f\n", e.sim, acpu, e.sim / acpu,
-            robot_dt, e.control_dt, load1());
+            robot_dt, e.control_dt, bench_load1());
   }
   free(e.q);
   // batches through the CLI beside this program (build/verdant)
@@ -250,7 +240,7 @@ int main(int argc, char** argv) {
   char* slash = strrchr(verdant, '/');
   snprintf(slash ? slash + 1 : verdant, sizeof verdant - (size_t)(slash ? slash + 1 - verdant : 0), "verdant");
   for (int jobs = 1; jobs <= 2; jobs++) {
-    double cpe = 0, l0 = load1();
+    double cpe = 0, l0 = bench_load1();
     double epm = batch(verdant, scene_path, n, jobs, &cpe);
     if (epm < 0) continue;
     printf("batch of %d episodes on %d job%s: %.1f episodes/min (%.2f CPU s per episode; load %.1f)\n", n, jobs,
