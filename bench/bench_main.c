@@ -29,6 +29,12 @@ static const case_def cases[] = {
      "A(s) :\n  if random() < 0.5:\n    produce F(s)[+(uniform(20,40))A(s*0.7)]A(s*0.9)\n"
      "  else:\n    produce F(s)[-(uniform(20,40))A(s*0.7)]/(137.5)A(s*0.9)\n",
      {14, 17, 20}},
+    // every module rewritten by a rule with a body: the rule calls dominate (the Python engine's
+    // worst case)
+    {"body_every_module",
+     "Axiom: A(0)\nproduction:\nA(x) :\n  if x % 2 == 0:\n    produce A(x + 1) A(x + 3)\n"
+     "  else:\n    produce A(x + 1)\n",
+     {34, 40, 46}},
 };
 
 typedef struct acc {

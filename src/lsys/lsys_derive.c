@@ -372,6 +372,7 @@ static int has_rules(const vd_lsystem* ls) { return ls->nrule > 0; }
 // (with source index src)
 static vd_status interpretation_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src,
                                      int64_t max_modules) {
+  if (ls->py) return lsys_py_produce_hook(ls, name, out, src, max_modules);
   int fi = find_hook(ls, name);
   if (fi < 0) return VD_OK;
   func* f = ls->funcs[fi];
@@ -399,6 +400,21 @@ static vd_status interpret_into(vd_lsystem* ls, const vd_lstring* in, vd_lstring
   int m = 0;
   if ((st = lsys_recursive(ls, SEC_INTERPRETATION, in, out, P, ls->max_depth[SEC_INTERPRETATION], 0, &m))) return st;
   return interpretation_hook(ls, "EndInterpretation", out, in->n + 1, P->max_modules);
+}
+
+vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant) {
+  lsys_pass P;
+  memset(&P, 0, sizeof P);
+  P.max_modules = INT64_MAX / 64;
+  vd_lstring geo = vd_lstring_empty();
+  vd_status st = interpret_into(ls, s, &geo, &P);
+  if (!st) {
+    vd_turtle_def td = vd_turtle_def_default();
+    st = vd_turtle_run(ls, &geo, &td, plant, ls->err);
+  }
+  vd_lstring_free(&geo);
+  lsys_pass_free(&P);
+  return st;
 }
 
 // L-Py's environmental programs: before a step whose rules read query modules, the turtle

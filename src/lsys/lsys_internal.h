@@ -527,6 +527,12 @@ vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, 
 // call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
 // the current string (an End hook may return a new one). Missing hooks are fine.
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
+// call hook name (StartInterpretation, EndInterpretation) with what it produces appended to out,
+// recorded as coming from module src; a hook that declares a parameter gets the turtle (None)
+vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules);
+// the plant the string s draws (interpretation with its hooks, then the turtle), for the scene
+// a Python hook receives (EndEach(lstring, lscene))
+vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant);
 // drop objects that no module of s refers to any more (after a step)
 void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)
@@ -545,9 +551,14 @@ vd_status lsys_obj_guide(const vd_lsystem* ls, double v, int m, double* length, 
 // A function of x: its range and its n samples at equal steps (QuantisedFunction).
 vd_status lsys_obj_function(const vd_lsystem* ls, double v, double* fx, double* lx, double** val, int* n, char* why,
                             size_t cap);
+// A 3D vector (Vector3, a sequence of three numbers) as c[0..2].
+vd_status lsys_obj_vec3(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap);
 // A geometry as a triangle mesh: nv vertices (x, y, z), nt triangles, closed when it bounds a volume.
 vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, int** tri, int* nt, int* closed,
                         char* why, size_t cap);
+// The turtle settings the file made through context().turtle (setAngleIncrement,
+// setWidthIncrement, setScaleMultiplier, setElasticity) applied over td (Python engine).
+void lsys_py_turtle_def(const vd_lsystem* ls, vd_turtle_def* td);
 // repr() of an object parameter into buf (cap bytes); "None" for a stale handle
 void lsys_py_repr(const vd_lsystem* ls, double v, char* buf, size_t cap);
 

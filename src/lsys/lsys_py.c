@@ -287,6 +287,9 @@ void lsys_py_leave(vd_lsystem* ls) {
 static vd_status status_of(PyObject* type) {
   if (PyErr_GivenExceptionMatches(type, PyExc_SyntaxError)) return VD_ERR_SYNTAX;
   if (PyErr_GivenExceptionMatches(type, PyExc_NameError)) return VD_ERR_NAME;
+  // a PlantGL / L-Py name the shim does not have (lsys_shim.py _NotInShim): a refusal
+  PyObject* nis = g_shim ? PyDict_GetItemString(g_shim, "_NotInShim") : NULL;  // borrowed
+  if (nis && PyErr_GivenExceptionMatches(type, nis)) return VD_ERR_UNSUPPORTED;
   if (PyErr_GivenExceptionMatches(type, PyExc_AttributeError)) return VD_ERR_NAME;
   if (PyErr_GivenExceptionMatches(type, PyExc_TypeError)) return VD_ERR_TYPE;
   if (PyErr_GivenExceptionMatches(type, PyExc_AssertionError)) return VD_ERR_ASSERT;
@@ -810,6 +813,65 @@ static PyObject* vd_append(PyObject* self, PyObject* arg) {
   return py_none();
 }
 
+static PyObject* vec_tuple(vd_vec3 v) { return Py_BuildValue("(ddd)", v.x, v.y, v.z); }
+
+// a primitive of the hook's scene: (kind, module, parent, ...) as _vd_build_scene reads it
+static PyObject* scene_prims(const vd_plant_spec* p) {
+  PyObject* list = PyList_New(0);
+  for (int i = 0; list && i < p->nseg; i++) {
+    const vd_segment_spec* g = &p->seg[i];
+    PyObject* it = Py_BuildValue("(sLiNNddN)", "seg", (long long)g->module, g->parent, vec_tuple(p->node[g->node0]),
+                                 vec_tuple(p->node[g->node1]), g->r0, g->r1, vec_tuple(g->up));
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  for (int i = 0; list && i < p->nsphere; i++) {
+    const vd_sphere_spec* g = &p->sphere[i];
+    PyObject* it =
+        Py_BuildValue("(sLiNd)", "sph", (long long)g->module, g->parent, vec_tuple(g->center), g->radius);
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  for (int i = 0; list && i < p->nmesh; i++) {
+    const vd_mesh_spec* m = &p->mesh[i];
+    PyObject* v = PyList_New(m->nvert);
+    PyObject* t = PyList_New(m->ntri);
+    for (int k = 0; v && k < m->nvert; k++) PyList_SET_ITEM(v, k, vec_tuple(p->vert[m->vert_start + k]));
+    for (int k = 0; t && k < m->ntri; k++) {
+      const int* q = &p->tri[3 * (m->tri_start + k)];
+      PyList_SET_ITEM(t, k, Py_BuildValue("(iii)", q[0], q[1], q[2]));
+    }
+    PyObject* it = v && t ? Py_BuildValue("(sLiNNi)", "mesh", (long long)m->module, m->parent, v, t, m->closed) : NULL;
+    if (!it) {
+      Py_XDECREF(v);
+      Py_XDECREF(t);
+    }
+    if (!it || PyList_Append(list, it)) Py_CLEAR(list);
+    Py_XDECREF(it);
+  }
+  return list;
+}
+
+// _vd.scene(): the primitives the hook's string draws
+static PyObject* vd_scene(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  if (!ls->py->hook_s) {
+    PyErr_SetString(PyExc_RuntimeError, "the scene is only known inside a hook");
+    return NULL;
+  }
+  vd_plant_spec* p = vd_plant_spec_create();
+  if (!p) return PyErr_NoMemory();
+  vm_out* saved = ls->py->out;
+  vd_status st = lsys_scene(ls, ls->py->hook_s, p);
+  ls->py->out = saved;
+  PyObject* r = st ? NULL : scene_prims(p);
+  vd_plant_spec_destroy(p);
+  if (st) return vd_abort();
+  return r;
+}
+
 static PyObject* vd_use_group(PyObject* self, PyObject* arg) {
   (void)self;
   vd_lsystem* ls = current();
@@ -909,6 +971,7 @@ static PyMethodDef vd_methods[] = {
     {"mk", (PyCFunction)(void (*)(void))vd_mk, METH_FASTCALL, "the items of a template"},
     {"parse", vd_parse, METH_O, "modules of an L-string text"},
     {"append", vd_append, METH_O, "append (name, params) items to the production"},
+    {"scene", vd_scene, METH_NOARGS, "the primitives the hook's string draws"},
     {"use_group", vd_use_group, METH_O, "useGroup"},
     {"get_group", vd_get_group, METH_NOARGS, "getGroup"},
     {"iteration", vd_iteration, METH_NOARGS, "getIterationNb"},
@@ -1158,6 +1221,19 @@ static int arity(PyObject* f) {
   return k;
 }
 
+vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules) {
+  lsys_py* py = ls->py;
+  if (!py->ns) return VD_OK;
+  PyObject* f = PyDict_GetItemString(py->ns, name);  // borrowed
+  if (!f || !PyCallable_Check(f)) return VD_OK;
+  PyObject* args[1] = {Py_None};
+  vm_out vo = {out, src, max_modules, 0, 0};
+  Py_INCREF(f);
+  vd_status st = call_rule(ls, f, args, arity(f) >= 1 ? 1 : 0, &vo);
+  Py_DECREF(f);
+  return st;
+}
+
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules) {
   lsys_py* py = ls->py;
   if (!py->ns) return VD_OK;
@@ -1174,8 +1250,11 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
     n = 1;
   }
   if (want >= 2) {
-    Py_INCREF(Py_None);
-    args[1] = Py_None;
+    args[1] = shim_call("_vd_lazy_scene", NULL);  // made from s when the hook reads it
+    if (!args[1]) {
+      Py_DECREF(args[0]);
+      return py_error(ls);
+    }
     n = 2;
   }
   Py_INCREF(f);
@@ -1188,14 +1267,32 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   }
   lstr_clear(scratch);
   vm_out* saved = py->out;
+  const vd_lstring* saved_s = py->hook_s;
   py->out = &vo;  // an nproduce in a hook has nowhere to go but is not an error
+  py->hook_s = s;
   PyObject* r = PyObject_Vectorcall(f, args, (size_t)n, NULL);
   py->out = saved;
+  py->hook_s = saved_s;
   Py_DECREF(f);
+  // a hook that changed the L-string it was given in place (lstring[0][0] = 2) and returned
+  // nothing: the changed string is the result, as the hook saw L-Py's own string
+  if (r == Py_None && n >= 1) {
+    Py_DECREF(r);
+    Py_INCREF(args[0]);
+    r = args[0];
+  }
   for (int i = 0; i < n; i++) Py_DECREF(args[i]);
   if (!r) return py_error(ls);
   vd_status st = VD_OK;
-  if (r != Py_None && r != Py_True && r != Py_False) {
+  // a hook may return (lstring, scene): the string counts
+  if (PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 2) {
+    PyObject* first = PyTuple_GET_ITEM(r, 0);
+    Py_INCREF(first);
+    Py_DECREF(r);
+    r = first;
+  }
+  PyObject* scene_type = PyDict_GetItemString(g_shim, "Scene");  // borrowed
+  if (r != Py_None && r != Py_True && r != Py_False && !(scene_type && PyObject_IsInstance(r, scene_type) == 1)) {
     // the hook returned a new string: it replaces the current one
     PyObject* items = shim_call("_vd_items", r);
     lstr_clear(scratch);
@@ -1435,6 +1532,26 @@ static double* doubles(PyObject* seq, int* n) {
 
 static void free_doubles(double* a, int n) { vd_free(a, sizeof(double) * (size_t)(n ? n : 1)); }
 
+vd_status lsys_obj_vec3(const vd_lsystem* ls, double v, double c[3], char* why, size_t cap) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  lsys_py_enter(mls);
+  vd_status st = VD_ERR_TYPE;
+  PyObject* r = obj_query(mls, v, "_vd_vec3", NULL, why, cap);
+  int k = 0;
+  double* p = r ? doubles(r, &k) : NULL;
+  if (p && k == 3 && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
+    memcpy(c, p, sizeof(double) * 3);
+    st = VD_OK;
+  } else if (r) {
+    snprintf(why, cap, "a vector that is not three finite numbers");
+  }
+  if (p) free_doubles(p, k);
+  Py_XDECREF(r);
+  PyErr_Clear();
+  lsys_py_leave(mls);
+  return st;
+}
+
 vd_status lsys_obj_points(const vd_lsystem* ls, double v, double** p, int* n, int* dim, char* why, size_t cap) {
   vd_lsystem* mls = (vd_lsystem*)ls;
   *p = NULL;
@@ -1562,4 +1679,23 @@ vd_status lsys_obj_mesh(const vd_lsystem* ls, double v, double** xyz, int* nv, i
   PyErr_Clear();
   lsys_py_leave(mls);
   return st;
+}
+
+void lsys_py_turtle_def(const vd_lsystem* ls, vd_turtle_def* td) {
+  vd_lsystem* mls = (vd_lsystem*)ls;
+  if (!ls || !ls->py || !ls->py->ns || g_state != 1) return;
+  lsys_py_enter(mls);
+  PyObject* d = shim_call("_vd_turtle_settings", ls->py->ns);
+  static const char* names[] = {"setAngleIncrement", "setWidthIncrement", "setScaleMultiplier", "setElasticity"};
+  double* fields[] = {&td->angle, &td->width_inc, &td->scale_factor, &td->elasticity};
+  for (int k = 0; d && PyDict_Check(d) && k < 4; k++) {
+    PyObject* a = PyDict_GetItemString(d, names[k]);  // borrowed: the arguments' tuple
+    if (!a || !PyTuple_Check(a) || PyTuple_GET_SIZE(a) < 1) continue;
+    double v = PyFloat_AsDouble(PyTuple_GET_ITEM(a, 0));
+    if (!PyErr_Occurred() && isfinite(v)) *fields[k] = v;
+    PyErr_Clear();
+  }
+  Py_XDECREF(d);
+  PyErr_Clear();
+  lsys_py_leave(mls);
 }

@@ -10,6 +10,7 @@
 # points (x, y, w), [firstKnot, lastKnot] parameter ranges, stride 30, QuantisedFunction's
 # sampling 100, arc length by the stride's chords.
 import builtins as _builtins
+import itertools as _itertools
 import math as _math
 import os as _os
 import random as _random
@@ -97,6 +98,12 @@ def _vd_import(name, globals=None, locals=None, fromlist=(), level=0):
             mod = globals["__vd_future"] = _future_module()
         _lpy.__lpyfuture__ = mod
         return mod if fromlist else OPENALEA["openalea"]
+    if level == 0 and name == "openalea.lpy.tableparameterset" and globals is not None:
+        mod = globals.get("__vd_tableps")
+        if mod is None:
+            mod = globals["__vd_tableps"] = _tableparam_module()
+        _lpy.tableparameterset = mod
+        return mod if fromlist else OPENALEA["openalea"]
     if level == 0 and (name == "openalea" or name.startswith("openalea.")):
         mod = OPENALEA.get(name)
         if mod is None:
@@ -107,14 +114,68 @@ def _vd_import(name, globals=None, locals=None, fromlist=(), level=0):
         mod = _real_import(name, globals, locals, fromlist, level)
     except ModuleNotFoundError:
         mod = _import_beside(name, globals, fromlist, level)
+        if mod is None and level == 0 and name in ("pylab", "matplotlib", "matplotlib.pyplot"):
+            mod = _plot_module(name, fromlist)
         if mod is None:
             raise
+    if getattr(mod, "__name__", None) in ("importlib", "imp"):
+        mod = _reload_proxy(mod)
     if not _run["np_seeded"] and name.split(".")[0] == "numpy":
         npr = _np_random()
         if npr is not None:
             npr.seed(_run["seed"] % (1 << 32))
             _run["np_seeded"] = True
     return mod
+
+
+def _reload_proxy(mod):
+    """importlib (or imp) whose reload() gives verdant's openalea modules back as they are (each
+    run has fresh ones) and runs a module beside the .lpy file again: neither is in
+    sys.modules, where the real reload looks."""
+    p = _types.ModuleType(mod.__name__)
+    p.__dict__.update(mod.__dict__)
+    real = mod.reload
+
+    def reload(m):
+        if getattr(m, "__vd_local__", False):
+            # a module beside the .lpy file: run again
+            m.__spec__.loader.exec_module(m)
+            return m
+        return m if getattr(m, "__vd_shim__", False) else real(m)
+    p.reload = reload
+    return p
+
+
+_PLOT_CALLS = ["plot", "show", "draw", "close", "figure", "clf", "cla", "subplot", "xlabel", "ylabel", "title",
+               "legend", "grid", "axis", "xlim", "ylim", "ion", "ioff", "pause", "scatter", "bar", "hist", "text",
+               "imshow", "colorbar", "gca", "gcf", "hold", "semilogx", "semilogy", "loglog", "fill", "fill_between",
+               "axhline", "axvline", "tight_layout", "xticks", "yticks", "annotate", "errorbar", "contour",
+               "contourf", "pcolor", "pcolormesh", "quiver", "boxplot", "pie", "step", "stem", "suptitle"]
+
+
+def _plot_module(name, fromlist):
+    """pylab / matplotlib.pyplot where matplotlib is not installed: plotting draws nothing (as
+    PlantGL's Viewer here: a command-line run has no window), pylab's numpy names are numpy's;
+    savefig, whose file a user would expect, is refused."""
+    m = _types.ModuleType("matplotlib.pyplot" if name != "pylab" else "pylab")
+    if name == "pylab":
+        try:
+            import numpy
+            m.__dict__.update({k: v for k, v in numpy.__dict__.items() if not k.startswith("_")})
+        except ImportError:
+            pass
+    for n in _PLOT_CALLS:
+        setattr(m, n, _NoDisplay())
+    m.subplots = lambda *a, **k: (_NoDisplay(), _NoDisplay())
+    m.savefig = _unsupported("savefig (matplotlib is not installed)")
+    m.__vd_shim__ = True
+    if name == "pylab":
+        return m
+    pkg = _types.ModuleType("matplotlib")
+    pkg.pyplot = m
+    pkg.use = _NoDisplay()
+    pkg.__vd_shim__ = True
+    return m if fromlist and name == "matplotlib.pyplot" else pkg
 
 
 def _import_beside(name, globals, fromlist, level):
@@ -130,6 +191,9 @@ def _import_beside(name, globals, fromlist, level):
         import importlib.util as iu
         spec = iu.spec_from_file_location(top, path)
         mod = iu.module_from_spec(spec)
+        # its own imports are answered as the file's are (openalea from this shim)
+        mod.__builtins__ = _BUILTINS
+        mod.__vd_local__ = True
         spec.loader.exec_module(mod)
         _local_modules[path] = mod
     return mod
@@ -545,6 +609,7 @@ def _future_module():
     result (the EndEach it provides, or decorates, gives the string before the step back);
     pushString/popString keep strings by name."""
     m = _types.ModuleType("openalea.lpy.__lpyfuture__")
+    m.__vd_shim__ = True
     state = {"discard": False, "last": None, "push": None, "pop": None, "stack": {}}
 
     def DiscardNewString():
@@ -597,6 +662,150 @@ def _future_module():
         setattr(m, name, f)
     m.__all__ = ["DiscardNewString", "enable_string_discard", "pushString", "popString", "enable_string_pushpop",
                  "EndEach"]
+    return m
+
+
+class _Table:
+    """get_table() where pandas is not installed: the table's columns (parameter name -> {uid:
+    value}); printed as rows."""
+
+    def __init__(self, data, n):
+        self.data, self.n = data, n
+
+    @property
+    def columns(self):
+        return list(self.data)
+
+    def to_dict(self):
+        return {k: dict(v) for k, v in self.data.items()}
+
+    def __len__(self):
+        return self.n
+
+    def __repr__(self):
+        cols = list(self.data)
+        rows = [[""] + cols] + [[str(i)] + [repr(self.data[c][i]) if i in self.data[c] else "NaN" for c in cols]
+                                for i in range(self.n)]
+        w = [max(len(r[k]) for r in rows) for k in range(len(cols) + 1)]
+        return "\n".join("  ".join(x.rjust(w[k]) for k, x in enumerate(r)) for r in rows)
+
+
+def _tableparam_module():
+    """openalea.lpy.tableparameterset, a fresh one for every run: parameter sets whose values
+    live in one table (parameter name -> {uid: value}); get_table() gives it as a pandas
+    DataFrame when pandas is installed."""
+    m = _types.ModuleType("openalea.lpy.tableparameterset")
+    m.__vd_shim__ = True
+    state = {"table": None}
+
+    class ParamDictTable:
+        def __init__(self):
+            self.id = 0
+            self.data = {}
+
+        def dataframe(self):
+            try:
+                from pandas import DataFrame
+            except ImportError:
+                return _Table(self.data, self.id)
+            return DataFrame(self.data)
+
+        def pnames(self):
+            return list(self.data)
+
+        def get_new_id(self, att):
+            uid = self.id
+            self.id += 1
+            for k, v in att.items():
+                self.setattr(uid, k, v)
+            return uid
+
+        def hasattr(self, uid, name):
+            return name in self.data and uid in self.data[name]
+
+        def setattr(self, uid, name, value):
+            self.data.setdefault(name, {})[uid] = value
+
+        def getattr(self, uid, name):
+            if not self.hasattr(uid, name):
+                raise AttributeError("parameter set %d has no parameter %r" % (uid, name))
+            return self.data[name][uid]
+
+        def delattr(self, uid, name):
+            if not self.hasattr(uid, name):
+                raise AttributeError(name)
+            del self.data[name][uid]
+
+        def rename(self, old, new):
+            self.data[new] = self.data.pop(old)
+
+    def init_table(value=None):
+        state["table"] = ParamDictTable() if value is None else value
+
+    def init_dict_table(value=None):
+        init_table(ParamDictTable() if value is None else value)
+
+    def table():
+        if state["table"] is None:
+            init_table()
+        return state["table"]
+
+    def get_table():
+        return table().dataframe()
+
+    class TableParameterSet:
+        """A parameter set whose values are a row of the module's table."""
+
+        def __init__(self, **kw):
+            self.__dict__["uid"] = table().get_new_id(kw)
+
+        def rename(self, old, new):
+            table().rename(old, new)
+
+        def setdefault(self, *args, **kw):
+            for k, v in list(zip(args[0::2], args[1::2])) + list(kw.items()):
+                if not table().hasattr(self.uid, k):
+                    table().setattr(self.uid, k, v)
+
+        def hasattr(self, name):
+            return table().hasattr(self.uid, name)
+
+        def get(self, name, default=None):
+            return table().getattr(self.uid, name) if table().hasattr(self.uid, name) else default
+
+        def set(self, **kw):
+            for k, v in kw.items():
+                table().setattr(self.uid, k, v)
+
+        def parameter_names(self):
+            return table().pnames()
+
+        def __getattr__(self, name):
+            if name.startswith("__"):
+                raise AttributeError(name)
+            return table().getattr(self.__dict__["uid"], name)
+
+        def __setattr__(self, name, value):
+            if name == "uid":
+                self.__dict__["uid"] = value
+            else:
+                table().setattr(self.uid, name, value)
+
+        def __delattr__(self, name):
+            table().delattr(self.uid, name)
+
+        def __contains__(self, name):
+            return table().hasattr(self.uid, name)
+
+        def __repr__(self):
+            t = table()
+            return "TableParameterSet(%d,%s)" % (self.uid, ",".join(
+                "%s=%r" % (k, t.getattr(self.uid, k)) for k in t.pnames() if t.hasattr(self.uid, k)))
+
+    for name, f in (("init_table", init_table), ("init_dict_table", init_dict_table), ("get_table", get_table),
+                    ("ParamDictTable", ParamDictTable), ("ParamTable", ParamDictTable),
+                    ("TableParameterSet", TableParameterSet)):
+        setattr(m, name, f)
     return m
 
 
@@ -691,6 +900,12 @@ class _Context:
 
     def setObject(self, k, v):
         self[k] = v
+
+
+def _vd_turtle_settings(ns):
+    """The turtle settings the file made through context().turtle: {setter name: arguments}."""
+    ctx = ns.get("__vd_context")
+    return dict(ctx.turtle.settings) if ctx is not None else {}
 
 
 def _vd_init_context(ns):
@@ -1731,7 +1946,11 @@ class Box(_Geometry):
         return v, t, True
 
 
-class TriangleSet(_Geometry):
+class Mesh(_Geometry):
+    """The base of PlantGL's explicit meshes (TriangleSet, QuadSet, FaceSet)."""
+
+
+class TriangleSet(Mesh):
     def __init__(self, pointList=(), indexList=(), *a, **kw):
         self.pointList = Point3Array(pointList)
         self.indexList = [tuple(int(i) for i in f) for f in indexList]
@@ -1827,6 +2046,51 @@ class BezierPatch(NurbsPatch):
     def __init__(self, ctrlPointMatrix=None, ustride=30, vstride=30, ccw=True, **kw):
         m = ctrlPointMatrix if ctrlPointMatrix is not None else kw.pop("ctrlPointList")
         NurbsPatch.__init__(self, m, None, None, len(m) - 1, len(m[0]) - 1, ustride, vstride, ccw, **kw)
+
+
+class NurbsPatch3D:
+    """A NURBS volume (openalea.plantgl.scenegraph.nurbspatch_nd): a 3D array of (x, y, z, w)
+    control points, PlantGL's default knots; getPointAt(u, v, w) maps the unit cube into space."""
+
+    def __init__(self, points, udegree=3, vdegree=3, wdegree=3, uknotList=None, vknotList=None, wknotList=None,
+                 ustride=30, vstride=30, wstride=30):
+        self.ctrlPointMatrix = [[[p if isinstance(p, Vector4) else Vector4(*(tuple(p) + (1.0,) * (4 - len(p))))
+                                  for p in row] for row in plane] for plane in points]
+        dims = (len(points), len(points[0]), len(points[0][0]))
+        self.udegree, self.vdegree, self.wdegree = (min(int(d), n - 1) for d, n in
+                                                    zip((udegree, vdegree, wdegree), dims))
+        degs = (self.udegree, self.vdegree, self.wdegree)
+        self._knots = [RealArray(k) if k is not None else RealArray(_default_knots(n, d))
+                       for k, n, d in zip((uknotList, vknotList, wknotList), dims, degs)]
+        self.uknotList, self.vknotList, self.wknotList = self._knots
+        self.ustride, self.vstride, self.wstride = int(ustride), int(vstride), int(wstride)
+        self.name = ""
+
+    def isValid(self):
+        return True
+
+    def getPointAt(self, u, v, w):
+        P = self.ctrlPointMatrix
+        dims = (len(P), len(P[0]), len(P[0][0]))
+        degs = (self.udegree, self.vdegree, self.wdegree)
+        spans, bases = [], []
+        for x, k, d, n in zip((u, v, w), self._knots, degs, dims):
+            x = min(max(x, k[d]), k[n])
+            sp = _find_span(k, d, n, x)
+            spans.append(sp)
+            bases.append(_basis(k, d, sp, x))
+        C = [0.0] * 4
+        for i in range(degs[0] + 1):
+            for j in range(degs[1] + 1):
+                for l in range(degs[2] + 1):
+                    c = P[spans[0] - degs[0] + i][spans[1] - degs[1] + j][spans[2] - degs[2] + l]._c
+                    b = bases[0][i] * bases[1][j] * bases[2][l] * c[3]
+                    C[0] += c[0] * b
+                    C[1] += c[1] * b
+                    C[2] += c[2] * b
+                    C[3] += b
+        wt = C[3] if abs(C[3]) > 1e-10 else 1.0
+        return Vector3(C[0] / wt, C[1] / wt, C[2] / wt)
 
 
 class Paraboloid(_Geometry):
@@ -1944,11 +2208,98 @@ class Shape(_Geometry):
 
 
 class Scene(list):
+    """A list of Shapes. The one a hook receives (EndEach(lstring, lscene)) is filled on first use
+    with what the turtle draws from the string: one Shape per primitive, id = the module's index
+    in the string, geometry as PglTurtleDrawer builds it (Cylinder/Frustum/Cone placed by
+    Oriented and Translated, Polyline for zero radii, Sphere, TriangleSet)."""
+    _vd_pending = False
+
+    def _vd_fill(self):
+        if self._vd_pending:
+            self._vd_pending = False
+            list.extend(self, _vd_build_scene(_vd.scene()))
+
+    def __len__(self):
+        self._vd_fill()
+        return list.__len__(self)
+
+    def __getitem__(self, i):
+        self._vd_fill()
+        return list.__getitem__(self, i)
+
+    def __iter__(self):
+        self._vd_fill()
+        return list.__iter__(self)
+
+    def __bool__(self):
+        return self.__len__() > 0
+
     def add(self, s):
+        self._vd_fill()
         self.append(s)
+
+    def todict(self):
+        d = {}
+        for sh in self:
+            d.setdefault(sh.id, []).append(sh)
+        return d
 
     def _mesh(self):
         return Group(list(self))._mesh()
+
+
+def _vd_lazy_scene(_=None):
+    sc = Scene()
+    sc._vd_pending = True
+    return sc
+
+
+def _placed(g, pos, u, l):
+    """PglTurtleDrawer::transform: local x along U, y along -L, z along H, then the position."""
+    if abs(u.x - 1) > 1e-9 or abs(u.y) > 1e-9 or abs(u.z) > 1e-9 or abs(l.x) > 1e-9 or abs(l.y + 1) > 1e-9 or abs(l.z) > 1e-9:
+        g = Oriented(u, -l, g)
+    if norm(pos) > 1e-12:
+        g = Translated(pos, g)
+    return g
+
+
+def _vd_build_scene(prims):
+    """Shapes from the turtle's primitives (kind, module, parent, ...), in module order."""
+    out = []
+    order = sorted(range(len(prims)), key=lambda k: (prims[k][1], k))
+    for k in order:
+        p = prims[k]
+        kind, mid, parent = p[0], int(p[1]), int(p[2])
+        if kind == "seg":
+            p0, p1, r0, r1, up = Vector3(*p[3]), Vector3(*p[4]), p[5], p[6], Vector3(*p[7])
+            d = p1 - p0
+            length = norm(d)
+            h = d / length if length > 0 else Vector3(0, 0, 1)
+            l = (up ^ h).normed()
+            if r0 > 1e-6:
+                taper = r1 / r0
+                if abs(taper) < 1e-6:
+                    g = Cone(r0, length, False)
+                elif abs(taper - 1) < 1e-6:
+                    g = Cylinder(r0, length, False)
+                else:
+                    g = Frustum(r0, length, taper, False)
+                g = _placed(g, p0, up, l)
+            elif r1 < 1e-6:
+                g = Polyline([p0, p1])
+            else:
+                g = Cone(r1, length, False)
+                if abs(l.x - 1) > 1e-9 or abs(l.y) > 1e-9 or abs(l.z) > 1e-9 or abs(up.y + 1) > 1e-9:
+                    g = Oriented(l, -up, g)
+                g = Translated(p1, g)
+        elif kind == "sph":
+            g = Sphere(p[4])
+            if norm(Vector3(*p[3])) > 1e-12:
+                g = Translated(Vector3(*p[3]), g)
+        else:
+            g = TriangleSet(p[3], p[4])
+        out.append(Shape(g, None, mid, parent))
+    return out
 
 
 def _mesh_of(g):
@@ -1958,6 +2309,286 @@ def _mesh_of(g):
         return None
     f = getattr(g, "_mesh", None)
     return f() if f is not None else None
+
+
+# ---------------------------------------------------------------------------------------------
+# algorithms: point grids (spatial queries of space-colonisation models) and the Discretizer
+
+
+class _PointGrid:
+    """PlantGL's Point2Grid/Point3Grid: the points filed in voxels of a regular grid over their
+    bounds. Queries give the indices of the enabled points, voxel by voxel (in the order of the
+    voxels' linear ids, then of their filing); a disabled point is no longer found until it is
+    enabled again. Built as Point3Grid(voxelsize, points), Point3Grid(voxelsize, minpoint,
+    maxpoint, points) or Point3Grid(points, n) (n voxels along each axis of the bounds)."""
+    _vec = None
+
+    def __init__(self, *a):
+        if len(a) == 2 and self._is_points(a[0]):
+            pts, n = a
+            self._init_points(pts)
+            n = float(n)
+            if not n > 0:
+                raise ValueError("%s: the number of voxels per axis must be positive" % type(self).__name__)
+            size = [(hi - lo) / n for lo, hi in zip(self._lo, self._hi)]
+        elif len(a) == 2:
+            self._init_points(a[1])
+            size = self._size(a[0])
+        elif len(a) == 4:
+            self._init_points(a[3])
+            self._lo, self._hi = list(self._vec(a[1])), list(self._vec(a[2]))
+            size = self._size(a[0])
+        else:
+            raise TypeError("%s(voxelsize, points), (voxelsize, minpoint, maxpoint, points) or (points, n)"
+                            % type(self).__name__)
+        # an axis without extent (or a zero voxel size) has one voxel
+        self._vs = [s if s > 0 else 1.0 for s in size]
+        self._dims = [max(1, int(_math.floor((hi - lo) / s)) + 1) for lo, hi, s in zip(self._lo, self._hi, self._vs)]
+        self._cells = {}
+        for i, p in enumerate(self._pts):
+            self._cells.setdefault(self._cell(p), []).append(i)
+
+    def _is_points(self, x):
+        if isinstance(x, (int, float, _Vec)):
+            return False
+        x = list(x)
+        return not x or not isinstance(x[0], (int, float))
+
+    def _size(self, v):
+        d = len(self._lo)
+        if isinstance(v, (int, float)):
+            return [float(v)] * d
+        return [float(c) for c in self._vec(v)]
+
+    def _init_points(self, pts):
+        self._pts = [tuple(float(c) for c in self._vec(p)) for p in pts]
+        d = 2 if self._vec is Vector2 else 3
+        if self._pts:
+            self._lo = [min(p[k] for p in self._pts) for k in range(d)]
+            self._hi = [max(p[k] for p in self._pts) for k in range(d)]
+        else:
+            self._lo, self._hi = [0.0] * d, [0.0] * d
+
+    def _index(self, x, k):
+        return min(max(int(_math.floor((x - self._lo[k]) / self._vs[k])), 0), self._dims[k] - 1)
+
+    def _cell(self, p):
+        return tuple(self._index(x, k) for k, x in enumerate(p))
+
+    def _around(self, c, r):
+        """The enabled point indices of the voxels that the box c +- r touches, in voxel order."""
+        ranges = [range(self._index(x - r, k), self._index(x + r, k) + 1) for k, x in enumerate(c)]
+        out = []
+        for cell in _itertools.product(*ranges):
+            out += self._cells.get(cell, ())
+        return out
+
+    def query_ball_point(self, point, radius):
+        c = tuple(float(x) for x in self._vec(point))
+        return [i for i in self._around(c, radius)
+                if not _math.dist(self._pts[i], c) > radius]
+
+    def query_points_in_cone(self, origin, direction, radius, angle=_math.pi / 2):
+        o = tuple(float(x) for x in self._vec(origin))
+        d = self._vec(direction).normed()
+        cosa = _math.cos(angle / 2)
+        out = []
+        for i in self._around(o, radius):
+            v = [a - b for a, b in zip(self._pts[i], o)]
+            dist = _math.sqrt(sum(x * x for x in v))
+            if dist > radius + 1e-5:
+                continue
+            dt = sum(x * y for x, y in zip(v, d)) / dist if dist > 0 else 0.0
+            if dt > cosa - 1e-5:
+                out.append(i)
+        return out
+
+    def closest_point(self, point, maxdist=float("inf")):
+        """The index of the nearest enabled point within maxdist, or None."""
+        c = tuple(float(x) for x in self._vec(point))
+        best, bi = maxdist, None
+        for cell in sorted(self._cells):
+            for i in self._cells[cell]:
+                dist = _math.dist(self._pts[i], c)
+                if dist < best:
+                    best, bi = dist, i
+        return bi
+
+    def is_point_enabled(self, i):
+        return i in self._cells.get(self._cell(self._pts[i]), ())
+
+    def disable_point(self, i):
+        lst = self._cells.get(self._cell(self._pts[i]), [])
+        if i in lst:
+            lst.remove(i)
+            return True
+        return False
+
+    def enable_point(self, i):
+        lst = self._cells.setdefault(self._cell(self._pts[i]), [])
+        if i not in lst:
+            lst.append(i)
+            return True
+        return False
+
+    def disable_points(self, ids):
+        for i in list(ids):
+            self.disable_point(i)
+
+    def enable_points(self, ids):
+        for i in list(ids):
+            self.enable_point(i)
+
+    def get_enabled_point_indices(self):
+        return [i for i in range(len(self._pts)) if self.is_point_enabled(i)]
+
+    def get_disabled_point_indices(self):
+        return [i for i in range(len(self._pts)) if not self.is_point_enabled(i)]
+
+    def _array(self, ids):
+        return (Point2Array if self._vec is Vector2 else Point3Array)([self._pts[i] for i in ids])
+
+    def get_enabled_points(self):
+        return self._array(self.get_enabled_point_indices())
+
+    def get_disabled_points(self):
+        return self._array(self.get_disabled_point_indices())
+
+    def nbFilledVoxels(self):
+        return sum(1 for v in self._cells.values() if v)
+
+    def size(self):
+        n = 1
+        for d in self._dims:
+            n *= d
+        return n
+
+    def getVoxelSize(self):
+        return self._vec(*self._vs)
+
+    def dimensions(self):
+        return tuple(self._dims)
+
+
+class Point3Grid(_PointGrid):
+    _vec = Vector3
+
+
+class Point2Grid(_PointGrid):
+    _vec = Vector2
+
+
+def _group_points(points, group):
+    pts = [_vec(points[i]) for i in group] if group else [_vec(p) for p in points]
+    return pts
+
+
+def pointset_directions(origin, points, group=()):
+    """The unit directions from origin to the points (those of group when given)."""
+    o = _vec(origin)
+    return Point3Array([direction(p - o) for p in _group_points(points, group)])
+
+
+def pointset_mean_direction(origin, points, group=()):
+    """PlantGL's pointset_mean_direction: the normed mean of the unit directions from origin to
+    the points (those of group when given)."""
+    d = pointset_directions(origin, points, group)
+    if not d:
+        return Vector3(0, 0, 0)
+    s = Vector3(0, 0, 0)
+    for v in d:
+        s += v
+    return (s / len(d)).normed()
+
+
+def findClosestFromSubset(origin, points, group=()):
+    """(index, distance) of the point nearest origin (among group when given; the first of equals)."""
+    o = _vec(origin)
+    ids = list(group) if group else range(len(points))
+    best = None
+    for i in ids:
+        dist = norm(_vec(points[i]) - o)
+        if best is None or dist < best[1]:
+            best = (i, dist)
+    return best
+
+
+class PointSet(_Geometry):
+    """Points (PlantGL's PointSet): no surface, so @g of it draws nothing (with a warning)."""
+
+    def __init__(self, pointList=(), colorList=None, width=1, **kw):
+        self.pointList, self.colorList, self.width = Point3Array(pointList), colorList, width
+
+
+class Discretizer:
+    """PlantGL's Discretizer action: geometry.apply(d) puts the geometry's discrete form in
+    d.result: a Polyline2D/Polyline of a curve's stride + 1 points, a TriangleSet of a surface
+    or a solid (the mesh the turtle draws)."""
+
+    def __init__(self):
+        self.result = None
+
+    def clear(self):
+        self.result = None
+
+    def getDiscretization(self):
+        return self.result
+
+    def process(self, g):
+        if isinstance(g, _Curve):
+            pts = g._vd_points(0)
+            self.result = Polyline2D(pts) if len(pts[0]) == 2 else Polyline(pts)
+            return True
+        m = _mesh_of(g)
+        if m is None:
+            self.result = None
+            return False
+        self.result = TriangleSet(m[0], m[1])
+        return True
+
+
+def _geometry_apply(self, action):
+    """PlantGL's geometry.apply(action): the action processes the geometry."""
+    return action.process(self)
+
+
+_Geometry.apply = _geometry_apply
+
+
+# ---------------------------------------------------------------------------------------------
+# display and extensions: verdant has no viewer (every Viewer call does nothing, as in L-Py's
+# batch runs); tools it does not provide fail when called, not when imported
+
+
+class _NoDisplay:
+    """PlantGL's Viewer without a window: attributes and calls accepted, nothing shown."""
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return _NoDisplay()
+
+    def __setattr__(self, name, value):
+        pass
+
+    def __call__(self, *a, **k):
+        return None
+
+
+Viewer = _NoDisplay()
+eStatic, eAnimatedPrimitives, eAnimatedScene = 0, 1, 2
+
+
+def pgl_support_extension(name):
+    """PlantGL's optional extensions (CGAL, ...): none here."""
+    return False
+
+
+def _unsupported(what):
+    def f(*a, **k):
+        raise NotImplementedError("%s is not available in verdant's PlantGL" % what)
+    f.__name__ = what
+    return f
 
 
 # ---------------------------------------------------------------------------------------------
@@ -2019,6 +2650,17 @@ def _vd_function(f):
     return None
 
 
+def _vd_vec3(x):
+    """The three coordinates of a 3D vector (Vector3, a sequence of three numbers), or None."""
+    if isinstance(x, (Vector2, Vector4, str)):
+        return None
+    try:
+        c = [float(a) for a in x]
+    except (TypeError, ValueError):
+        return None
+    return c if len(c) == 3 else None
+
+
 def _vd_number(x):
     """float(x) for number-like objects; None otherwise."""
     try:
@@ -2045,31 +2687,65 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "Point2Matrix", "Point3Matrix", "Point4Matrix", "Color3", "Color4", "Material", "ImageTexture",
                "Texture2D", "Texture2DTransformation", "NurbsCurve2D", "NurbsCurve", "BezierCurve2D", "BezierCurve",
                "Polyline2D", "Polyline", "Curve2D", "QuantisedFunction", "Sphere", "Cylinder", "Cone", "Frustum",
-               "Disc", "Box", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
-               "BezierPatch", "Paraboloid",
+               "Disc", "Box", "Mesh", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
+               "BezierPatch", "Paraboloid", "NurbsPatch3D", "Point2Grid", "Point3Grid", "Discretizer",
+               "PointSet", "pointset_directions", "pointset_mean_direction", "findClosestFromSubset",
                "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
         "PatternModule"]
 
+_DISPLAY = ["Viewer", "eStatic", "eAnimatedPrimitives", "eAnimatedScene", "pgl_support_extension"]
 _pgl_math = _module("openalea.plantgl.math", _MATH)
 _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
-_pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH)
+_pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH + _DISPLAY)
+_pgl_nd = _module("openalea.plantgl.scenegraph.nurbspatch_nd", ["NurbsPatch3D"])
+_pgl_sg.nurbspatch_nd = _pgl_nd
+_pgl_light = _types.ModuleType("openalea.plantgl.light.light")
+_pgl_light.diffuseInterception = _unsupported("diffuseInterception")
+_pgl_light.directionalInterception = _unsupported("directionalInterception")
+_pgl_light_pkg = _types.ModuleType("openalea.plantgl.light")
+_pgl_light_pkg.light = _pgl_light
 _pgl = _module("openalea.plantgl", [])
-_pgl.all, _pgl.math, _pgl.scenegraph = _pgl_all, _pgl_math, _pgl_sg
+_pgl.all, _pgl.math, _pgl.scenegraph, _pgl.light = _pgl_all, _pgl_math, _pgl_sg, _pgl_light_pkg
 _lpy = _module("openalea.lpy", _LPY)
+_lpy_ps = _module("openalea.lpy.parameterset", ["ParameterSet"])
+_lpy.parameterset = _lpy_ps
 _openalea = _module("openalea", [])
 _openalea.plantgl, _openalea.lpy = _pgl, _lpy
 OPENALEA = {"openalea": _openalea, "openalea.plantgl": _pgl, "openalea.plantgl.all": _pgl_all,
-            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy}
+            "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy,
+            "openalea.plantgl.light": _pgl_light_pkg, "openalea.plantgl.light.light": _pgl_light,
+            "openalea.lpy.parameterset": _lpy_ps, "openalea.plantgl.scenegraph.nurbspatch_nd": _pgl_nd}
+
+
+class NotInVerdant(AttributeError):
+    """A PlantGL or L-Py name the shim does not have: the engine refuses the file (unsupported),
+    naming it; hasattr() and getattr(m, name, default) still see an AttributeError."""
+
+
+def _missing_attr(modname):
+    def __getattr__(name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        raise NotInVerdant("%s.%s (verdant's PlantGL / L-Py does not have it)" % (modname, name))
+    return __getattr__
+
+
+_NotInShim = NotInVerdant
+
+
+for _m in OPENALEA.values():
+    _m.__vd_shim__ = True
+    _m.__getattr__ = _missing_attr(_m.__name__)
 
 _BUILTINS = dict(_builtins.__dict__)
 _BUILTINS["__import__"] = _vd_import
 _BUILTINS["print"] = _vd_print
 
 BASE = {"__builtins__": _BUILTINS, "__name__": "__lpy__"}
-for _n in _MATH + _SCENEGRAPH + _LPY:
+for _n in _MATH + _SCENEGRAPH + _LPY + _DISPLAY:
     BASE[_n] = globals()[_n]
 BASE["__vd_p"] = _vd.p
 BASE["__vd_mk"] = _vd_mk

@@ -230,6 +230,11 @@ static vd_status num(turtle* T, int k, double* out) {
   if (!isfinite(v)) {
     if (vd_lsys_value_is_str(v))
       return fail(T, VD_ERR_TYPE, "parameter %d is a string, expected a number", k + 1);
+    if (vd_lsys_value_is_obj(v)) {
+      char r[120];
+      lsys_py_repr(T->ls, v, r, sizeof r);
+      return fail(T, VD_ERR_TYPE, "parameter %d is %s, expected a number", k + 1, r);
+    }
     return fail(T, VD_ERR_VALUE, "parameter %d is not finite", k + 1);
   }
   *out = v;
@@ -1295,13 +1300,28 @@ static vd_status angle_arg(turtle* T, double* deg) {
   return num_or(T, 0, T->def.angle, deg);
 }
 
-// a vector from up to three parameters starting at k (missing ones from dflt)
-static vd_status vec_args(turtle* T, int k, vd_vec3 dflt, vd_vec3* out) {
+// a vector from parameter *k on: one vector object (Vector3 or a 3-tuple of the Python engine,
+// as L-Py's turtle takes) or up to three numbers (missing ones from dflt); *k moves past them
+static vd_status vec_at(turtle* T, int* k, vd_vec3 dflt, vd_vec3* out) {
   vd_status st;
-  if ((st = num_or(T, k, dflt.x, &out->x)) || (st = num_or(T, k + 1, dflt.y, &out->y)) ||
-      (st = num_or(T, k + 2, dflt.z, &out->z)))
+  if (*k < T->np && vd_lsys_value_is_obj(T->p[*k])) {
+    char why[200];
+    double c[3];
+    if (lsys_obj_vec3(T->ls, T->p[*k], c, why, sizeof why) != VD_OK)
+      return fail(T, VD_ERR_TYPE, "parameter %d: expected a number or a 3D vector, got %s", *k + 1, why);
+    *out = vd_v3(c[0], c[1], c[2]);
+    (*k)++;
+    return VD_OK;
+  }
+  if ((st = num_or(T, *k, dflt.x, &out->x)) || (st = num_or(T, *k + 1, dflt.y, &out->y)) ||
+      (st = num_or(T, *k + 2, dflt.z, &out->z)))
     return st;
+  *k += 3;
   return VD_OK;
+}
+
+static vd_status vec_args(turtle* T, int k, vd_vec3 dflt, vd_vec3* out) {
+  return vec_at(T, &k, dflt, out);
 }
 
 // @v(alpha): roll about H so that U comes closest to vertical (PlantGL rollToVert)
@@ -1588,10 +1608,12 @@ static vd_status step(turtle* T) {
   case VD_SYM_SETHEAD: {
     vd_vec3 u;
     if (T->np == 0) return set_head(T, vd_v3(0, 0, 1), vd_v3(1, 0, 0));
-    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = vec_args(T, 3, vd_v3(0, 0, 0), &u)))
-      return st;
+    int k = 0;
+    if ((st = vec_at(T, &k, vd_v3(0, 0, 0), &v))) return st;
+    int has_up = k < T->np;
+    if ((st = vec_at(T, &k, vd_v3(0, 0, 0), &u))) return st;
     if (vd_norm(v) < EPS) return fail(T, VD_ERR_VALUE, "zero heading");
-    if (T->np <= 3 || vd_norm(u) < EPS) {
+    if (!has_up || vd_norm(u) < EPS) {
       // no usable up: turn toward the heading like PinpointRel
       tend_to(T, vd_normalize(v), 1);
       return VD_OK;
@@ -1612,7 +1634,8 @@ static vd_status step(turtle* T) {
     int rel = T->sym == VD_SYM_LINEREL || T->sym == VD_SYM_OLINEREL;
     int keep = T->sym == VD_SYM_LINETO || T->sym == VD_SYM_LINEREL;
     if (T->np == 0) return VD_OK;
-    if ((st = vec_args(T, 0, vd_v3(0, 0, 0), &v)) || (st = num_or(T, 3, -1, &b))) return st;
+    int k = 0;
+    if ((st = vec_at(T, &k, vd_v3(0, 0, 0), &v)) || (st = num_or(T, k, -1, &b))) return st;
     return line_to(T, rel ? vd_add(t->pos, v) : v, b, keep);
   }
   case VD_SYM_EULER:
@@ -1820,6 +1843,8 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
   // the file's own default angle (context.turtle.setAngleIncrement, as L-Py's turtle takes it)
   double fa;
   if (ls && lsys_turtle_angle(ls, &fa)) T.def.angle = fa;
+  // the Python engine's other settings of the file (setWidthIncrement, setScaleMultiplier, ...)
+  if (ls && ls->py) lsys_py_turtle_def(ls, &T.def);
   vd_status st = check_def(&T.def, err);
   if (st) return st;
   T.ls = ls;
