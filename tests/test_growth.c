@@ -140,3 +140,24 @@ TEST(growth, bad_settings) {
   vd_growth_destroy(g);
   vd_lsys_destroy(ls);
 }
+
+TEST(growth, seed_findings_on_hopea) {
+  // the seed's Hopea odorata (25 years): eq. 5 with eq. 3 diverges; in 15 m/s wind the ML-Tree
+  // collapses where the MRL-Tree holds (verdant validate --full, docs/validation.md)
+  const char* cases[2] = {"finding_hopea_eq5", "finding_hopea_wind"};
+  int expect[2] = {1, 2};
+  for (int c = 0; c < 2; c++) {
+    vd_validate_def def;
+    memset(&def, 0, sizeof def);
+    def.full = 1;
+    def.filter = cases[c];
+    vd_validate_result* r = NULL;
+    int n = 0;
+    vd_error e = {0};
+    REQUIRE(vd_growth_validate(&def, &r, &n, &e) == VD_OK);
+    CHECK_INT(n, expect[c]);
+    for (int k = 0; k < n; k++)
+      if (!r[k].pass) vdt_fail(__FILE__, __LINE__, "%s: %s = %g, threshold %g", r[k].name, r[k].quantity, r[k].measured, r[k].reference);
+    vd_free(r, sizeof *r * (size_t)n);
+  }
+}

@@ -210,9 +210,66 @@ TEST(lpy, refusals_name_the_construct) {
   REFUSED("Axiom: A\nproduction:\nA > ?I(it) --> B\n", "'?I' pattern module");
   REFUSED("Axiom: A\nproduction:\nA(*p) --> B\n", "'*args' pattern parameter");
   REFUSED("Axiom: A\nproduction:\nA(**p) --> B\n", "'**kwds' pattern parameter");
-  REFUSED("Axiom: A\nproduction:\n*(n in 'AB') --> B\n", "condition on the pattern parameter 'n'");
+  REFUSED("Axiom: A\nproduction:\n*(n in 'AB') --> B\n", "'in' operator");  // native: the Python engine takes it
   REFUSED("Axiom: A\nproduction:\nx(A) --> B\n", "x(...) or or(...) in a strict predecessor");
   REFUSED("@decorate\ndef f(): pass\nAxiom: A\n", "decorator");
+}
+
+TEST(lpy, conditions_on_pattern_parameters) {
+  // L-Py's value constraints: a parameter written `x > 1` matches when the condition holds on it
+  const char* src = "Axiom: A(1) B(2) A(3) B(4)\nproduction:\nA(x) < B(y > 2) --> Y(x, y)\n"
+                    "A(x == 1) > B(y) --> X(y)\n";
+  DERIVES(src, 1, "X(2)B(2)A(3)Y(3,4)");
+  PY_DERIVES(src, 1, "X(2)B(2)A(3)Y(3,4)");
+  // on the name of `*(...)` and any parameter; `in` is Python (the Python engine)
+  PY_DERIVES("Axiom: A(1) B(2) S(3) U(4)\nproduction:\n*(n in 'SU', x) --> X(x)\nB(x > 1) --> Y(x)\n", 1,
+             "A(1)Y(2)X(3)X(4)");
+  // in a repetition (its variables bind lists: the Python engine): only the modules that pass count
+  PY_DERIVES("Axiom: I(1) I(2) I(0) A\nproduction:\nx(I(l > 0), 2) < A --> B\n", 1, "I(1)I(2)I(0)A");
+  PY_DERIVES("Axiom: I(0) I(1) I(2) A\nproduction:\nx(I(l > 0), 2) < A --> B\n", 1, "I(0)I(1)I(2)B");
+  // a condition that fails to evaluate is an error with its line, not a silent mismatch
+  vd_error e;
+  CHECK_STATUS(run_status("Axiom: A(1)\nproduction:\nA(x > zz) --> B\n", &e), VD_ERR_NAME, e);
+  CHECK(e.line == 3);
+}
+
+TEST(lpy, in_left_and_right_context) {
+  // InLeftContext / InRightContext in a rule's body read on from where the rule's contexts
+  // ended, bind the pattern's variables into the dict, and move on when they match
+  const char* src = "Axiom: C B B B A(2) D E(5)\nproduction:\nA(x) :\n  n = 0\n  while InLeftContext(B): n += 1\n"
+                    "  p = {}\n  if InRightContext(D E(y), p): produce X(n, p['y'])\n";
+  PY_DERIVES(src, 1, "CBBBX(3,5)DE(5)");
+  // after the rule's own left context; the string form, a failed match leaves the dict alone
+  PY_DERIVES("Axiom: B B B A(2) D\nproduction:\nB < A(x) :\n  n = 0\n  while inLeftContext('B'): n += 1\n"
+             "  p = {}\n  assert not inRightContext('E(y)', p) and p == {}\n  produce X(n)\n",
+             1, "BBBX(2)D");
+}
+
+TEST(lpy, scene_argument_of_the_hooks) {
+  // EndEach(lstring, scene) / End(lstring, scene): the string interpreted and drawn, one shape per
+  // primitive, its id the module that drew it (L-Py's shape ids); (lstring, scene) or the scene
+  // returned keep the string
+  PY_DERIVES("def EndEach(lstring, scene):\n  assert len(scene) == 3, len(scene)\n"
+             "  assert sorted(scene.todict().keys()) == [0, 2] and len(scene.todict()[2]) == 2\n"
+             "  return lstring, scene\n"
+             "def End(lstring, scene):\n  return scene\n"
+             "Axiom: A\nproduction:\nA --> B [ C ]\ninterpretation:\nB --> F\nC --> F @O(0.1)\n",
+             1, "B[C]");
+  // a hook that returns nothing keeps what it changed in place (L-Py hands it the string itself)
+  PY_DERIVES("def EndEach(lstring):\n  lstring[0][0] = 2\nAxiom: A(1)\nproduction:\nA(x) --> A(x)\n", 1, "A(2)");
+}
+
+TEST(lpy, vector_query_modules_python_engine) {
+  // ?P without parameters gets a Vector3 appended, ?F the four vectors of the frame (position,
+  // heading, up, left), as L-Py's turtle fills them (the native engine has no vectors: refused)
+  const char* src = "Axiom: F(2) ?P ?F\nderivation length: 2\nproduction:\n"
+                    "?P(v) > ?F(p, h, u, l) :\n  assert v == p and abs(v.z - 2) < 1e-12 and abs(h.z - 1) < 1e-12\n"
+                    "  assert abs(u.x - 1) < 1e-12 and abs(l.y + 1) < 1e-12\n  produce ?P(v) X\n";
+  char b[256];
+  vd_error e = {0};
+  CHECK_STATUS(derive_engine(src, VD_LSYS_PYTHON, -1, b, sizeof b, &e), VD_OK, e);
+  CHECK(strncmp(b, "F(2)?P(Vector3(0,0,2))X?F(", 26) == 0);
+  REFUSED(src, "?P without parameters");
 }
 
 TEST(lpy, discard_new_string) {
@@ -224,6 +281,12 @@ TEST(lpy, discard_new_string) {
   DERIVES(src, -1, "ABB");
   // the same in the Python engine, whose __lpyfuture__ provides the EndEach that discards
   PY_DERIVES(src, -1, "ABB");
+  // importlib.reload of it (L-Py's own tests do) gives the run's module back
+  PY_DERIVES("import importlib\nimport openalea.lpy.__lpyfuture__\nimportlib.reload(openalea.lpy.__lpyfuture__)\n"
+             "from openalea.lpy.__lpyfuture__ import *\n"
+             "Axiom: A\nderivation length: 3\nproduction:\nA :\n  if getIterationNb() == 1: DiscardNewString()\n"
+             "  produce A B\n",
+             -1, "ABB");
 }
 
 TEST(lpy, query_modules_filled_before_each_step) {
@@ -390,4 +453,19 @@ TEST(lpy, turtle_angle_increment_of_the_file) {
                e);
   CHECK_NEAR(b.y, -1, 1e-9);
   CHECK_NEAR(b.z, 1, 1e-9);
+}
+
+TEST(lpy, turtle_takes_vectors_python_engine) {
+  // @M(v), @R(h, u) with vector objects or tuples, as L-Py's turtle takes them
+  vd_vec3 b = {0, 0, 0};
+  vd_error e;
+  CHECK_STATUS(grow_end("Axiom: @M(Vector3(1, 2, 3)) F(1)\n", VD_LSYS_PYTHON, &b, &e), VD_OK, e);
+  CHECK_NEAR(b.x, 1, 1e-9);
+  CHECK_NEAR(b.y, 2, 1e-9);
+  CHECK_NEAR(b.z, 4, 1e-9);
+  CHECK_STATUS(grow_end("Axiom: @R((1, 0, 0), Vector3(0, 0, 1)) F(2)\n", VD_LSYS_PYTHON, &b, &e), VD_OK, e);
+  CHECK_NEAR(b.x, 2, 1e-9);
+  CHECK_NEAR(b.z, 0, 1e-9);
+  // an object that is no vector is an error naming it
+  CHECK_STATUS(grow_end("Axiom: @M([1]) F(1)\n", VD_LSYS_PYTHON, &b, &e), VD_ERR_TYPE, e);
 }

@@ -224,36 +224,58 @@ static double rel_height(const result* r) {
   return r->ok && r->s.height0 > 0 && !r->s.diverged ? r->s.height / r->s.height0 : NAN;
 }
 
-static void case_hopea(gv* v) {
-  if (!want(v, "finding_hopea_eq5_unstable finding_hopea_mrl_stiffer finding_hopea_wind_ml_collapses "
-               "finding_hopea_wind_mrl_holds improved_hopea_wind"))
-    return;
+// parse data/hopea.lpy once; 0 on failure
+static int hopea_ready(gv* v) {
   vd_error e = {0};
   if (!v->hopea && vd_lsys_parse(growth_hopea_lpy, strlen(growth_hopea_lpy), "data/hopea.lpy", &v->hopea, &e)) {
     v->st = vd_error_set(v->err, e.status ? e.status : VD_ERR_VALUE, "", 0, 0, "validate: data/hopea.lpy: %s", e.msg);
-    return;
+    return 0;
   }
+  return 1;
+}
+
+// seed sec. 3.1.3: eq. 5 "not always able to achieve stability across all portions of the
+// tree". With c sqrt(k (m1 + m2)) a new bud (the smallest mass) on a heavy node is damped far
+// beyond critical (zeta = c (m1 + m2) / (2 sqrt(m1 m2))), and eq. 3 takes damping explicitly
+static void case_hopea_eq5(gv* v) {
+  if (!want(v, "finding_hopea_eq5_unstable") || !hopea_ready(v)) return;
   char note[200];
-  // seed sec. 3.1.3: eq. 5 "not always able to achieve stability across all portions of the
-  // tree". With c sqrt(k (m1 + m2)) a new bud (the smallest mass) on a heavy node is damped far
-  // beyond critical (zeta = c (m1 + m2) / (2 sqrt(m1 m2))), and eq. 3 takes damping explicitly
   vd_growth_def d = hopea_def(VD_GROWTH_MSS, 1);
   result a = grow_on(v->hopea, &d, 3);
   d.mss.damping = 0;
   result b = grow_on(v->hopea, &d, 3);
   snprintf(note, sizeof note, "paper settings (eq. 3, eq. 5 c = 1), 3 years: largest move %.3g m of %.2f m; with c = 0 %.3g m",
            a.s.max_displacement, a.s.height0, b.s.max_displacement);
-  finding(v, "finding_hopea_eq5_unstable", "largest move / rest height", a.ok && a.s.height0 > 0 ? (isfinite(a.s.max_displacement) ? a.s.max_displacement / a.s.height0 : INFINITY) : NAN,
-          2, 1, note);
-  // the rest with the paper's springs, wind load, Stokes drag and eq. 8, stepped implicitly
-  vd_growth_def ml = hopea_def(VD_GROWTH_MSS, 1), mrl = hopea_def(VD_GROWTH_MRL, 1);
-  ml.opt.integrator = mrl.opt.integrator = VD_MSS_IMPLICIT;
+  double q = a.ok && a.s.height0 > 0 ? (isfinite(a.s.max_displacement) ? a.s.max_displacement / a.s.height0 : INFINITY) : NAN;
+  finding(v, "finding_hopea_eq5_unstable", "largest move / rest height", q, 2, 1, note);
+}
+
+// the rest with the paper's springs, wind load, Stokes drag and eq. 8, stepped implicitly (eq. 3
+// diverges on this tree)
+static void hopea_paper_pair(vd_growth_def* ml, vd_growth_def* mrl) {
+  *ml = hopea_def(VD_GROWTH_MSS, 1), *mrl = hopea_def(VD_GROWTH_MRL, 1);
+  ml->opt.integrator = mrl->opt.integrator = VD_MSS_IMPLICIT;
+}
+
+// seed sec. 4.1 on its own tree: MRL more rigid than ML under gravity
+static void case_hopea_stiffer(gv* v) {
+  if (!want(v, "finding_hopea_mrl_stiffer") || !hopea_ready(v)) return;
+  char note[200];
+  vd_growth_def ml, mrl;
+  hopea_paper_pair(&ml, &mrl);
   result gm = grow_on(v->hopea, &ml, 25), gr = grow_on(v->hopea, &mrl, 25);
   snprintf(note, sizeof note, "paper springs, implicit, gravity, 25 years: largest move ML %.3f m, MRL %.3f m (height %.1f m)",
            gm.s.max_displacement, gr.s.max_displacement, gm.s.height0);
   finding(v, "finding_hopea_mrl_stiffer", "move ML / move MRL", gm.ok && gr.ok && gr.s.max_displacement > 0 ? gm.s.max_displacement / gr.s.max_displacement : NAN, 1, 1, note);
-  // seed sec. 4.3: in wind the ML-Tree collapses where the MRL-Tree holds (wind on the
-  // internodes' projected areas and the leaves: eq. 10 on node cross-sections barely loads a tree)
+}
+
+// seed sec. 4.3: in wind the ML-Tree collapses where the MRL-Tree holds (wind on the
+// internodes' projected areas and the leaves: eq. 10 on node cross-sections barely loads a tree)
+static void case_hopea_wind(gv* v) {
+  if (!want(v, "finding_hopea_wind_ml_collapses finding_hopea_wind_mrl_holds") || !hopea_ready(v)) return;
+  char note[200];
+  vd_growth_def ml, mrl;
+  hopea_paper_pair(&ml, &mrl);
   ml.opt.wind_model = mrl.opt.wind_model = VD_MSS_WIND_AREA;
   ml.opt.wind = mrl.opt.wind = vd_v3(15, 0, 0);
   result wm = grow_on(v->hopea, &ml, 25), wr = grow_on(v->hopea, &mrl, 25);
@@ -261,7 +283,12 @@ static void case_hopea(gv* v) {
            rel_height(&wm), wm.s.height, wm.s.height0, rel_height(&wr));
   finding(v, "finding_hopea_wind_ml_collapses", "height / rest height, ML", rel_height(&wm), 0.5, -1, note);
   finding(v, "finding_hopea_wind_mrl_holds", "height / rest height, MRL", rel_height(&wr), 0.5, 1, note);
-  // the improved models in the same wind and soil
+}
+
+// the improved models in the same wind and soil
+static void case_hopea_improved(gv* v) {
+  if (!want(v, "improved_hopea_wind") || !hopea_ready(v)) return;
+  char note[200];
   vd_growth_def mli = hopea_def(VD_GROWTH_MSS, 0), mrli = hopea_def(VD_GROWTH_MRL, 0);
   mli.opt.wind = mrli.opt.wind = vd_v3(15, 0, 0);
   mli.opt.breaking = mrli.opt.breaking = 1;
@@ -283,7 +310,7 @@ vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** ou
                          "finding_phototropism", "finding_gravitropism", "finding_tropisms",
                          "finding_eq3_wider_than_eq4", "improved_wind", "finding_soil_methods",
                          "finding_hopea_eq5_unstable", "finding_hopea_mrl_stiffer", "finding_hopea_wind_ml_collapses",
-                         "finding_hopea_wind_mrl_holds", "improved_hopea_wind", "finding_hopea"};
+                         "finding_hopea_wind_mrl_holds", "improved_hopea_wind"};
   for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) any |= !def->filter || strstr(names[k], def->filter);
   if (!any) return VD_OK;
   vd_status st = vd_lsys_parse(growth_tree_lpy, strlen(growth_tree_lpy), "data/tree.lpy", &v.ls, err);
@@ -295,7 +322,10 @@ vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** ou
     case_stability(&v);
     case_wind(&v);
     case_soil(&v);
-    case_hopea(&v);
+    case_hopea_eq5(&v);
+    case_hopea_stiffer(&v);
+    case_hopea_wind(&v);
+    case_hopea_improved(&v);
   }
   vd_lsys_destroy(v.ls);
   vd_lsys_destroy(v.hopea);

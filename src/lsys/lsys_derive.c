@@ -105,6 +105,7 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   vd_free(ls->pdecl, sizeof(struct pdecl) * (size_t)ls->cappdecl);
   vd_free(ls->mlist, sizeof(struct mlist) * (size_t)ls->capmlist);
   vd_free(ls->mval, sizeof(value) * (size_t)ls->capmval);
+  vd_free(ls->cpat, sizeof(lsys_cpat) * (size_t)ls->capcpat);
   vd_arena_free(&ls->arena);
   vd_free(ls, sizeof *ls);
 }
@@ -402,6 +403,74 @@ static vd_status interpret_into(vd_lsystem* ls, const vd_lstring* in, vd_lstring
   return interpretation_hook(ls, "EndInterpretation", out, in->n + 1, P->max_modules);
 }
 
+// the query modules that take Vector3 objects (Python engine), as L-Py's turtle fills them: ?F
+// its first four parameters (position, heading, up, left; appended when missing), ?P ?H ?U ?L
+// ?R without parameters one appended vector, with one object parameter a new vector; s is
+// rebuilt with the new parameter counts
+static vd_status query_objects(vd_lsystem* ls, vd_lstring* s, const vd_lstring* geo, const lsys_qframes* qf,
+                               int64_t max_modules) {
+  vd_lstring t = vd_lstring_empty();
+  if ((s->src && !lstr_enable_src(&t)) || (s->line && !lstr_enable_line(&t)) ||
+      !lstr_reserve(&t, s->n, s->par[s->n] + 4 * (int64_t)qf->n)) {
+    vd_lstring_free(&t);
+    return vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+  }
+  (void)max_modules;
+  vd_status st = VD_OK;
+  int r = 0;  // next record (in string order, as the turtle met them)
+  t.par[0] = 0;
+  for (int64_t j = 0; j < s->n && !st; j++) {
+    // the record of module j, if any (records of modules that are not copies are skipped)
+    const double* rec = NULL;
+    while (r < qf->n) {
+      int64_t k = (int64_t)qf->v[13 * r];
+      if (!(geo->src[k] & LSYS_SRC_IDENTITY)) {
+        r++;
+        continue;
+      }
+      int64_t sj = geo->src[k] & ~LSYS_SRC_IDENTITY;
+      if (sj < j) {
+        r++;
+        continue;
+      }
+      if (sj == j) rec = qf->v + 13 * r++;
+      break;
+    }
+    int64_t a = s->par[j], np = s->par[j + 1] - a;
+    double nv[64];
+    int64_t nn = np;
+    if (rec) {
+      int frame = s->sym[j] == VD_SYM_GETFRAME;
+      int vecs = frame ? 4 : 1;
+      nn = np > vecs ? np : vecs;
+      if (nn > 64) nn = 64;
+      for (int64_t k = 0; k < nn; k++) nv[k] = k < np ? s->val[a + k] : 0;
+      int32_t sym = s->sym[j];
+      for (int k = 0; k < vecs && !st; k++) {
+        // ?P: position; ?H heading; ?U up; ?L left; ?R right; ?F all four
+        int f = frame ? k : sym == VD_SYM_GETPOS ? 0 : sym == VD_SYM_GETHEAD ? 1 : sym == VD_SYM_GETUP ? 2 : 3;
+        double sg = sym == VD_SYM_GETRIGHT ? -1 : 1;
+        st = lsys_py_vec3(ls, sg * rec[1 + 3 * f], sg * rec[2 + 3 * f], sg * rec[3 + 3 * f], &nv[k]);
+      }
+    }
+    if (!lstr_reserve(&t, t.n + 1, t.par[t.n] + nn)) st = vm_error(ls, VD_ERR_NOMEM, 0, 0, "out of memory");
+    if (st) break;
+    t.sym[t.n] = s->sym[j];
+    memcpy(t.val + t.par[t.n], rec ? nv : s->val + a, sizeof(double) * (size_t)nn);
+    if (t.src && s->src) t.src[t.n] = s->src[j];
+    if (t.line && s->line) t.line[t.n] = s->line[j];
+    t.par[t.n + 1] = t.par[t.n] + nn;
+    t.n++;
+  }
+  if (st) {
+    vd_lstring_free(&t);
+    return st;
+  }
+  vd_lstring_free(s);
+  *s = t;
+  return VD_OK;
+}
+
 vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant) {
   lsys_pass P;
   memset(&P, 0, sizeof P);
@@ -426,7 +495,11 @@ static vd_status query_pass(vd_lsystem* ls, vd_lstring* s, lsys_pass* P) {
   vd_status st = interpret_into(ls, s, geo, P);
   P->identity_bit = 0;
   if (st) return st;
-  if ((st = lsys_turtle_query(ls, geo, ls->err))) return st;
+  lsys_qframes qf = {NULL, 0, 0};
+  if ((st = lsys_turtle_query(ls, geo, ls->err, ls->py ? &qf : NULL))) {
+    vd_free(qf.v, sizeof(double) * (size_t)qf.cap);
+    return st;
+  }
   for (int64_t k = 0; k < geo->n; k++) {
     int32_t sym = geo->sym[k];
     if (sym < VD_SYM_GETPOS || sym > VD_SYM_GETRIGHT || !(geo->src[k] & LSYS_SRC_IDENTITY)) continue;
@@ -434,7 +507,9 @@ static vd_status query_pass(vd_lsystem* ls, vd_lstring* s, lsys_pass* P) {
     int64_t np = geo->par[k + 1] - geo->par[k];
     memcpy(s->val + s->par[j], geo->val + geo->par[k], sizeof(double) * (size_t)np);
   }
-  return VD_OK;
+  if (qf.n) st = query_objects(ls, s, geo, &qf, P->max_modules);
+  vd_free(qf.v, sizeof(double) * (size_t)qf.cap);
+  return st;
 }
 
 // the run's settings with defaults filled in; the interpreter budget starts
@@ -645,6 +720,7 @@ vd_status vd_lsys_interpret(vd_lsystem* ls, const vd_lsys_def* def, const vd_lst
 }
 
 const char* lsys_file(const vd_lsystem* ls) { return ls->file; }
+
 
 int lsys_turtle_angle(const vd_lsystem* ls, double* angle) {
   if (ls->has_turtle_angle) *angle = ls->turtle_angle;

@@ -868,3 +868,15 @@ vd_status vm_call_func(vd_lsystem* ls, int fi, int nargs, const value* args, val
   if (frame != small) vd_free(frame, sizeof(value) * (size_t)nl);
   return st;
 }
+
+int lsys_cond_holds(vd_lsystem* ls, const pcond* c, value v, value* frame) {
+  int h = 1;
+  if (c->pyfn >= 0) {
+    if (lsys_py_test(ls, c->pyfn, v, &h)) return -1;
+  } else if (c->e) {
+    value r;
+    if (vm_eval(ls, c->e, frame, &r)) return -1;
+    h = value_truthy(r);
+  }
+  return h != 0;
+}

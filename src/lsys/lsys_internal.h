@@ -146,6 +146,13 @@ typedef struct pmod {
   int line, col;
 } pmod;
 
+// A condition on a pattern parameter (`*(n in 'AB', x > 0)`, L-Py's value constraints): a native
+// expression over the rule's frame, or (Python engine) the index of a one-argument function.
+typedef struct pcond {
+  expr* e;   // native: the condition, its variable bound in the frame (NULL: no condition)
+  int pyfn;  // Python engine: chunk index of `lambda name: condition`, -1 none
+} pcond;
+
 // What a few pattern elements need beyond a module.
 typedef struct pext {
   int args_slot;   // PK_MOD / PK_ANY: slot of a trailing `*args` (a list), -1 none
@@ -156,6 +163,8 @@ typedef struct pext {
   struct pstr* sub;  // PK_REP: the repeated pattern (sub[0]); PK_OR: the alternatives
   int nsub;
   int rmin, rmax;  // PK_REP: repetitions allowed
+  pcond* cond;     // conditions per parameter (nparam), NULL when none has one
+  pcond name_cond; // PK_ANY: condition on the name (meaningful only when cond is set)
 } pext;
 
 // A pattern: a string of pattern elements.
@@ -183,6 +192,7 @@ typedef struct rule {
   int section;    // SEC_*
   int group;      // rule group (0 = always active)
   int is_static;  // -static-> / @static: L-Py evaluates the successor once
+  int incontext;  // its body calls InLeftContext / InRightContext (Python engine): general matcher
   int line;
   int pyfn;       // Python engine: index of the rule's function (lsys_py.c), -1 native
 } rule;
@@ -234,6 +244,25 @@ typedef struct lsys_py lsys_py;
 typedef struct toplevel {
   stmt* body;  // top-level statements in file order
 } toplevel;
+
+// Where the rule being applied matched (L-Py's LstringMatcher): InLeftContext / InRightContext
+// in its body read on from there (Python engine).
+typedef struct lsys_cur {
+  const struct lsys_mctx* M;  // NULL outside a rule's body
+  const rule* r;
+  int64_t left;        // where the left context ended (the predecessor's start without one)
+  int64_t right;       // where the right context ended (after the predecessor without one)
+  int64_t rlast;       // last module matched on the right
+} lsys_cur;
+
+// A pattern of InLeftContext / InRightContext, parsed once: its text (string id), the pattern
+// and its variables' names (string ids, in slot order).
+typedef struct lsys_cpat {
+  int sid;
+  pstr p;
+  int nvar;
+  int* var;  // (nvar, arena)
+} lsys_cpat;
 
 struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields grouped by meaning; one per model
   char file[256];
@@ -324,6 +353,9 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int backward;            // derive right to left (backward()); new right contexts apply
   int frame_displayed;     // the step is the last one (L-Py draws a frame then)
   int discard_requested;   // DiscardNewString(): the step's result is dropped
+  lsys_cur cur;            // the rule being applied (Python engine: InLeftContext, InRightContext)
+  lsys_cpat* cpat;         // InLeftContext / InRightContext patterns parsed so far (ncpat)
+  int ncpat, capcpat;
   int call_depth;
   int steps_done;          // derivation steps taken since the axiom (vd_lsys_derive_step)
   int64_t max_ops;         // interpreter work allowed in this run (loop iterations + calls)
@@ -452,7 +484,15 @@ void lsys_pass_free(lsys_pass* P);
 int lsys_mlist_new(vd_lsystem* ls, int n);
 // Run the turtle over s without keeping geometry, writing the turtle's position and frame into
 // the parameters of the query modules ?P ?H ?U ?L ?R of s.
-vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err);
+// Frames of the query modules that take Vector3 objects (Python engine: ?F, ?P ... without
+// parameters or with an object): 13 values per module, its index in the string then the
+// turtle's position, heading, up and left.
+typedef struct lsys_qframes {
+  double* v;
+  int n, cap;  // modules recorded, capacity (modules)
+} lsys_qframes;
+// qf Nullable: without it such modules are refused
+vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err, lsys_qframes* qf);
 #define LSYS_SRC_IDENTITY (INT64_C(1) << 62)  // on a source index: the module was copied unchanged
 // File lines of the modules idx[0..n) of s, a string the last derivation made (interpreted or
 // not): the derivation runs again keeping lines; 1 when s is that string (lines[k] is 0 where
@@ -466,7 +506,16 @@ int lsys_turtle_angle(const vd_lsystem* ls, double* angle);
 // The file name of an lsystem ("" when parsed from text without one).
 const char* lsys_file(const vd_lsystem* ls);
 // Match rule r at module i (general matcher); *first, *end = the predecessor's modules.
-int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end);
+// With cur (nullable), where the contexts ended (InLeftContext / InRightContext go on from there).
+int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end,
+                    lsys_cur* cur);
+// InLeftContext (right = 0) / InRightContext (right = 1) in the body of the rule being applied
+// (ls->cur): match p from where the last context ended, binding its variables into frame; on a
+// match the position moves on. 1 or 0; -1 on an error (ls->err set).
+int lsys_context_match(vd_lsystem* ls, int right, const pstr* p, value* frame);
+// the pattern text s[0..len) of InLeftContext / InRightContext, parsed once per lsystem; NULL
+// with the error set (line: the rule's)
+const lsys_cpat* lsys_context_pattern(vd_lsystem* ls, const char* s, int len, int line);
 
 vd_status vm_exec_block(vd_lsystem* ls, stmt* s, value* frame, vm_out* out, int* returned,
                         value* retval);
@@ -484,6 +533,8 @@ int builtin_find(const char* name, int len);
 int builtin_in_ns(int ns, const char* name, int len);
 value ns_constant(int ns, const char* name, int len, int* found);
 int value_truthy(value v);
+// does the pattern condition c hold on v (bound in frame)? 1 or 0; -1 on an error (ls->err set)
+int lsys_cond_holds(vd_lsystem* ls, const pcond* c, value v, value* frame);
 vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col);
 value param_to_value(double d);
 
@@ -513,6 +564,9 @@ vd_status lsys_py_rule(vd_lsystem* ls, rule* r, const char* const* names, const 
 vd_status lsys_py_axiom(vd_lsystem* ls, const tmpl* t, const lsys_line* lines, int nline, int* li);
 // `derivation length:` text
 vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno);
+// a condition on the pattern parameter name (`name in 'AB'`): the chunk index of a function of
+// name that returns its truth, or -1 with the error set
+int lsys_py_cond(vd_lsystem* ls, const char* name, int nlen, const char* s, int len, int lineno);
 
 // run time
 void lsys_py_free(vd_lsystem* ls);
@@ -524,6 +578,8 @@ vd_status lsys_py_run_toplevel(vd_lsystem* ls, uint64_t seed);
 vd_status lsys_py_dlength_eval(vd_lsystem* ls, int* steps);
 vd_status lsys_py_emit_axiom(vd_lsystem* ls, vm_out* out);
 vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, vm_out* out);
+// call the condition function fn (lsys_py_cond) on v: *holds its truth
+vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds);
 // call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
 // the current string (an End hook may return a new one). Missing hooks are fine.
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
@@ -538,6 +594,8 @@ void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)
 void lsys_py_reset_objects(vd_lsystem* ls);
 vd_status lsys_py_set_global(vd_lsystem* ls, const char* name, const char* text);
+// a Vector3(x, y, z) object as a parameter (a handle) in *out
+vd_status lsys_py_vec3(vd_lsystem* ls, double x, double y, double z, double* out);
 vd_status lsys_py_get_global(vd_lsystem* ls, const char* name, double* out);
 // What the turtle reads from object parameters (the Python engine's curves, functions and
 // geometry). Arrays are vd_malloc'd, the caller frees them (sizes from the counts). Each returns

@@ -239,6 +239,19 @@ static int bind_lists(const mstate* S, const pmod* p, int32_t sym, int name, con
   return 1;
 }
 
+// the conditions of a pattern module on what it bound (L-Py's value constraints); an error
+// (set in ls->err) is no match
+static int conds_hold(const mstate* S, const pmod* p) {
+  const pext* x = p->x;
+  if (!x || !x->cond) return 1;  // no condition (name_cond is set only with cond)
+  if (p->kind == PK_ANY && x->has_name && x->name_slot >= 0 &&
+      lsys_cond_holds(S->ls, &x->name_cond, S->frame[x->name_slot], S->frame) != 1)
+    return 0;
+  for (int k = 0; x->cond && k < p->nparam; k++)
+    if (p->slot[k] >= 0 && lsys_cond_holds(S->ls, &x->cond[k], S->frame[p->slot[k]], S->frame) != 1) return 0;
+  return 1;
+}
+
 static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k) {
   int64_t j = at(v, k);
   const vd_lstring* s = v->s;
@@ -247,7 +260,8 @@ static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k
   int lists = p->x && (p->x->args_slot >= 0 || p->x->kwds_slot >= 0);
   if (p->kind == PK_MOD) {
     if (s->sym[j] != p->sym) return 0;
-    return lists ? bind_lists(S, p, s->sym[j], -1, val, np) : bind_params(p, val, np, S->frame);
+    if (!(lists ? bind_lists(S, p, s->sym[j], -1, val, np) : bind_params(p, val, np, S->frame))) return 0;
+    return conds_hold(S, p);
   }
   if (p->kind != PK_ANY) return 0;
   if (!p->x) return 1;
@@ -255,10 +269,10 @@ static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k
   const char* name = vd_lsys_symbol_name(S->ls, s->sym[j]);
   int id = str_intern(S->ls, name, (int)strlen(name));
   if (id < 0) return 0;
-  if (lists) return bind_lists(S, p, s->sym[j], id, val, np);
+  if (lists) return bind_lists(S, p, s->sym[j], id, val, np) && conds_hold(S, p);
   if (p->x->name_slot >= 0) S->frame[p->x->name_slot] = (value){V_STR, id};
   else if ((int)p->x->name_val.n != id) return 0;
-  return bind_params(p, val, np, S->frame);
+  return bind_params(p, val, np, S->frame) && conds_hold(S, p);
 }
 
 // set every variable of a pattern to None (the alternatives of or(...) that did not match)
@@ -485,7 +499,10 @@ static int right_match(const mstate* S, const view* v, int64_t start, int64_t* l
   }
   if (it >= v->n) {
     // nothing to the right: only None and repetitions that may match nothing succeed
-    if (to - from == 1 && p->m[from].kind == PK_NONE) return 1;
+    if (to - from == 1 && p->m[from].kind == PK_NONE) {
+      *end = it;
+      return 1;
+    }
     while (i < to && is_re(&p->m[i])) {
       int64_t e;
       if (!right_re(S, v, v->n, &lm, &p->m[i], &e, string_mode)) return 0;
@@ -591,7 +608,8 @@ static int pred_backward(const mstate* S, const view* v, int64_t i, const pstr* 
 // ---------------------------------------------------------------------------------------------
 // a rule
 
-int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end) {
+int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, int64_t* first, int64_t* end,
+                    lsys_cur* cur) {
   mstate S = {M->ls, frame};
   M->ls->nmlist = M->ls->nmval = 0;  // lists bound by an earlier attempt are no longer referenced
   const unsigned char* ign = M->ignored[r->filter + 1];
@@ -604,8 +622,8 @@ int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, 
     e = i + 1;
     if (!pred_backward(&S, &src, i, &r->pred, &b)) return 0;
   }
-  int64_t tmp;
-  if (r->left.n && !left_match(&S, &src, b, &r->left, r->left.n - 1, &tmp, M->string_mode)) return 0;
+  int64_t tmp, lend = b;
+  if (r->left.n && !left_match(&S, &src, b, &r->left, r->left.n - 1, &lend, M->string_mode)) return 0;
   if (r->nleft.n) {
     // the string written so far, read up the tree from its end
     view dst = {M->dest, M->dest->n, 0, NULL, ign, M->nsym};
@@ -617,11 +635,32 @@ int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, 
     int64_t lm = NONE;
     if (!right_match(&S, &dst, 0, &lm, &r->nright, 0, r->nright.n, &tmp, M->string_mode)) return 0;
   }
-  if (r->right.n) {
-    int64_t lm = e - 1;
-    if (!right_match(&S, &src, e, &lm, &r->right, 0, r->right.n, &tmp, M->string_mode)) return 0;
-  }
+  int64_t rend = e, rlast = e - 1;
+  if (r->right.n && !right_match(&S, &src, e, &rlast, &r->right, 0, r->right.n, &rend, M->string_mode)) return 0;
   *first = b;
   *end = e;
+  if (cur) *cur = (lsys_cur){M, r, lend, rend, rlast};
+  return 1;
+}
+
+int lsys_context_match(vd_lsystem* ls, int right, const pstr* p, value* frame) {
+  lsys_cur* c = &ls->cur;
+  const lsys_mctx* M = c->M;
+  if (!M) return 0;
+  if (!p->n) return 1;
+  mstate S = {ls, frame};
+  const unsigned char* ign = M->ignored[c->r->filter + 1];
+  view src = {M->src, M->src->n, 0, M->match, ign, M->nsym};
+  int64_t end, lm = c->rlast;
+  int ok = right ? right_match(&S, &src, c->right, &lm, p, 0, p->n, &end, M->string_mode)
+                 : left_match(&S, &src, c->left, p, p->n - 1, &end, M->string_mode);
+  if (ls->err && ls->err->status) return -1;
+  if (!ok) return 0;
+  if (right) {
+    c->right = end;
+    c->rlast = lm;
+  } else {
+    c->left = end;
+  }
   return 1;
 }

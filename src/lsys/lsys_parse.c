@@ -1134,7 +1134,8 @@ static int parse_pattern_params(vd_lsystem* ls, scope* sc, const char* s, int p,
   if (lx_next(&L)) return 0;
   int slots[64];
   value cv[64];
-  int np = 0;
+  pcond cd[64];
+  int np = 0, ncond = 0;
   while (!tok_is(&L, ')')) {
     if (np == 64) {
       perr(ls, VD_ERR_LIMIT, lineno, lx_col(&L), "more than 64 pattern parameters");
@@ -1189,15 +1190,39 @@ static int parse_pattern_params(vd_lsystem* ls, scope* sc, const char* s, int p,
     if (L.t == T_NAME && !tok_name(&L, "True") && !tok_name(&L, "False") && !tok_name(&L, "None")) {
       lexer name = L;
       if (lx_next(&L)) return 0;
-      if (!tok_is(&L, ',') && !tok_is(&L, ')')) {
-        perr(ls, VD_ERR_UNSUPPORTED, lineno, lx_col(&name), "unsupported: condition on the pattern parameter '%.*s'",
-             name.tlen, name.s + name.start);
-        return 0;
-      }
       int sl = scope_add(ls, sc, name.s + name.start, name.tlen);
       if (sl < 0) {
         perr(ls, VD_ERR_NOMEM, lineno, lx_col(&name), "out of memory");
         return 0;
+      }
+      cd[np] = (pcond){NULL, -1};
+      if (!tok_is(&L, ',') && !tok_is(&L, ')')) {
+        // a condition (L-Py's value constraint): `n in 'AB'` is `lambda n: n in 'AB'`
+        int close = close_paren(s, p, b);
+        if (close < 0) {
+          perr(ls, VD_ERR_SYNTAX, lineno, col0 + p, "unclosed '(' in a pattern");
+          return 0;
+        }
+        int end = next_comma(s, name.start, close);
+        if (ls->engine == VD_LSYS_PYTHON) {
+          cd[np].pyfn = lsys_py_cond(ls, name.s + name.start, name.tlen, s + name.start, end - name.start, lineno);
+          if (cd[np].pyfn < 0) return 0;
+        } else {
+          lexer E;
+          lx_init(&E, ls, s, end, lineno, col0, name.start);
+          if (lx_next(&E)) return 0;
+          pctx C = {ls, &E, sc};
+          if (!(cd[np].e = parse_expr(&C))) return 0;
+          if (E.t != T_EOF) {
+            char bb[64];
+            perr(ls, VD_ERR_SYNTAX, lineno, lx_col(&E), "unexpected %s in the condition on '%.*s'",
+                 tok_desc(&E, bb, sizeof bb), name.tlen, name.s + name.start);
+            return 0;
+          }
+        }
+        ncond++;
+        lx_init(&L, ls, s, b, lineno, col0, end);
+        if (lx_next(&L)) return 0;
       }
       slots[np] = sl;
       cv[np] = (value){V_NONE, 0};
@@ -1212,6 +1237,7 @@ static int parse_pattern_params(vd_lsystem* ls, scope* sc, const char* s, int p,
       }
       slots[np] = -1;
       cv[np] = e->k;
+      cd[np] = (pcond){NULL, -1};
     }
     np++;
     if (tok_is(&L, ',')) {
@@ -1234,6 +1260,22 @@ static int parse_pattern_params(vd_lsystem* ls, scope* sc, const char* s, int p,
     }
     memcpy(m->slot, slots, sizeof(int) * (size_t)np);
     memcpy(m->cval, cv, sizeof(value) * (size_t)np);
+  }
+  if (ncond) {
+    // conditions take the general matcher (m->x set)
+    if (!m->x) {
+      if (!(m->x = aalloc(ls, sizeof(pext)))) {
+        perr(ls, VD_ERR_NOMEM, lineno, m->col, "out of memory");
+        return 0;
+      }
+      m->x->args_slot = m->x->kwds_slot = -1;
+    }
+    m->x->name_cond = (pcond){NULL, -1};
+    if (!(m->x->cond = aalloc(ls, sizeof(pcond) * (size_t)np))) {
+      perr(ls, VD_ERR_NOMEM, lineno, m->col, "out of memory");
+      return 0;
+    }
+    memcpy(m->x->cond, cd, sizeof(pcond) * (size_t)np);
   }
   return 1;
 }
@@ -1365,6 +1407,7 @@ static int parse_pstr(vd_lsystem* ls, scope* sc, const char* s, int a, int b, in
         }
         m->slot++;
         m->cval++;
+        if (m->x->cond) m->x->name_cond = *m->x->cond++;
         m->nparam--;
         pos = after;
       }
@@ -2837,4 +2880,38 @@ fail:
 done:
   vd_free(P.lines, (size_t)P.capline * sizeof(pline));
   return st;
+}
+
+// ---------------------------------------------------------------------------------------------
+// patterns of InLeftContext / InRightContext (Python engine, at run time)
+
+const lsys_cpat* lsys_context_pattern(vd_lsystem* ls, const char* s, int len, int line) {
+  int sid = str_intern(ls, s, len);
+  if (sid < 0) {
+    str_intern_error(ls, sid, line, 0);
+    return NULL;
+  }
+  for (int i = 0; i < ls->ncpat; i++)
+    if (ls->cpat[i].sid == sid) return &ls->cpat[i];
+  if (!vd_grow((void**)&ls->cpat, &ls->capcpat, ls->ncpat + 1, sizeof(lsys_cpat))) {
+    perr(ls, VD_ERR_NOMEM, line, 0, "out of memory");
+    return NULL;
+  }
+  lsys_cpat* c = &ls->cpat[ls->ncpat];
+  memset(c, 0, sizeof *c);
+  c->sid = sid;
+  const char* t = ls->str[sid];  // lives as long as the lsystem (names point into it)
+  scope sc = {0};
+  sc.is_function = 1;
+  int ok = parse_pstr(ls, &sc, t, 0, len, line, 1, 0, &c->p);
+  if (ok && sc.n > 64) ok = !perr(ls, VD_ERR_LIMIT, line, 0, "more than 64 variables in a context pattern");
+  if (ok && sc.n && !(c->var = aalloc(ls, sizeof(int) * (size_t)sc.n)))
+    ok = !perr(ls, VD_ERR_NOMEM, line, 0, "out of memory");
+  for (int i = 0; ok && i < sc.n; i++)
+    if ((c->var[i] = str_intern(ls, sc.names[i], sc.lens[i])) < 0) ok = !str_intern_error(ls, c->var[i], line, 0);
+  c->nvar = sc.n;
+  scope_free(&sc);
+  if (!ok) return NULL;
+  ls->ncpat++;
+  return c;
 }

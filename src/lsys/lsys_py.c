@@ -23,6 +23,7 @@
 // starts, so handles of an older derivation's string are stale (they read back as None).
 #include "lsys/lsys_py.h"  // Python.h first: it sets the feature macros
 
+#include <limits.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -966,6 +967,41 @@ static PyObject* vd_log_text(PyObject* self, PyObject* arg) {
   return py_none();
 }
 
+// inLeftContext(pattern, params) / inRightContext: match the pattern on from where the
+// rule's contexts ended (L-Py's LstringMatcher); its variables go into params (a dict)
+static PyObject* vd_in_context(PyObject* self, PyObject* args) {
+  (void)self;
+  int right;
+  const char* pat;
+  Py_ssize_t plen;
+  PyObject* params;
+  if (!PyArg_ParseTuple(args, "is#O", &right, &pat, &plen, &params)) return NULL;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  if (!ls->cur.M) {
+    PyErr_Format(PyExc_RuntimeError, "in%sContext outside the body of a rule", right ? "Right" : "Left");
+    return NULL;
+  }
+  if (plen > INT_MAX / 2) {
+    PyErr_SetString(PyExc_ValueError, "pattern too long");
+    return NULL;
+  }
+  const lsys_cpat* cp = lsys_context_pattern(ls, pat, (int)plen, ls->cur.r->line);
+  if (!cp) return vd_abort();
+  value frame[64];
+  for (int i = 0; i < 64; i++) frame[i] = (value){V_NONE, 0};
+  int ok = lsys_context_match(ls, right, &cp->p, frame);
+  if (ok < 0) return vd_abort();
+  for (int i = 0; ok && params != Py_None && i < cp->nvar; i++) {
+    PyObject* v = value_object(ls, frame[i]);
+    PyObject* k = v ? str_object(ls, cp->var[i]) : NULL;  // borrowed
+    int r = k ? PyObject_SetItem(params, k, v) : -1;
+    Py_XDECREF(v);
+    if (r < 0) return NULL;
+  }
+  return PyBool_FromLong(ok);
+}
+
 static PyMethodDef vd_methods[] = {
     {"p", (PyCFunction)(void (*)(void))vd_p, METH_FASTCALL, "produce a template"},
     {"mk", (PyCFunction)(void (*)(void))vd_mk, METH_FASTCALL, "the items of a template"},
@@ -983,6 +1019,7 @@ static PyMethodDef vd_methods[] = {
     {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
     {"set_option", vd_set_option, METH_VARARGS, "context().options.setSelection"},
     {"set_turtle_angle", vd_set_turtle_angle, METH_O, "context().turtle.setAngleIncrement"},
+    {"in_context", vd_in_context, METH_VARARGS, "inLeftContext / inRightContext"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef vd_module_def = {PyModuleDef_HEAD_INIT, "_verdant_lsys", "verdant's L-system engine", -1,
@@ -1206,6 +1243,21 @@ vd_status lsys_py_eval(vd_lsystem* ls, const expr* e, value* out) {
   return VD_OK;
 }
 
+vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds) {
+  lsys_py* py = ls->py;
+  vd_status st = need_ns(ls);
+  if (st) return st;
+  PyObject* a = value_object(ls, v);
+  if (!a) return py_error(ls);
+  PyObject* r = PyObject_CallOneArg(py->fobj[fn], a);
+  Py_DECREF(a);
+  int t = r ? PyObject_IsTrue(r) : -1;
+  Py_XDECREF(r);
+  if (t < 0) return py_error(ls);
+  *holds = t;
+  return VD_OK;
+}
+
 // number of positional parameters a hook declares (0 when unknown)
 static int arity(PyObject* f) {
   PyObject* code = PyObject_GetAttrString(f, "__code__");
@@ -1307,6 +1359,15 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   }
   Py_DECREF(r);
   return st;
+}
+
+vd_status lsys_py_vec3(vd_lsystem* ls, double x, double y, double z, double* out) {
+  PyObject* c = Py_BuildValue("(ddd)", x, y, z);
+  PyObject* v = c ? shim_call("_vd_make_vec3", c) : NULL;
+  Py_XDECREF(c);
+  int ok = v && keep_object(ls, v, out);
+  Py_XDECREF(v);
+  return ok ? VD_OK : py_error(ls);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -297,6 +297,55 @@ static size_t lstring_end(const char* t, size_t n, size_t a, int paren) {
 
 // Translate Python source t[0..n) starting at file line `line`: produce, nproduce and
 // makestring statements become calls; the line count stays the same.
+// InLeftContext(A(x) B, params) at t[*i] (L-Py's pattern written as modules): made
+// inLeftContext('A(x) B', params), the pattern a string; *i and *copied move after it
+static vd_status translate_incontext(vd_lsystem* ls, const char* t, size_t n, size_t* i, size_t* copied, int ln,
+                                     int col, sbuf* out) {
+  int right = t[*i + 2] == 'R';
+  size_t a = *i + (right ? 14 : 13);
+  while (a < n && (t[a] == ' ' || t[a] == '\t')) a++;
+  if (a >= n || t[a] != '(') return vm_error(ls, VD_ERR_SYNTAX, ln, col, "expected '(' after In%sContext", right ? "Right" : "Left");
+  // the closing parenthesis and the last top-level comma before it (the parameters' dict)
+  size_t comma = 0, e = a + 1;
+  int depth = 0;
+  char q = 0;
+  for (; e < n; e++) {
+    char c = t[e];
+    if (q) {
+      if (c == '\\') e++;
+      else if (c == q) q = 0;
+    } else if (c == '\'' || c == '"') {
+      q = c;
+    } else if (c == '(' || c == '[' || c == '{') {
+      depth++;
+    } else if (c == ']' || c == '}') {
+      depth--;
+    } else if (c == ')') {
+      if (depth-- == 0) break;
+    } else if (c == ',' && depth == 0) {
+      comma = e;
+    }
+  }
+  if (e >= n) return vm_error(ls, VD_ERR_SYNTAX, ln, col, "unclosed '(' after In%sContext", right ? "Right" : "Left");
+  size_t pe = comma ? comma : e;
+  sb_put(out, t + *copied, *i - *copied);
+  sb_puts(out, right ? "inRightContext('" : "inLeftContext('");
+  for (size_t k = a + 1; k < pe; k++) {
+    char c = t[k];
+    if (c == '\n' || c == '\r') c = ' ';
+    if (c == '\'' || c == '\\') sb_put(out, "\\", 1);
+    sb_put(out, &c, 1);
+  }
+  sb_puts(out, "'");
+  // ", params)" or ")" as written (newlines kept: the lines stay the file's)
+  size_t nl = 0;
+  for (size_t k = a + 1; k < pe; k++) nl += t[k] == '\n';
+  for (size_t k = 0; k < nl; k++) sb_puts(out, "\n");
+  *copied = pe;
+  *i = pe;
+  return VD_OK;
+}
+
 static vd_status translate(vd_lsystem* ls, const char* t, size_t n, int line, int col0, sbuf* out) {
   size_t i = 0, copied = 0;
   char q = 0;
@@ -342,6 +391,11 @@ static vd_status translate(vd_lsystem* ls, const char* t, size_t n, int line, in
         q = c;
         i++;
       }
+      continue;
+    }
+    if (c == 'I' && (keyword_at(t, n, i, "InLeftContext") || keyword_at(t, n, i, "InRightContext"))) {
+      vd_status st = translate_incontext(ls, t, n, &i, &copied, ln, col0 + (int)(i - line_start), out);
+      if (st) return st;
       continue;
     }
     const char* kw = NULL;
@@ -602,6 +656,9 @@ vd_status lsys_py_rule(vd_lsystem* ls, rule* r, const char* const* names, const 
   }
   if (k < 0) return ls->err->status ? ls->err->status : nomem(ls, h->lineno);
   r->pyfn = k;
+  // InLeftContext / InRightContext (translated to inLeftContext / inRightContext) read where the
+  // rule's contexts ended: the general matcher records it
+  r->incontext = strstr(ls->py->fn[k].src, "nLeftContext(") || strstr(ls->py->fn[k].src, "nRightContext(");
   return VD_OK;
 }
 
@@ -642,6 +699,22 @@ vd_status lsys_py_dlength(vd_lsystem* ls, const char* s, int len, int lineno) {
   if (k < 0) return ls->err->status;
   ls->py->fn_dlen = k;
   return VD_OK;
+}
+
+int lsys_py_cond(vd_lsystem* ls, const char* name, int nlen, const char* s, int len, int lineno) {
+  if (!ls->py->text) {
+    // a pattern read at run time (InLeftContext): its functions are compiled already
+    vm_error(ls, VD_ERR_UNSUPPORTED, lineno, 0, "unsupported: a condition on '%.*s' in an InLeftContext / InRightContext pattern",
+             nlen, name);
+    return -1;
+  }
+  sbuf b = {0};
+  sb_printf(&b, "def __vd_c%d(", ls->py->nfn);
+  sb_put(&b, name, (size_t)nlen);
+  sb_puts(&b, "): return (\n");
+  sb_put(&b, s, (size_t)len);
+  sb_puts(&b, "\n)");
+  return finish_chunk(ls, &b, lineno - 1);
 }
 
 vd_status lsys_py_parse_end(vd_lsystem* ls, size_t init_at) {

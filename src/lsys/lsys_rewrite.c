@@ -24,7 +24,7 @@ static int key_symbol(const rule* r, int backward) {
 // right context, no `=]`
 static int rule_is_simple(const rule* r) {
   const pstr* parts[3] = {&r->pred, &r->left, &r->right};
-  if (r->nleft.n || r->nright.n) return 0;
+  if (r->nleft.n || r->nright.n || r->incontext) return 0;
   for (int p = 0; p < 3; p++)
     for (int k = 0; k < parts[p]->n; k++) {
       const pmod* m = &parts[p]->m[k];
@@ -412,14 +412,23 @@ static inline __attribute__((always_inline)) int apply_try(vd_lsystem* ls, const
       e = i + r->pred.n;
       ok = fast_match(M, r, i, e, frame);
     } else {
-      ok = lsys_rule_match(M, r, i, frame, &b, &e);
+      ok = lsys_rule_match(M, r, i, frame, &b, &e, r->incontext ? &ls->cur : NULL);
+      if (!ok && ls->err && ls->err->status) {
+        // a pattern condition failed to evaluate
+        *st = ls->err->status;
+        if (frame != small) vd_free(frame, sizeof(value) * (size_t)nl);
+        return -1;
+      }
     }
     int applied = 0;
     if (ok) {
       int64_t mark = out->n;
       vm_out vo = {out, in->src ? in->src[b] : b, max_modules, 0, 0};
       if (ls->py) {
+        lsys_cur saved = ls->cur;  // a rule body may run rules (an interpretation inside it)
+        if (!r->incontext) ls->cur.M = NULL;
         *st = lsys_py_apply_rule(ls, r, frame, &vo);
+        ls->cur = saved;
       } else if (r->succ) {
         *st = vm_emit_tmpl(ls, r->succ, frame, &vo);
         vo.produced = 1;

@@ -491,6 +491,26 @@ def getGroup():
     return _vd.get_group()
 
 
+def inLeftContext(pattern, params=None):
+    """In a rule's body: does the pattern match left of where the rule's left context ended?
+    Its variables go into params; on a match the next call reads on from there."""
+    return _vd.in_context(0, str(pattern), params)
+
+
+def inRightContext(pattern, params=None):
+    """The same on the right of the rule's right context."""
+    return _vd.in_context(1, str(pattern), params)
+
+
+InLeftContext = inLeftContext     # the file's InLeftContext(A(x), params) is translated to a string
+InRightContext = inRightContext
+
+
+def _vd_make_vec3(c):
+    """A Vector3 the turtle fills into a query module (?P, ?F ...)."""
+    return Vector3(*c)
+
+
 def getIterationNb():
     return _vd.iteration()
 
@@ -2694,7 +2714,7 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
-        "PatternModule"]
+        "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext"]
 
 _DISPLAY = ["Viewer", "eStatic", "eAnimatedPrimitives", "eAnimatedScene", "pgl_support_extension"]
 _pgl_math = _module("openalea.plantgl.math", _MATH)

@@ -140,6 +140,7 @@ typedef struct turtle {  // NOLINT(clang-analyzer-optin.performance.Padding): fi
   tgcp* gcp;         // recorded tube paths, a stack that follows [ ] (ngcp)
   int ngcp, cap_gcp;
   double* query; // Nullable: parameter values of the string (query run: ?P ?H ... are filled)
+  lsys_qframes* qf;  // Nullable: frames of the query modules that take Vector3 objects
   // warnings, reported after the run with the file line of their first module
   struct twarn {
     int64_t i;     // first module it happened at
@@ -1381,18 +1382,34 @@ static void euler_angles(turtle* T, double az, double el, double roll) {
 // Vector3 object, which the native engine does not have)
 static vd_status query_fill(turtle* T) {
   if (!T->query) return VD_OK;
+  const tstate* t = &T->t;
+  double* p = T->query + T->s->par[T->i];
+  int objects = T->sym == VD_SYM_GETFRAME || T->np == 0 || (T->np == 1 && lsys_unbox_str(p[0]) < 0 && isnan(p[0]));
+  if (objects && T->qf) {
+    // the Python engine makes the Vector3 objects (lsys_py_query_objects)
+    lsys_qframes* q = T->qf;
+    if (!vd_grow((void**)&q->v, &q->cap, 13 * (q->n + 1), sizeof(double)))
+      return fail(T, VD_ERR_NOMEM, "out of memory");
+    double* r = q->v + 13 * q->n++;
+    vd_vec3 f[4] = {t->pos, t->h, t->u, t->l};
+    r[0] = (double)T->i;
+    for (int k = 0; k < 4; k++) {
+      r[1 + 3 * k] = f[k].x;
+      r[2 + 3 * k] = f[k].y;
+      r[3 + 3 * k] = f[k].z;
+    }
+    return VD_OK;
+  }
   if (T->sym == VD_SYM_GETFRAME)
     return fail(T, VD_ERR_UNSUPPORTED, "unsupported: ?F (GetFrame fills Vector3 objects)");
   if (T->np == 0)
     return fail(T, VD_ERR_UNSUPPORTED, "unsupported: %s without parameters (L-Py appends a Vector3 object)",
                 sym_name(T, T->sym));
-  const tstate* t = &T->t;
   vd_vec3 v = T->sym == VD_SYM_GETPOS    ? t->pos
               : T->sym == VD_SYM_GETHEAD ? t->h
               : T->sym == VD_SYM_GETUP   ? t->u
               : T->sym == VD_SYM_GETLEFT ? t->l
                                          : vd_sub(vd_v3(0, 0, 0), t->l);
-  double* p = T->query + T->s->par[T->i];
   double c[3] = {v.x, v.y, v.z};
   for (int k = 0; k < T->np && k < 3; k++) {
     if (isnan(p[k]))  // a string or an object (NaN-boxed)
@@ -1834,11 +1851,12 @@ static void report(turtle* T, vd_status st, vd_error* err) {
 }
 
 static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
-                            vd_plant_spec* plant, vd_error* err, double* query) {
+                            vd_plant_spec* plant, vd_error* err, double* query, lsys_qframes* qf) {
   VD_ASSERT(s && plant);
   turtle T;
   memset(&T, 0, sizeof T);
   T.query = query;
+  T.qf = qf;
   T.def = def ? *def : vd_turtle_def_default();
   // the file's own default angle (context.turtle.setAngleIncrement, as L-Py's turtle takes it)
   double fa;
@@ -1933,14 +1951,14 @@ static vd_status turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_
 
 vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turtle_def* def,
                         vd_plant_spec* plant, vd_error* err) {
-  return turtle_run(ls, s, def, plant, err, NULL);
+  return turtle_run(ls, s, def, plant, err, NULL, NULL);
 }
 
-vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err) {
+vd_status lsys_turtle_query(const vd_lsystem* ls, vd_lstring* s, vd_error* err, lsys_qframes* qf) {
   vd_plant_spec* scratch = vd_plant_spec_create();
   if (!scratch) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   vd_turtle_def d = vd_turtle_def_default();
-  vd_status st = turtle_run(ls, s, &d, scratch, err, s->val);
+  vd_status st = turtle_run(ls, s, &d, scratch, err, s->val, qf);
   vd_plant_spec_destroy(scratch);
   return st;
 }
