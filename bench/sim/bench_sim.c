@@ -16,17 +16,6 @@
 #include "verdant/verdant.h"
 #include "../bench_util.h"
 
-// the machine's 1-minute load average now (the machine is shared: say it beside every time)
-static double load1(void) {
-  double l = -1;
-  FILE* f = fopen("/proc/loadavg", "r");
-  if (f) {
-    if (fscanf(f, "%lf", &l) != 1) l = -1;
-    fclose(f);
-  }
-  return l;
-}
-
 // a plant run's settings
 typedef struct run_def {
   const char* name;      // case name in the CSV
@@ -82,7 +71,7 @@ static double plant_run(FILE* csv, const vd_model* pm, const run_def* r) {
   vd_sim_collider p = {VD_SIM_SPHERE, {0.04, 0, 0}, vd_v3(0.5, 0, 0.6 * top), vd_quat_identity(), vd_v3(0, 0, 0), NULL};
   int id = r->bare ? -1 : vd_sim_add_collider(d, &p);
   int steps = (int)(r->secs / m->opt.dt + 0.5);
-  double l0 = load1(), w0 = bench_wall(), c0 = bench_cpu();
+  double l0 = bench_load1(), w0 = bench_wall(), c0 = bench_cpu();
   for (int k = 0; k < steps; k++) {
     if (id >= 0) vd_sim_set_collider_pose(m, d, id, vd_v3(0.5 - 1.0 * k / steps, 0, 0.6 * top), vd_quat_identity());
     vd_sim_step(m, d);
@@ -90,7 +79,7 @@ static double plant_run(FILE* csv, const vd_model* pm, const run_def* r) {
   double wall = bench_wall() - w0, ct = bench_cpu() - c0;
   int dyn = 0;
   for (int t = 0; t < m->nseg; t++) dyn += !(m->seg_flags[t] & VD_SIM_FIXED);
-  double sps = steps / (r->threads > 1 ? wall : ct), load = 0.5 * (l0 + load1());
+  double sps = steps / (r->threads > 1 ? wall : ct), load = 0.5 * (l0 + bench_load1());
   printf("%-22s %-6s %2d it %2d thr  %6d seg  %8.0f steps/s  %6.2fx real time  %6.3f us/seg-step  (cpu %.2f s, wall %.2f s, "
          "load %.1f, %lld warnings)\n",
          r->name, r->solver == VD_SIM_GS ? "gs" : "direct", r->iters, r->threads, dyn, sps, sps * m->opt.dt,
@@ -148,7 +137,7 @@ static void reduction_run(FILE* csv, const vd_model* pm, const run_def* r, doubl
          100 * (fbreak - base[1]) / base[1]);
   fprintf(csv, "reduction,%s,direct,1,%d,%d,%.6f,,%.1f,%.3f,%.4f,%.6g,%.6g,1,%.2f,fruit displacement under 0.5 N (m) / "
                "relative change; speed-up %.2f; calyx breaks at %.4f N (full %.4f N)\n",
-          r->name, dyn, steps, ct, sps, sps * m->opt.dt, 1e6 / sps / dyn, disp, (disp - base[0]) / base[0], load1(),
+          r->name, dyn, steps, ct, sps, sps * m->opt.dt, 1e6 / sps / dyn, disp, (disp - base[0]) / base[0], bench_load1(),
           sps / base[2], fbreak, base[1]);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);
@@ -171,13 +160,13 @@ static double batch_run(FILE* csv, const vd_model* pm, int n, int threads, doubl
     vd_sim_add_collider(d[i], &p);
   }
   int steps = (int)(secs / m->opt.dt + 0.5);
-  double l0 = load1(), w0 = bench_wall(), c0 = bench_cpu();
+  double l0 = bench_load1(), w0 = bench_wall(), c0 = bench_cpu();
   for (int k = 0; k < steps; k++) {
     for (int i = 0; i < n; i++)
       vd_sim_set_collider_pose(m, d[i], 1, vd_v3(0.5 - 1.0 * k / steps, 0.01 * i, 0.6 * top), vd_quat_identity());
     vd_sim_step_batch(m, d, n, 1, threads, NULL);
   }
-  double wall = bench_wall() - w0, ct = bench_cpu() - c0, sps = (double)steps * n / wall, load = 0.5 * (l0 + load1());
+  double wall = bench_wall() - w0, ct = bench_cpu() - c0, sps = (double)steps * n / wall, load = 0.5 * (l0 + bench_load1());
   printf("batch of %d tomatoes, %d threads: %8.0f steps/s in all from wall (%.2fx real time each; CPU %.2f s, wall %.2f s, "
          "load %.1f)\n", n, threads, sps, sps * m->opt.dt / n, ct, wall, load);
   fprintf(csv, "batch,tomato_x%d,direct,1,%d,%d,%.6f,%.6f,%.1f,%.3f,,,,%d,%.2f,steps/s of all states from wall time\n", n,
@@ -378,8 +367,8 @@ int main(int argc, char** argv) {
   if (ci) fclose(ci);
   double cal = calibration_ns();
   printf("== machine: %s, %ld cores online, load %.2f; %.3f ns per dependent floating-point add (compare runs with it)\n",
-         cpu, sysconf(_SC_NPROCESSORS_ONLN), load1(), cal);
-  fprintf(csv, "calibration,ns_per_dependent_add,,,,,,,,,%.5f,,,,%.2f,%s\n", cal, load1(), cpu);
+         cpu, sysconf(_SC_NPROCESSORS_ONLN), bench_load1(), cal);
+  fprintf(csv, "calibration,ns_per_dependent_add,,,,,,,,,%.5f,,,,%.2f,%s\n", cal, bench_load1(), cpu);
   printf("== cantilevers at dt = 1 ms (direct solver, 1 iteration); CPU time\n");
   // reference: the same model at N = 1280 (second-order convergence: within 3e-7 of the limit)
   double ref = cantilever_tip(1280);
@@ -423,16 +412,16 @@ int main(int argc, char** argv) {
     plant_run(csv, tree, &tr2);
     w2 = bench_wall() - w0;
   }
-  printf("   tree: 2 threads %.2fx one thread (wall, load %.1f)\n", w1 / w2, load1());
+  printf("   tree: 2 threads %.2fx one thread (wall, load %.1f)\n", w1 / w2, bench_load1());
   fprintf(csv, "ratio,tree_2threads_over_1,direct,1,,,,,%.4f,,,,,2,%.2f,wall time of the same run on 1 and 2 threads\n",
-          w1 / w2, load1());
+          w1 / w2, bench_load1());
   (void)tr1_sps;
   printf("== batches: one model, states stepped by vd_sim_step_batch\n");
   double b1 = batch_run(csv, tomato, 8, 1, quick ? 0.1 : 0.5);
   double b2 = batch_run(csv, tomato, 8, 2, quick ? 0.1 : 0.5);
   printf("   batch of 8 tomatoes: 2 threads %.2fx one thread\n", b2 / b1);
   fprintf(csv, "ratio,batch8_2threads_over_1,direct,1,,,,,%.4f,,,,,2,%.2f,steps/s of all states (wall)\n", b2 / b1,
-          load1());
+          bench_load1());
   printf("== model reductions of the tomato (sag-free): what they change and what they save\n");
   double base[3] = {0, 0, 0};
   run_def red[6] = {{"full", VD_SIM_DIRECT, 1, 1, 0, 0, 0, 1, 0, 0, 0, 0},
@@ -447,7 +436,7 @@ int main(int argc, char** argv) {
   if (mj > 0) {
     printf("   MuJoCo %.1f steps/s; the rod solver %.0f steps/s: %.1fx faster\n", mj, tom_sps, tom_sps / mj);
     fprintf(csv, "ratio,rods_over_mujoco_tomato,direct,1,,,,,%.4f,,,,,1,%.2f,MuJoCo %.2f steps/s (its CPU time)\n",
-            tom_sps / mj, load1(), mj);
+            tom_sps / mj, bench_load1(), mj);
   }
   printf("== solver choice: settled sag of a 1 m cantilever (40 segments) after 3 s of damped dynamics\n");
   static const int gs_it[5] = {5, 20, 50, 200, 1000};
