@@ -62,4 +62,15 @@ static void fuzz_assert(const char* expr, const char* file, int line) {
   abort();
 }
 
+// the LLVMFuzzerInitialize of most targets: the checking allocator and the assert hook
+#define FUZZ_DEFAULT_INITIALIZE                                  \
+  int LLVMFuzzerInitialize(int* argc, char*** argv);             \
+  int LLVMFuzzerInitialize(int* argc, char*** argv) {            \
+    (void)argc;                                                  \
+    (void)argv;                                                  \
+    fuzz_install_allocator();                                    \
+    vd_set_assert_handler(fuzz_assert);                          \
+    return 0;                                                    \
+  }
+
 #endif

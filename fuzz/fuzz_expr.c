@@ -4,16 +4,9 @@
 // derived one step, so the expression parser and the evaluator see it.
 #include "fuzz_common.h"
 
-int LLVMFuzzerInitialize(int* argc, char*** argv);
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-int LLVMFuzzerInitialize(int* argc, char*** argv) {
-  (void)argc;
-  (void)argv;
-  fuzz_install_allocator();
-  vd_set_assert_handler(fuzz_assert);
-  return 0;
-}
+FUZZ_DEFAULT_INITIALIZE
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // wrap the input (the buffer is plain malloc: not counted by the verdant allocator)

@@ -5,7 +5,6 @@
 // fuzz input is never run as Python.
 #include "fuzz_common.h"
 
-int LLVMFuzzerInitialize(int* argc, char*** argv);
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 // progress hook: stop after 3 steps, so a derivation runs min(3, the file's length) steps
@@ -16,13 +15,7 @@ static int stop_after_3(void* user, int step, int steps, int64_t modules) {
   return step >= 3;
 }
 
-int LLVMFuzzerInitialize(int* argc, char*** argv) {
-  (void)argc;
-  (void)argv;
-  fuzz_install_allocator();
-  vd_set_assert_handler(fuzz_assert);
-  return 0;
-}
+FUZZ_DEFAULT_INITIALIZE
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   int64_t before = vd_alloc_bytes();

@@ -7,16 +7,9 @@
 
 #define FUZZ_MAX_VERT 200000  // largest mesh tessellated per input (vertices)
 
-int LLVMFuzzerInitialize(int* argc, char*** argv);
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-int LLVMFuzzerInitialize(int* argc, char*** argv) {
-  (void)argc;
-  (void)argv;
-  fuzz_install_allocator();
-  vd_set_assert_handler(fuzz_assert);
-  return 0;
-}
+FUZZ_DEFAULT_INITIALIZE
 
 // tessellate with def when the counted mesh is small enough; returns 1 when it was
 static int tessellate_capped(const vd_model* m, const vd_data* d, const vd_mesh_def* def) {

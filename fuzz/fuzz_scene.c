@@ -5,16 +5,9 @@
 #include "fuzz_common.h"
 #include "verdant/robot.h"
 
-int LLVMFuzzerInitialize(int* argc, char*** argv);
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
-int LLVMFuzzerInitialize(int* argc, char*** argv) {
-  (void)argc;
-  (void)argv;
-  fuzz_install_allocator();
-  vd_set_assert_handler(fuzz_assert);
-  return 0;
-}
+FUZZ_DEFAULT_INITIALIZE
 
 int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   int64_t before = vd_alloc_bytes();
