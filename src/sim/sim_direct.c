@@ -197,13 +197,18 @@ SIM_INLINE void qmul_lanes(lane* restrict a, lane* restrict b, lane* restrict c,
 // t = |Im q| / Re q <= 0.1 (its series); elsewhere need[l] = 1 and the caller calls quat_log
 SIM_INLINE void qlog_lanes(lane* restrict q, lane* restrict v, lane need) {
   L {
-    double sg = q[0][l] < 0 ? -1.0 : 1.0;
+    // (-0: sg = -1, w = +0 instead of 1 and -0: not ok either way; copysign keeps the loop
+    // free of branches, a comparison was threaded into them once inlined)
+    double sg = copysign(1.0, q[0][l]);
     double w = sg * q[0][l], x = sg * q[1][l], y = sg * q[2][l], z = sg * q[3][l];
     double s2 = x * x + y * y + z * z, w2 = w * w;
-    int ok = w > 0 && s2 <= 0.01 * w2;
-    double k = 2 * sim_atan_ratio(ok ? s2 / w2 : 0.0) / (ok ? w : 1.0);
+    // operands picked, not operations, all in doubles: a conditional division, or an int
+    // flag, keeps the loop scalar
+    double ok = w > 0 ? 1.0 : 0.0;
+    ok = s2 <= 0.01 * w2 ? ok : 0.0;
+    double k = 2 * sim_atan_ratio((ok > 0 ? s2 : 0.0) / (ok > 0 ? w2 : 1.0)) / (ok > 0 ? w : 1.0);
     v[0][l] = k * x, v[1][l] = k * y, v[2][l] = k * z;
-    need[l] = ok ? 0.0 : 1.0;
+    need[l] = 1.0 - ok;
   }
 }
 
@@ -319,7 +324,7 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
   L {
     double dot = qr[0][l] * in->st->q0[0][l] + qr[1][l] * in->st->q0[1][l] + qr[2][l] * in->st->q0[2][l] + qr[3][l] * in->st->q0[3][l];
     double sg = dot < 0 ? -1.0 : 1.0;
-    for (int k = 0; k < 4; k++) qr[k][l] *= sg;
+    qr[0][l] *= sg, qr[1][l] *= sg, qr[2][l] *= sg, qr[3][l] *= sg;
   }
   if (kind == VD_SIM_BEND_QUAT) {
     L {
@@ -500,17 +505,39 @@ static void held_terms(const vd_sim_model* m, const vd_sim_data* d, const sim_wo
   }
 }
 
-// add the children's contributions to slot s's body (lane l of block b), in their fixed order
-PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, sim_blk* restrict b, int l, int s) {
-  double* restrict bh = &b->h[0][l];  // element i of the lane at bh[SIM_W * i]; g follows h
-  for (int k = p->kid_start[s]; k < p->kid_start[s + 1]; k++) {
-    int c = p->kid_slot[k];
-    if (d->seg_broken[p->slot_seg[c]]) continue;  // it hangs from its spare now
-    const sim_blk* cb = &p->blk[c / SIM_W];
-    const double* restrict ch = &cb->dh[0][c % SIM_W];
-    const double* restrict cg = &cb->dg[0][c % SIM_W];
-    _Pragma("GCC unroll 21") for (int i = 0; i < 21; i++) bh[SIM_W * i] += ch[SIM_W * i];
-    _Pragma("GCC unroll 6") for (int i = 0; i < 6; i++) b->g[i][l] += cg[SIM_W * i];
+// add the children's contributions to the bodies of block bi, each body's in their fixed order:
+// round j adds every lane's j-th child, loaded lane-parallel (gathers) from the child's block,
+// whose stores are long done; adding lane by lane with scalar loads of the lanes the block's
+// linearisation had just written as vectors stalled on store forwarding (a fifth of the step)
+SIM_INLINE void gather_kids(const vd_sim_data* d, const sim_plan* p, sim_blk* restrict b, int bi) {
+  int k0[SIM_W], nk[SIM_W], most = 0;
+  for (int l = 0; l < SIM_W; l++) {
+    int s = bi * SIM_W + l;
+    k0[l] = p->kid_start[s], nk[l] = p->kid_start[s + 1] - k0[l];
+    most = nk[l] > most ? nk[l] : most;
+  }
+  const ptrdiff_t bs = (ptrdiff_t)(sizeof(sim_blk) / sizeof(double));
+  const double* restrict dh = &p->blk[0].dh[0][0];
+  const double* restrict dg = &p->blk[0].dg[0][0];
+  for (int j = 0; j < most; j++) {
+    ptrdiff_t off[SIM_W];
+    lane use;
+    for (int l = 0; l < SIM_W; l++) {
+      int c = j < nk[l] ? p->kid_slot[k0[l] + j] : -1;
+      int on = c >= 0 && !d->seg_broken[p->slot_seg[c]];  // a broken child hangs from its spare now
+      use[l] = on ? 1.0 : 0.0;
+      off[l] = on ? (ptrdiff_t)(c / SIM_W) * bs + c % SIM_W : 0;
+    }
+    for (int i = 0; i < 21; i++)
+      L {
+        double v = dh[off[l] + SIM_W * i];
+        b->h[i][l] = use[l] > 0 ? b->h[i][l] + v : b->h[i][l];
+      }
+    for (int i = 0; i < 6; i++)
+      L {
+        double v = dg[off[l] + SIM_W * i];
+        b->g[i][l] = use[l] > 0 ? b->g[i][l] + v : b->g[i][l];
+      }
   }
 }
 
@@ -669,10 +696,9 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
     eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l;
-      if (p->slot_seg[s] < 0) continue;
-      if (p->held_start[s + 1] > p->held_start[s]) held_terms(m, d, w, ctx, b, l, s);
-      gather_lane(d, p, b, l, s);
+      if (p->slot_seg[s] >= 0 && p->held_start[s + 1] > p->held_start[s]) held_terms(m, d, w, ctx, b, l, s);
     }
+    gather_kids(d, p, b, bi);
     if (p->tip_block[bi])
       forward_kernel(b, 1);
     else
