@@ -231,28 +231,72 @@ SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// the step's frame velocities, SIM_W segments at a time (the log map's series vectorises)
+// the frames' prediction and velocities, SIM_W segments at a time (the maps' series vectorise).
+// Whole groups move between the segments' quaternions and the lanes by interleaved loads and
+// stores in lane loops (vector permutes): lanes filled or read one scalar at a time made the
+// vector code wait on store forwarding.
+
+// lanes of SIM_W consecutive quaternions (n < SIM_W: the rest repeat the first)
+SIM_INLINE void quat_lanes(const vd_quat* restrict src, int n, lane* restrict q) {
+  if (n == SIM_W) {
+    const double* restrict a = &src[0].w;
+    L q[0][l] = a[4 * l], q[1][l] = a[4 * l + 1], q[2][l] = a[4 * l + 2], q[3][l] = a[4 * l + 3];
+    return;
+  }
+  for (int l = 0; l < SIM_W; l++) {
+    vd_quat c = src[l < n ? l : 0];
+    q[0][l] = c.w, q[1][l] = c.x, q[2][l] = c.y, q[3][l] = c.z;
+  }
+}
+
+// segments [t0, t1) of a dynamic step with the loads kept in the residual (the direct solver):
+// seg_prev = the frame, the frame turned by h omega (fixed ones kept): quat_rotate_by's bytes
+SIM_CLONES void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h, int t0, int t1) {
+  memcpy(w->seg_prev + t0, d->seg_quat + t0, (size_t)(t1 - t0) * sizeof(vd_quat));
+  for (int b = t0; b < t1; b += SIM_W) {
+    int n = t1 - b < SIM_W ? t1 - b : SIM_W;
+    // a last short group goes through a padded copy (the lane loops stay free of branches)
+    vd_quat qb[SIM_W];
+    vd_vec3 ob[SIM_W];
+    const double *qs = &d->seg_quat[b].w, *os = &d->seg_omega[b].x;
+    double* qo = &d->seg_quat[b].w;
+    if (n < SIM_W) {
+      for (int l = 0; l < SIM_W; l++) qb[l] = d->seg_quat[b + (l < n ? l : 0)], ob[l] = d->seg_omega[b + (l < n ? l : 0)];
+      qs = &qb[0].w, os = &ob[0].x, qo = &qb[0].w;
+    }
+    lane q[4], v[3], need;
+    L q[0][l] = qs[4 * l], q[1][l] = qs[4 * l + 1], q[2][l] = qs[4 * l + 2], q[3][l] = qs[4 * l + 3];
+    L v[0][l] = os[3 * l] * h, v[1][l] = os[3 * l + 1] * h, v[2][l] = os[3 * l + 2] * h;
+    qrot_lanes(q, v, need);
+    L qo[4 * l] = q[0][l], qo[4 * l + 1] = q[1][l], qo[4 * l + 2] = q[2][l], qo[4 * l + 3] = q[3][l];
+    if (n < SIM_W) memcpy(d->seg_quat + b, qb, (size_t)n * sizeof(vd_quat));
+    // fixed frames stay; turns beyond the series' range take the scalar map
+    for (int l = 0; l < n; l++) {
+      int t = b + l;
+      if (m->seg_flags[t] & VD_SIM_FIXED) d->seg_quat[t] = w->seg_prev[t];
+      else if (need[l] > 0) d->seg_quat[t] = quat_rotate_by(w->seg_prev[t], vd_scale(d->seg_omega[t], h));
+    }
+  }
+}
 
 SIM_CLONES void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work* w, double s, int t0, int t1) {
   for (int b = t0; b < t1; b += SIM_W) {
     int n = t1 - b < SIM_W ? t1 - b : SIM_W;
     lane q[4], qp[4], dq[4], v[3], need;
-    for (int l = 0; l < SIM_W; l++) {
-      int t = b + (l < n ? l : 0);
-      vd_quat a = d->seg_quat[t], c = w->seg_prev[t];
-      q[0][l] = a.w, q[1][l] = a.x, q[2][l] = a.y, q[3][l] = a.z;
-      qp[0][l] = c.w, qp[1][l] = c.x, qp[2][l] = c.y, qp[3][l] = c.z;
-    }
+    quat_lanes(d->seg_quat + b, n, q);
+    quat_lanes(w->seg_prev + b, n, qp);
     qmul_lanes(q, qp, dq, 1, -1);
     qlog_lanes(dq, v, need);
+    if (n == SIM_W) {
+      double* restrict o = &d->seg_omega[b].x;
+      L o[3 * l] = v[0][l] * s, o[3 * l + 1] = v[1][l] * s, o[3 * l + 2] = v[2][l] * s;
+    } else {
+      for (int l = 0; l < n; l++) d->seg_omega[b + l] = vd_v3(v[0][l] * s, v[1][l] * s, v[2][l] * s);
+    }
     for (int l = 0; l < n; l++) {
       int t = b + l;
-      if (m->seg_flags[t] & VD_SIM_FIXED) {
-        d->seg_omega[t] = vd_v3(0, 0, 0);
-        continue;
-      }
-      vd_vec3 r = need[l] > 0 ? quat_log((vd_quat){dq[0][l], dq[1][l], dq[2][l], dq[3][l]}) : vd_v3(v[0][l], v[1][l], v[2][l]);
-      d->seg_omega[t] = vd_scale(r, s);
+      if (m->seg_flags[t] & VD_SIM_FIXED) d->seg_omega[t] = vd_v3(0, 0, 0);
+      else if (need[l] > 0) d->seg_omega[t] = vd_scale(quat_log((vd_quat){dq[0][l], dq[1][l], dq[2][l], dq[3][l]}), s);
     }
   }
 }

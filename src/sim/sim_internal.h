@@ -357,6 +357,10 @@ int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
 // The frames' velocities at the end of a step, lane-parallel (sim_direct.c; the same bytes as
 // the scalar log map): segments [t0, t1) get omega = s log(q conj(q_prev)) (fixed ones 0).
 void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work* w, double s, int t0, int t1);
+// The frames' prediction of a dynamic step without the loads (the direct solver's): segments
+// [t0, t1) keep their frame in seg_prev and turn by h omega (fixed ones stay), lane-parallel
+// with the same bytes as quat_rotate_by.
+void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h, int t0, int t1);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
 // 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division
