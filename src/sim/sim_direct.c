@@ -359,6 +359,16 @@ PROF_NOINLINE static void gather_in(const vd_sim_model* m, const vd_sim_data* d,
   }
 }
 
+// what the linearisation of a block passes to its elimination alone (on the stack)
+typedef struct sim_fw {
+  lane c[6];    // damped constraint values c': stretch rows in world axes (m), bend (1/m)
+  lane al[9];   // damped compliances alpha~': stretch (upper 3x3, world), bend (diagonal)
+  lane lf[6];   // the joint's multipliers: stretch as R lambda_s / l0 (world), bend
+  lane mi[3];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib
+  lane d3[3];   // the frame's d3
+  lane ok;      // 1 while both factorisations of the lane held
+} sim_fw;
+
 // bend-twist strain and its Jacobian dC/dpsi of the lanes (sim_bend_strain, lane-parallel);
 // lanes whose log needs libm are recomputed by sim_bend_strain itself
 SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane* restrict dc) {
@@ -417,7 +427,8 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
 
 // linearise a block from its gathered inputs: body matrix (mass + ties) I and the inertia, the
 // residual g with -J^T lambda, the joint's values, compliances and Jacobians (world stretch rows)
-PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, double h, double gam, vd_sim_bend kind) {
+PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_fw* restrict fw, sim_in* in, double h, double gam,
+                                               vd_sim_bend kind) {
   double h2 = h * h, ig = 1.0 / (1 + gam);
   lane *rt = b->rt, rp[9], dq[4], dth[3], need, cb[3], dc[9];
   rot_lanes(in->qt, rt);
@@ -440,7 +451,7 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
     L acb[k][l] = (in->bend[l] > 0 ? in->st->cb[k][l] : 1.0) / h2;
   }
   // body: world inertia ib I + (it - ib) d3 d3^T; g_t = I (dth - h om) - h^2 (tau - om x I om)
-  lane* d3 = b->d3;
+  lane* d3 = fw->d3;
   lane ci, iw[6], dt[3], io[3], tq[3], il0;
   L ci[l] = in->st->it[l] - in->st->ib[l], il0[l] = 1.0 / in->st->l0[l];
   L d3[0][l] = rt[2][l], d3[1][l] = rt[5][l], d3[2][l] = rt[8][l];
@@ -463,12 +474,12 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
       v[k][l] = (cs + acs[k][l] * in->lam[k][l] + gam * (cs - in->cp[k][l])) * ig;
     }
   for (int i = 0; i < 3; i++) {
-    L b->lf[i][l] = (rt[3 * i][l] * in->lam[0][l] + rt[3 * i + 1][l] * in->lam[1][l] + rt[3 * i + 2][l] * in->lam[2][l]) * il0[l];
-    L b->c[i][l] = in->st->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
+    L fw->lf[i][l] = (rt[3 * i][l] * in->lam[0][l] + rt[3 * i + 1][l] * in->lam[1][l] + rt[3 * i + 2][l] * in->lam[2][l]) * il0[l];
+    L fw->c[i][l] = in->st->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
   }
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L b->al[SYM[i][k]][l] = in->st->l0[l] * in->st->l0[l] * ig *
+      L fw->al[SYM[i][k]][l] = in->st->l0[l] * in->st->l0[l] * ig *
                               (rt[3 * i][l] * acs[0][l] * rt[3 * k][l] + rt[3 * i + 1][l] * acs[1][l] * rt[3 * k + 1][l] +
                                rt[3 * i + 2][l] * acs[2][l] * rt[3 * k + 2][l]);
   // bend-twist: G = dC/dpsi R_p^T (zero when inactive)
@@ -479,15 +490,15 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   for (int k = 0; k < 3; k++)
     L {
       double c = in->bend[l] * cb[k][l];
-      b->c[3 + k][l] = (c + acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
-      b->al[6 + k][l] = acb[k][l] * ig;
-      b->lf[3 + k][l] = in->lam[3 + k][l];
+      fw->c[3 + k][l] = (c + acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
+      fw->al[6 + k][l] = acb[k][l] * ig;
+      fw->lf[3 + k][l] = in->lam[3 + k][l];
     }
   // g = M (y - y_n - h v_n) - h^2 f - J^T lambda, J^T lambda = [f; f x E + G^T lambda_b]
   lane fxe[3];
-  CROSS(fxe, b->lf, in->e);
+  CROSS(fxe, fw->lf, in->e);
   for (int k = 0; k < 3; k++) {
-    L b->g[k][l] = in->mass[l] * in->dx[k][l] - h2 * in->fe[k][l] - b->lf[k][l] + in->tieg[k][l];
+    L b->g[k][l] = in->mass[l] * in->dx[k][l] - h2 * in->fe[k][l] - fw->lf[k][l] + in->tieg[k][l];
     L b->g[3 + k][l] = b->g[3 + k][l] - h2 * tq[k][l] - fxe[k][l] -
                        (gm[k][l] * in->lam[3][l] + gm[3 + k][l] * in->lam[4][l] + gm[6 + k][l] * in->lam[5][l]);
     L b->e[k][l] = in->e[k][l];
@@ -497,7 +508,7 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   L {
     double mt = in->mass[l] + in->tieh[l];
     b->h[S00][l] = mt, b->h[S11][l] = mt, b->h[S22][l] = mt;
-    b->mi[0][l] = 1.0 / mt, b->mi[1][l] = 1.0 / in->st->ib[l], b->mi[2][l] = 1.0 / in->st->it[l] - 1.0 / in->st->ib[l];
+    fw->mi[0][l] = 1.0 / mt, fw->mi[1][l] = 1.0 / in->st->ib[l], fw->mi[2][l] = 1.0 / in->st->it[l] - 1.0 / in->st->ib[l];
   }
   for (int k = 0; k < 6; k++) L b->h[15 + k][l] = iw[k][l];
 }
@@ -560,9 +571,9 @@ SIM_INLINE void gather_kids(const vd_sim_data* d, const sim_plan* p, sim_blk* re
     k0[l] = p->kid_start[s], nk[l] = p->kid_start[s + 1] - k0[l];
     most = nk[l] > most ? nk[l] : most;
   }
-  const ptrdiff_t bs = (ptrdiff_t)(sizeof(sim_blk) / sizeof(double));
-  const double* restrict dh = &p->blk[0].dh[0][0];
-  const double* restrict dg = &p->blk[0].dg[0][0];
+  const ptrdiff_t bs = (ptrdiff_t)(sizeof(sim_kid) / sizeof(double));
+  const double* restrict dh = &p->kid[0].dh[0][0];
+  const double* restrict dg = &p->kid[0].dg[0][0];
   for (int j = 0; j < most; j++) {
     ptrdiff_t off[SIM_W];
     lane use;
@@ -590,19 +601,19 @@ SIM_INLINE void gather_kids(const vd_sim_data* d, const sim_plan* p, sim_blk* re
 
 // forward elimination of a block: H^-1, S = J H^-1 J^T + alpha^, r, S^-1 and the contribution
 // to the parent; tip: the body matrix is (mass) I and the inertia, its inverse written down
-SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
+SIM_INLINE void forward_kernel(sim_blk* restrict b, sim_fw* restrict fw, sim_kid* restrict kc, const int tip) {
   // H^-1 and S^-1 are written where the block keeps them (a tip's straight into b->h)
   lane hl[21], sm[21], ok, *hi = tip ? b->h : hl, *si = b->s;
   L ok[l] = 1.0;
   if (tip) {
     // (m I)^-1 and R diag(1/ib, 1/ib, 1/it) R^T = (1/ib) I + (1/it - 1/ib) d3 d3^T
     for (int k = 0; k < 15; k++) L hi[k][l] = 0;
-    L hi[S00][l] = b->mi[0][l];
-    L hi[S11][l] = b->mi[0][l];
-    L hi[S22][l] = b->mi[0][l];
+    L hi[S00][l] = fw->mi[0][l];
+    L hi[S11][l] = fw->mi[0][l];
+    L hi[S22][l] = fw->mi[0][l];
     for (int i = 0; i < 3; i++)
       for (int k = i; k < 3; k++)
-        L hi[15 + SYM[i][k]][l] = (i == k ? b->mi[1][l] : 0.0) + b->mi[2][l] * b->d3[i][l] * b->d3[k][l];
+        L hi[15 + SYM[i][k]][l] = (i == k ? fw->mi[1][l] : 0.0) + fw->mi[2][l] * fw->d3[i][l] * fw->d3[k][l];
   } else {
     inv6s(b->h, hi, ok);
   }
@@ -631,7 +642,7 @@ SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
   // S_ss = Ha + Q + Q^T + Z [E]x^T + alpha^_s; S_sb = (Hb + Z) G^T; S_bb = G Hd G^T + alpha^_b
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L sm[SYM[i][k]][l] = ha[SYM[i][k]][l] + q[3 * i + k][l] + q[3 * k + i][l] + zx[3 * i + k][l] + b->al[SYM[i][k]][l];
+      L sm[SYM[i][k]][l] = ha[SYM[i][k]][l] + q[3 * i + k][l] + q[3 * k + i][l] + zx[3 * i + k][l] + fw->al[SYM[i][k]][l];
   lane bz[9], vg[9];
   for (int k = 0; k < 9; k++) L bz[k][l] = hb[k][l] + z[k][l];
   for (int i = 0; i < 3; i++)
@@ -642,41 +653,41 @@ SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
       L sm[15 + SYM[i][k]][l] = vg[3 * i][l] * g[3 * k][l] + vg[3 * i + 1][l] * g[3 * k + 1][l] + vg[3 * i + 2][l] * g[3 * k + 2][l];
-  L sm[15 + S00][l] += b->al[6][l];
-  L sm[15 + S11][l] += b->al[7][l];
-  L sm[15 + S22][l] += b->al[8][l];
+  L sm[15 + S00][l] += fw->al[6][l];
+  L sm[15 + S11][l] += fw->al[7][l];
+  L sm[15 + S22][l] += fw->al[8][l];
   // r = -c' + J H^-1 g: hg = H^-1 g = (u, w); r_s = -c_s + u + E x w, r_b = -c_b + G w
   lane hg[6], ew[3], r[6];
   mul6s(hi, b->g, hg);
   CROSS(ew, e, hg + 3);
   for (int i = 0; i < 3; i++) {
-    L r[i][l] = -b->c[i][l] + hg[i][l] + ew[i][l];
-    L r[3 + i][l] = -b->c[3 + i][l] + g[3 * i][l] * hg[3][l] + g[3 * i + 1][l] * hg[4][l] + g[3 * i + 2][l] * hg[5][l];
+    L r[i][l] = -fw->c[i][l] + hg[i][l] + ew[i][l];
+    L r[3 + i][l] = -fw->c[3 + i][l] + g[3 * i][l] * hg[3][l] + g[3 * i + 1][l] * hg[4][l] + g[3 * i + 2][l] * hg[5][l];
   }
   inv6s(sm, si, ok);
   // contribution J_p^T S^-1 J_p = [[S^-1_A, S^-1_B G], [., G^T S^-1_D G]] and to g_p:
   // [(S^-1 r)_s + f; G^T ((S^-1 r)_b + lambda_b)]
   lane *sa = si, *sb = si + 6, *sd = si + 15;
   lane ug[9], sr[6], pb[3];
-  for (int k = 0; k < 6; k++) L b->dh[k][l] = sa[k][l];
+  for (int k = 0; k < 6; k++) L kc->dh[k][l] = sa[k][l];
   for (int i = 0; i < 3; i++)
     for (int k = 0; k < 3; k++) {
-      L b->dh[6 + 3 * i + k][l] = sb[3 * i][l] * g[k][l] + sb[3 * i + 1][l] * g[3 + k][l] + sb[3 * i + 2][l] * g[6 + k][l];
+      L kc->dh[6 + 3 * i + k][l] = sb[3 * i][l] * g[k][l] + sb[3 * i + 1][l] * g[3 + k][l] + sb[3 * i + 2][l] * g[6 + k][l];
       L ug[3 * i + k][l] = sd[SYM[i][0]][l] * g[k][l] + sd[SYM[i][1]][l] * g[3 + k][l] + sd[SYM[i][2]][l] * g[6 + k][l];
     }
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L b->dh[15 + SYM[i][k]][l] = g[i][l] * ug[k][l] + g[3 + i][l] * ug[3 + k][l] + g[6 + i][l] * ug[6 + k][l];
+      L kc->dh[15 + SYM[i][k]][l] = g[i][l] * ug[k][l] + g[3 + i][l] * ug[3 + k][l] + g[6 + i][l] * ug[6 + k][l];
   mul6s(si, r, sr);
   for (int k = 0; k < 3; k++) {
-    L b->dg[k][l] = sr[k][l] + b->lf[k][l];
-    L pb[k][l] = sr[3 + k][l] + b->lf[3 + k][l];
+    L kc->dg[k][l] = sr[k][l] + fw->lf[k][l];
+    L pb[k][l] = sr[3 + k][l] + fw->lf[3 + k][l];
   }
-  for (int k = 0; k < 3; k++) L b->dg[3 + k][l] = g[k][l] * pb[0][l] + g[3 + k][l] * pb[1][l] + g[6 + k][l] * pb[2][l];
+  for (int k = 0; k < 3; k++) L kc->dg[3 + k][l] = g[k][l] * pb[0][l] + g[3 + k][l] * pb[1][l] + g[6 + k][l] * pb[2][l];
   if (!tip)
     for (int k = 0; k < 21; k++) L b->h[k][l] = hi[k][l];
   for (int k = 0; k < 6; k++) L b->r[k][l] = r[k][l];
-  L b->ok[l] = ok[l];
+  L fw->ok[l] = ok[l];
 }
 
 // back substitution of a block, the parents' updates in dyp: dl = S^-1 (r + [dx_p; G dth_p]),
@@ -708,7 +719,7 @@ PROF_NOINLINE SIM_INLINE_PROF void back_kernel(sim_blk* restrict b, lane* restri
 // a spare node hangs only from the joint that broke onto it (lane l of block b): solve it now,
 // H = (m + ties) I + S^-1_A, dx = -H^-1 g; 0 when singular
 static int solve_spare(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
-                       const sim_blk* b, int l, int t) {
+                       const sim_kid* b, int l, int t) {
   const sim_plan* p = &w->plan;
   int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;
   double h = ctx->h, h2 = h * h;
@@ -734,24 +745,26 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
   sim_plan* p = &w->plan;
   for (int bi = b0; bi < b1; bi++) {
     sim_blk* b = &p->blk[bi];
+    sim_kid* kc = &p->kid[bi];
     sim_in in;
+    sim_fw fw;
     in.st = &p->stat[bi];
     gather_in(m, d, w, ctx, &in, bi);
-    eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
+    eval_block(b, &fw, &in, ctx->h, ctx->gamma, m->bend_measure);
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l;
       if (p->slot_seg[s] >= 0 && p->held_start[s + 1] > p->held_start[s]) held_terms(m, d, w, ctx, b, l, s);
     }
     gather_kids(d, p, b, bi);
     if (p->tip_block[bi])
-      forward_kernel(b, 1);
+      forward_kernel(b, &fw, kc, 1);
     else
-      forward_kernel(b, 0);
+      forward_kernel(b, &fw, kc, 0);
     for (int l = 0; l < SIM_W; l++) {
       int t = p->slot_seg[bi * SIM_W + l];
       if (t < 0) continue;
-      if (!(b->ok[l] > 0)) return 0;
-      if (d->seg_broken[t] && !solve_spare(m, d, w, ctx, b, l, t)) return 0;
+      if (!(fw.ok[l] > 0)) return 0;
+      if (d->seg_broken[t] && !solve_spare(m, d, w, ctx, kc, l, t)) return 0;
     }
   }
   return 1;

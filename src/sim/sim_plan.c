@@ -260,6 +260,7 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     size_t o_hl = TAKE(((size_t)nheld + 1) * 30 * sizeof(double));
     size_t o_bk = TAKE((size_t)nblock * sizeof(sim_blk) + 64);
     size_t o_st = TAKE((size_t)nblock * sizeof(sim_stat) + 64);
+    size_t o_kc = TAKE((size_t)nblock * sizeof(sim_kid) + 64);
 #undef TAKE
     char* mem = vd_calloc(1, top);
     if (!mem) {
@@ -277,6 +278,8 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     p->blk = (sim_blk*)(mem + o_bk + ((64 - (a & 63)) & 63));
     a = (uintptr_t)(mem + o_st);
     p->stat = (sim_stat*)(mem + o_st + ((64 - (a & 63)) & 63));
+    a = (uintptr_t)(mem + o_kc);
+    p->kid = (sim_kid*)(mem + o_kc + ((64 - (a & 63)) & 63));
     memcpy(p->tip_block, b.tips, (size_t)nblock);
     for (int t = 0; t < ns; t++) p->seg_slot[t] = -1;
     for (int s = 0; s < nslot; s++) {
