@@ -430,7 +430,7 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
 PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_fw* restrict fw, sim_in* in, double h, double gam,
                                                vd_sim_bend kind) {
   double h2 = h * h, ig = 1.0 / (1 + gam);
-  lane *rt = b->rt, rp[9], dq[4], dth[3], need, cb[3], dc[9];
+  lane rt[9], rp[9], dq[4], dth[3], need, cb[3], dc[9];
   rot_lanes(in->qt, rt);
   for (int k = 0; k < 4; k++) L b->qt[k][l] = in->qt[k][l];
   L b->l0[l] = in->st->l0[l];
@@ -820,11 +820,12 @@ SIM_CLONES static double trust_scale(const sim_plan* p) {
 SIM_CLONES static void apply_blocks(const vd_sim_model* m, vd_sim_data* d, sim_plan* p, double scale, int b0, int b1) {
   for (int bi = b0; bi < b1; bi++) {
     sim_blk* b = &p->blk[bi];
-    lane v[3], need, ls[3];
+    lane v[3], need, ls[3], rt[9];
+    rot_lanes(b->qt, rt);  // the frame's rotation at the linearisation, as eval_block had it
     for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
     qrot_lanes(b->qt, v, need);
     for (int k = 0; k < 3; k++)
-      L ls[k][l] = scale * (b->l0[l] * (b->rt[k][l] * b->dl[0][l] + b->rt[3 + k][l] * b->dl[1][l] + b->rt[6 + k][l] * b->dl[2][l]));
+      L ls[k][l] = scale * (b->l0[l] * (rt[k][l] * b->dl[0][l] + rt[3 + k][l] * b->dl[1][l] + rt[6 + k][l] * b->dl[2][l]));
     for (int l = 0; l < SIM_W; l++) {
       int t = p->slot_seg[bi * SIM_W + l];
       if (t < 0) continue;

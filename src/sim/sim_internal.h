@@ -224,7 +224,6 @@ typedef struct sim_blk {
   double dy[6][SIM_W];   // body update (m, rad)
   double dl[6][SIM_W];   // multiplier update (world stretch rows, bend rows)
   double qt[4][SIM_W];   // the frame at the linearisation
-  double rt[9][SIM_W];   // its rotation matrix
   double l0[SIM_W];      // rest length (m)
 } sim_blk;
 
