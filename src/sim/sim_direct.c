@@ -565,23 +565,27 @@ static void held_terms(const vd_sim_model* m, const vd_sim_data* d, const sim_wo
 // whose stores are long done; adding lane by lane with scalar loads of the lanes the block's
 // linearisation had just written as vectors stalled on store forwarding (a fifth of the step)
 SIM_INLINE void gather_kids(const vd_sim_data* d, const sim_plan* p, sim_blk* restrict b, int bi) {
-  int k0[SIM_W], nk[SIM_W], most = 0;
-  for (int l = 0; l < SIM_W; l++) {
-    int s = bi * SIM_W + l;
-    k0[l] = p->kid_start[s], nk[l] = p->kid_start[s + 1] - k0[l];
-    most = nk[l] > most ? nk[l] : most;
-  }
-  const ptrdiff_t bs = (ptrdiff_t)(sizeof(sim_kid) / sizeof(double));
   const double* restrict dh = &p->kid[0].dh[0][0];
   const double* restrict dg = &p->kid[0].dg[0][0];
-  for (int j = 0; j < most; j++) {
-    ptrdiff_t off[SIM_W];
-    lane use;
-    for (int l = 0; l < SIM_W; l++) {
-      int c = j < nk[l] ? p->kid_slot[k0[l] + j] : -1;
-      int on = c >= 0 && !d->seg_broken[p->slot_seg[c]];  // a broken child hangs from its spare now
-      use[l] = on ? 1.0 : 0.0;
-      off[l] = on ? (ptrdiff_t)(c / SIM_W) * bs + c % SIM_W : 0;
+  // the rounds and the lanes' children come from the plan (indices computed here and stored a
+  // scalar at a time would make the vector loads below wait for them), unless a child broke
+  int broken = 0;
+  for (int k = p->kid_start[bi * SIM_W]; k < p->kid_start[bi * SIM_W + SIM_W]; k++) broken |= d->seg_broken[p->slot_seg[p->kid_slot[k]]];
+  ptrdiff_t dyn_off[SIM_W];
+  lane dyn_use;
+  for (int r = p->kround[bi]; r < p->kround[bi + 1]; r++) {
+    const ptrdiff_t* restrict off = p->koff + (size_t)SIM_W * r;
+    const double* restrict use = p->kuse + (size_t)SIM_W * r;
+    if (broken) {
+      int j = r - p->kround[bi];
+      for (int l = 0; l < SIM_W; l++) {
+        int s = bi * SIM_W + l;
+        int c = j < p->kid_start[s + 1] - p->kid_start[s] ? p->kid_slot[p->kid_start[s] + j] : -1;
+        int on = c >= 0 && !d->seg_broken[p->slot_seg[c]];  // a broken child hangs from its spare now
+        dyn_use[l] = on ? 1.0 : 0.0;
+        dyn_off[l] = on ? off[l] : 0;
+      }
+      off = dyn_off, use = dyn_use;
     }
     for (int i = 0; i < 21; i++)
       L {

@@ -5,6 +5,7 @@
 #define VERDANT_SIM_INTERNAL_H
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "verdant/sim.h"
@@ -260,6 +261,9 @@ typedef struct sim_plan {
   int* par_slot;             // slot of the parent body, -1 when kinematic or padding (nslot)
   int* kid_start;            // children of slot s: kid_slot[kid_start[s] .. kid_start[s + 1]) (nslot + 1)
   int* kid_slot;             // (nbody)
+  int* kround;               // block b adds its children in rounds kround[b] .. kround[b + 1]: round r adds
+  ptrdiff_t* koff;           // each lane's j-th child, at koff[SIM_W r + l] in sim_kid's doubles (0 and
+  double* kuse;              // kuse 0 where none) (nblock + 1, nround x SIM_W, nround x SIM_W)
   unsigned char* tip_block;  // 1 when block b holds tips (no children) only (nblock)
   double* tie_h;             // ties on each slot's node, then on each spare: sum of h^2 / compliance (nslot + nspare)
   double* tie_g;             // ... and their residual sum c h^2 / compliance ((nslot + nspare) x 3)
