@@ -239,7 +239,7 @@ SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
 // lanes of SIM_W consecutive quaternions (n < SIM_W: the rest repeat the first)
 SIM_INLINE void quat_lanes(const vd_quat* restrict src, int n, lane* restrict q) {
   if (n == SIM_W) {
-    const double* restrict a = &src[0].w;
+    const double* restrict a = (const double*)src;
     L q[0][l] = a[4 * l], q[1][l] = a[4 * l + 1], q[2][l] = a[4 * l + 2], q[3][l] = a[4 * l + 3];
     return;
   }
@@ -258,11 +258,11 @@ SIM_CLONES void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_wor
     // a last short group goes through a padded copy (the lane loops stay free of branches)
     vd_quat qb[SIM_W];
     vd_vec3 ob[SIM_W];
-    const double *qs = &d->seg_quat[b].w, *os = &d->seg_omega[b].x;
-    double* qo = &d->seg_quat[b].w;
+    const double *qs = (const double*)(d->seg_quat + b), *os = (const double*)(d->seg_omega + b);
+    double* qo = (double*)(d->seg_quat + b);
     if (n < SIM_W) {
       for (int l = 0; l < SIM_W; l++) qb[l] = d->seg_quat[b + (l < n ? l : 0)], ob[l] = d->seg_omega[b + (l < n ? l : 0)];
-      qs = &qb[0].w, os = &ob[0].x, qo = &qb[0].w;
+      qs = (const double*)qb, os = (const double*)ob, qo = (double*)qb;
     }
     lane q[4], v[3], need;
     L q[0][l] = qs[4 * l], q[1][l] = qs[4 * l + 1], q[2][l] = qs[4 * l + 2], q[3][l] = qs[4 * l + 3];
@@ -288,7 +288,7 @@ SIM_CLONES void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, cons
     qmul_lanes(q, qp, dq, 1, -1);
     qlog_lanes(dq, v, need);
     if (n == SIM_W) {
-      double* restrict o = &d->seg_omega[b].x;
+      double* restrict o = (double*)(d->seg_omega + b);
       L o[3 * l] = v[0][l] * s, o[3 * l + 1] = v[1][l] * s, o[3 * l + 2] = v[2][l] * s;
     } else {
       for (int l = 0; l < n; l++) d->seg_omega[b + l] = vd_v3(v[0][l] * s, v[1][l] * s, v[2][l] * s);
@@ -451,12 +451,11 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_fw* restr
     L acb[k][l] = (in->bend[l] > 0 ? in->st->cb[k][l] : 1.0) / h2;
   }
   // body: world inertia ib I + (it - ib) d3 d3^T; g_t = I (dth - h om) - h^2 (tau - om x I om)
-  lane* d3 = fw->d3;
   lane ci, iw[6], dt[3], io[3], tq[3], il0;
   L ci[l] = in->st->it[l] - in->st->ib[l], il0[l] = 1.0 / in->st->l0[l];
-  L d3[0][l] = rt[2][l], d3[1][l] = rt[5][l], d3[2][l] = rt[8][l];
+  L fw->d3[0][l] = rt[2][l], fw->d3[1][l] = rt[5][l], fw->d3[2][l] = rt[8][l];
   for (int i = 0; i < 3; i++)
-    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->st->ib[l] : 0.0) + ci[l] * d3[i][l] * d3[k][l];
+    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->st->ib[l] : 0.0) + ci[l] * fw->d3[i][l] * fw->d3[k][l];
   for (int k = 0; k < 3; k++) L dt[k][l] = dth[k][l] - h * in->om[k][l];
   for (int i = 0; i < 3; i++) {
     L io[i][l] = iw[SYM[i][0]][l] * in->om[0][l] + iw[SYM[i][1]][l] * in->om[1][l] + iw[SYM[i][2]][l] * in->om[2][l];
