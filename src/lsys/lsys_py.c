@@ -939,7 +939,7 @@ static PyObject* vd_set_frame_displayed(PyObject* self, PyObject* arg) {
   int t = PyObject_IsTrue(arg);
   if (t < 0) return NULL;
   ls->frame_displayed = t;
-  Py_RETURN_NONE;
+  return py_none();
 }
 
 // isAnimationEnabled(): vd_lsys_animate runs
