@@ -777,8 +777,27 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
 SIM_CLONES static void back_range(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, int b0, int b1) {
   sim_plan* p = &w->plan;
   lane dyp[6];
+  const double* restrict base = (const double*)p->blk;
   for (int bi = b1 - 1; bi >= b0; bi--) {
     sim_blk* b = &p->blk[bi];
+    // the parents' updates, lane-parallel from the plan's offsets (as gather_kids), unless a
+    // joint of the block broke: its lane takes its spare node's update
+    int broken = 0;
+    for (int l = 0; l < SIM_W; l++) {
+      int t = p->slot_seg[bi * SIM_W + l];
+      broken |= t >= 0 && d->seg_broken[t];
+    }
+    if (!broken) {
+      const ptrdiff_t* restrict off = p->poff + bi * SIM_W;
+      const double* restrict use = p->puse + bi * SIM_W;
+      for (int k = 0; k < 6; k++)
+        L {
+          double v = base[off[l] + SIM_W * k];
+          dyp[k][l] = use[l] > 0 ? v : 0.0;
+        }
+      back_kernel(b, dyp);
+      continue;
+    }
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l, t = p->slot_seg[s], ps = p->par_slot[s];
       for (int k = 0; k < 6; k++) dyp[k][l] = 0;

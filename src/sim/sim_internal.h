@@ -259,6 +259,8 @@ typedef struct sim_plan {
   int* slot_seg;             // segment of each slot, -1 for padding (nslot)
   int* seg_slot;             // slot of each segment, -1 when fixed (nseg)
   int* par_slot;             // slot of the parent body, -1 when kinematic or padding (nslot)
+  ptrdiff_t* poff;           // where the parent's update dy of slot s starts, in doubles from blk (0 without)
+  double* puse;              // 1 where slot s has a parent body, else 0 (nslot, nslot)
   int* kid_start;            // children of slot s: kid_slot[kid_start[s] .. kid_start[s + 1]) (nslot + 1)
   int* kid_slot;             // (nbody)
   int* kround;               // block b adds its children in rounds kround[b] .. kround[b + 1]: round r adds

@@ -268,6 +268,7 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
         int t = b.order[bk * SIM_W + l], nk = t >= 0 ? b.kstart[t + 1] - b.kstart[t] : 0;
         if (nk > most) nround += nk - most, most = nk;
       }
+    size_t o_po = TAKE((size_t)nslot * sizeof(ptrdiff_t)), o_pu = TAKE((size_t)nslot * sizeof(double));
     size_t o_kr = TAKE(((size_t)nblock + 1) * I), o_ko = TAKE(((size_t)nround + 1) * SIM_W * sizeof(ptrdiff_t));
     size_t o_ku = TAKE(((size_t)nround + 1) * SIM_W * sizeof(double));
 #undef TAKE
@@ -289,6 +290,7 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     p->stat = (sim_stat*)(mem + o_st + ((64 - (a & 63)) & 63));
     a = (uintptr_t)(mem + o_kc);
     p->kid = (sim_kid*)(mem + o_kc + ((64 - (a & 63)) & 63));
+    p->poff = (ptrdiff_t*)(mem + o_po), p->puse = (double*)(mem + o_pu);
     p->kround = (int*)(mem + o_kr), p->koff = (ptrdiff_t*)(mem + o_ko), p->kuse = (double*)(mem + o_ku);
     memcpy(p->tip_block, b.tips, (size_t)nblock);
     for (int t = 0; t < ns; t++) p->seg_slot[t] = -1;
@@ -306,6 +308,13 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
       for (int k = b.kstart[t]; k < b.kstart[t + 1]; k++) p->kid_slot[nk++] = p->seg_slot[b.kids[k]];
     }
     p->kid_start[nslot] = nk;
+    for (int s = 0; s < nslot; s++) {
+      int ps = p->par_slot[s];
+      p->puse[s] = ps >= 0;
+      p->poff[s] = ps < 0 ? 0
+                          : (ptrdiff_t)(ps / SIM_W) * (ptrdiff_t)(sizeof(sim_blk) / sizeof(double)) +
+                                (ptrdiff_t)(offsetof(sim_blk, dy) / sizeof(double)) + ps % SIM_W;
+    }
     // the rounds (koff and kuse are zero from the allocation)
     int nr = 0;
     for (int bk = 0; bk < nblock; bk++) {
