@@ -138,11 +138,14 @@ class Options:
 
 
 class Context:
-    """What the tests set on a context: options, and globals given to the file."""
+    """What the tests set on a context: options, and globals given to the file. A function of
+    the file read back (l.context()['check']) runs inside verdant: the last run again, with
+    `--call NAME` after it (the same seed gives the same run)."""
 
-    def __init__(self):
+    def __init__(self, lsystem):
         self.options = Options()
         self.names = {}
+        self.lsystem = lsystem
 
     def __setitem__(self, name, value):
         self.names[name] = value
@@ -150,7 +153,9 @@ class Context:
     def __getitem__(self, name):
         if name in self.names:
             return self.names[name]
-        raise KeyError("%s: the file's objects stay inside verdant" % name)
+        if self.lsystem.last_run is None:
+            raise KeyError("%s: the file's objects stay inside verdant (run it first)" % name)
+        return lambda: self.lsystem._run(*self.lsystem.last_run, call=name)
 
 
 class LsystemError(Exception):
@@ -164,7 +169,8 @@ class Lsystem:
         if filename:
             with open(filename, encoding="utf-8") as f:
                 self.code = f.read()
-        self._context = Context()
+        self._context = Context(self)
+        self.last_run = None
 
     def set(self, code):
         self.code = code
@@ -206,7 +212,8 @@ class Lsystem:
                 text += "###### INITIALISATION ######\ndef __initialiseContext__(context):\n" + opts
         return text
 
-    def _run(self, steps=None, axiom=None):
+    def _run(self, steps=None, axiom=None, animate=False, call=None):
+        self.last_run = (steps, axiom, animate)
         with tempfile.TemporaryDirectory() as tmp:
             src = os.path.join(tmp, "model.lpy")
             with open(src, "w", encoding="utf-8") as f:
@@ -215,6 +222,10 @@ class Lsystem:
                    os.path.join(tmp, "lstring.json"), "--no-progress"]
             if steps is not None:
                 cmd += ["-n", str(steps)]
+            if animate:
+                cmd += ["--animate"]
+            if call:
+                cmd += ["--call", call]
             for name, value in self._context.names.items():
                 if not callable(value) and re.search(r"^%s\s*=" % re.escape(name), self.code, re.M):
                     cmd += ["--set", "%s=%r" % (name, value)]
@@ -238,7 +249,8 @@ class Lsystem:
         return self._run(args[0] if args else None)
 
     def animate(self, *args):
-        return self.derive()
+        # L-Py's animate(dt): interpret after every step (the time step is for a viewer)
+        return self._run(None, None, True)
 
     @property
     def axiom(self):

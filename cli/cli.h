@@ -39,7 +39,16 @@ typedef struct cli_plant_opts {
   const char* lstring_out; // --lstring FILE: the derived L-string as JSON (.lpy files), NULL: none
   int instances;           // --instances: a vd_instance_mode, or -1 (default): organs for .lpy
                            // files, a plant file's own numbering
+  int animate;             // grow --animate: draw after every step (vd_lsys_animate), .lpy files
+  const char* frames;      // grow --frames PATTERN: write each frame there (a %d field), or NULL
+  const char* call[8];     // grow --call NAME: the file's functions called after the run
+  int ncall;
 } cli_plant_opts;
+
+// The file of animation frame `frame` from a --frames pattern: the pattern with its one integer
+// field (%d, %4d, %04d) filled and %% as %; 0 when the pattern has no such field, more than
+// one, another conversion, or the name does not fit cap.
+int cli_frame_name(const char* pattern, int frame, char* buf, size_t cap);
 
 // Defaults: steps -1, seed 0, max_modules 50e6, progress if stderr is a TTY.
 void cli_plant_opts_init(cli_plant_opts* o);

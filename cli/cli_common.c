@@ -381,6 +381,90 @@ static vd_status load_curves(const cli_plant_opts* o, const char* text, size_t l
   return st;
 }
 
+int cli_frame_name(const char* pattern, int frame, char* buf, size_t cap) {
+  size_t n = 0;
+  int fields = 0;
+  for (const char* p = pattern; *p; p++) {
+    char piece[32];
+    const char* text = piece;
+    if (*p != '%') {
+      piece[0] = *p, piece[1] = 0;
+    } else if (p[1] == '%') {
+      piece[0] = '%', piece[1] = 0;
+      p++;
+    } else {
+      // %d, %Nd or %0Nd with N < 10
+      const char* q = p + 1;
+      int zero = *q == '0';
+      if (zero) q++;
+      int width = 0;
+      if (*q >= '1' && *q <= '9') width = *q++ - '0';
+      if (*q != 'd' || fields++) return 0;
+      snprintf(piece, sizeof piece, zero ? "%0*d" : "%*d", width, frame);
+      p = q;
+    }
+    size_t k = strlen(text);
+    if (n + k >= cap) return 0;
+    memcpy(buf + n, text, k + 1);
+    n += k;
+  }
+  return fields == 1;
+}
+
+// the file's label names, then --label, then the instances (organs unless --instances modules)
+static vd_status name_labels(const cli_plant_opts* o, const vd_lsystem* ls, vd_plant_spec* plant, vd_error* err) {
+  vd_status st = VD_OK;
+  for (int i = 0; !st && i < vd_lsys_label_count(ls); i++) {
+    int id;
+    const char* name;
+    vd_lsys_label_get(ls, i, &id, &name);
+    st = vd_plant_set_label(plant, id, name);
+  }
+  for (int i = 0; !st && i < o->nlabel; i++) {
+    const char* eq = strchr(o->label[i], '=');
+    st = vd_plant_set_label(plant, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
+  }
+  if (!st) st = vd_plant_complete_labels(plant);
+  if (!st) st = vd_plant_set_instances(plant, o->instances < 0 ? VD_INSTANCE_ORGANS : (vd_instance_mode)o->instances);
+  if (st) vd_error_set(err, st, o->path, 0, 0, "out of memory");
+  return st;
+}
+
+// an animation's frames written as they come (--frames)
+typedef struct frame_writer {
+  const cli_plant_opts* o;
+  const vd_lsystem* ls;
+  vd_error* err;
+  vd_status st;
+  int last;  // frames written: 0..last-1
+} frame_writer;
+
+static int write_frame(void* user, int frame, const vd_lstring* s, const vd_plant_spec* plant) {
+  (void)s;
+  frame_writer* w = user;
+  char path[4200];
+  if (!cli_frame_name(w->o->frames, frame, path, sizeof path)) {
+    w->st = vd_error_set(w->err, VD_ERR_ARG, w->o->frames, 0, 0, "frame %d: the file name is too long", frame);
+    return 1;
+  }
+  vd_plant_spec* p = vd_plant_spec_copy(plant);
+  w->st = p ? name_labels(w->o, w->ls, p, w->err) : vd_error_set(w->err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (!w->st) w->st = cli_write_plant(p, path, 0, w->err);
+  vd_plant_spec_destroy(p);
+  if (!w->st) w->last = frame + 1;
+  return w->st != VD_OK;
+}
+
+// a failed run leaves no frame behind
+static void remove_frames(const frame_writer* w) {
+  for (int k = 0; k < w->last; k++) {
+    char files[2][4200], path[4200];
+    if (!cli_frame_name(w->o->frames, k, path, sizeof path)) continue;
+    int nf = cli_plant_files(path, files);
+    for (int i = 0; i < nf; i++) remove(files[i]);
+  }
+}
+
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
   memset(info, 0, sizeof *info);
   *out = NULL;
@@ -393,6 +477,9 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
                         kind);
   if (cli_has_ext(o->path, ".json")) {
     if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
+    if (o->animate || o->ncall)
+      return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "%s applies to .lpy files only",
+                          o->ncall ? "--call" : o->frames ? "--frames" : "--animate");
     // a plant file or a curves file, by its "format"
     char* text;
     size_t len;
@@ -440,30 +527,24 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   def.max_ops = o->max_ops;
   if (o->progress) def.progress = progress_cb;
   double t0 = cli_now();
-  if (!st) st = vd_lsys_derive(ls, &def, &derived, err);
+  frame_writer fw = {o, ls, err, VD_OK, 0};
+  if (o->frames) def.frame = write_frame, def.frame_user = &fw;
+  // an animation draws every frame and ends with the plant of the last (the turtle's time is in
+  // the derivation's)
+  if (!st) st = o->animate ? vd_lsys_animate(ls, &def, &derived, plant, err) : vd_lsys_derive(ls, &def, &derived, err);
+  if (fw.st) st = fw.st;
   double t1 = cli_now();
   if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
-  if (!st) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
-  if (!st) {
+  if (!st && !o->animate) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
+  if (!st && !o->animate) {
     vd_turtle_def td = vd_turtle_def_default();
     st = vd_turtle_run(ls, &geo, &td, plant, err);
   }
   double t2 = cli_now();
-  // label names: the file's LABELS, then --label
-  for (int i = 0; !st && i < vd_lsys_label_count(ls); i++) {
-    int id;
-    const char* name;
-    vd_lsys_label_get(ls, i, &id, &name);
-    st = vd_plant_set_label(plant, id, name);
-  }
-  for (int i = 0; !st && i < o->nlabel; i++) {
-    const char* eq = strchr(o->label[i], '=');
-    st = vd_plant_set_label(plant, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
-  }
-  if (!st) st = vd_plant_complete_labels(plant);
-  // instances: organs unless --instances modules (the turtle numbers them by module)
-  if (!st && (st = vd_plant_set_instances(plant, o->instances < 0 ? VD_INSTANCE_ORGANS : (vd_instance_mode)o->instances)))
-    vd_error_set(err, st, o->path, 0, 0, "out of memory");
+  // the file's functions, after the run (a check() of its asserts)
+  for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
+  if (!st) st = name_labels(o, ls, plant, err);
+  if (st && o->frames) remove_frames(&fw);
   if (!st) {
     // module counts by symbol for --stats
     info->modules = derived.n;

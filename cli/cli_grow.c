@@ -24,7 +24,15 @@ static const char* grow_help =
     "                        total_length (m))\n"
     "      --traits FILE     per-instance traits as CSV: instance, label, label_name, organ,\n"
     "                        segments, spheres, meshes, length_m, area_m2, diameter_m, volume_m3,\n"
-    "                        bbox (m)\n";
+    "                        bbox (m)\n"
+    "      --animate         .lpy files: interpret and draw after every derivation step, as\n"
+    "                        L-Py's animate (its hooks and interpretation rules run per frame;\n"
+    "                        every step runs; OUT is the last frame)\n"
+    "      --frames PATTERN  write each frame of --animate (implied) as a plant file: PATTERN\n"
+    "                        holds one %d, %4d or %04d for the frame number (0 = the axiom),\n"
+    "                        its extension picks the format (.json .obj .ply), e.g. f%03d.obj\n"
+    "      --call NAME       .lpy files: after the run, call the file's function NAME() (no\n"
+    "                        arguments; repeatable): a failed assert in it fails the run\n";
 
 static int cmp_u64(const void* a, const void* b) {
   uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
@@ -176,6 +184,27 @@ int cli_grow(int argc, char** argv) {
       traits = argv[++i];
     } else if (!strcmp(a, "--ascii")) {
       ascii = 1;
+    } else if (!strcmp(a, "--animate")) {
+      po.animate = 1;
+    } else if (!strcmp(a, "--frames")) {
+      if (i + 1 >= argc) return cli_usage_error("grow", "%s needs a file name pattern", a);
+      if (po.frames) return cli_usage_error("grow", "--frames given 2 times");
+      po.frames = argv[++i];
+      po.animate = 1;
+      char name[4200];
+      if (!cli_frame_name(po.frames, 0, name, sizeof name))
+        return cli_usage_error("grow", "--frames '%s': give one %%d, %%Nd or %%0Nd (N < 10) for the frame number "
+                               "(%%%% for a %%)", po.frames);
+      if (!cli_has_ext(name, ".json") && !cli_has_ext(name, ".obj") && !cli_has_ext(name, ".ply"))
+        return cli_usage_error("grow", "--frames '%s': unknown format (use .json, .obj or .ply)", po.frames);
+    } else if (!strcmp(a, "--call")) {
+      if (i + 1 >= argc) return cli_usage_error("grow", "%s needs a function name", a);
+      const char* f = argv[++i];
+      int ok = f[0] == '_' || ((f[0] | 32) >= 'a' && (f[0] | 32) <= 'z');
+      for (const char* c = f; ok && *c; c++) ok = *c == '_' || (*c >= '0' && *c <= '9') || ((*c | 32) >= 'a' && (*c | 32) <= 'z');
+      if (!ok) return cli_usage_error("grow", "--call expects a Python function name, got '%s'", f);
+      if (po.ncall == 8) return cli_usage_error("grow", "too many --call options (8 at most)");
+      po.call[po.ncall++] = f;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error("grow", "unknown option '%s'", a);
     } else if (!po.path) {
@@ -185,7 +214,8 @@ int cli_grow(int argc, char** argv) {
     }
   }
   if (!po.path) return cli_usage_error("grow", "missing PLANT (an .lpy or plant .json file)");
-  if (!out && !stats && !traits) return cli_usage_error("grow", "nothing to do: give -o OUT, --traits FILE and/or --stats");
+  if (!out && !stats && !traits && !po.frames && !po.ncall)
+    return cli_usage_error("grow", "nothing to do: give -o OUT, --frames PATTERN, --traits FILE, --call NAME and/or --stats");
   if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
     return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
   if (ascii && !(out && cli_has_ext(out, ".ply")))

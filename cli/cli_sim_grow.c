@@ -326,7 +326,7 @@ static vd_status write_text(const char* path, const char* text, vd_error* err) {
   return st;
 }
 
-static const char* kind_name(int k) { return k == VD_MSS_UPROOT ? "uproot" : "break"; }
+static const char* kind_name(int k) { return k == VD_MSS_UPROOT ? "uproot" : k == VD_MSS_ANCHOR ? "anchorage" : "break"; }
 
 static vd_status write_events(const vd_growth* g, const char* dir, vd_error* err) {
   int n;
@@ -334,7 +334,7 @@ static vd_status write_events(const vd_growth* g, const char* dir, vd_error* err
   size_t cap = 128 + (size_t)n * 160;
   char* text = vd_malloc(cap);
   if (!text) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  size_t len = (size_t)snprintf(text, cap, "kind,age,time_s,node,segment,label,stress_Pa_or_tilt_rad,limit,removed_nodes\n");
+  size_t len = (size_t)snprintf(text, cap, "kind,age,time_s,node,segment,label,stress_Pa_or_tilt_rad_or_share,limit,removed_nodes\n");
   for (int k = 0; k < n && len < cap; k++)
     len += (size_t)snprintf(text + len, cap - len, "%s,%d,%.6f,%d,%d,%s,%.6g,%.6g,%d\n", kind_name(ev[k].kind), ev[k].age,
                             ev[k].time, ev[k].node, ev[k].segment, ev[k].label, ev[k].stress, ev[k].limit, ev[k].removed);
@@ -356,11 +356,14 @@ static cJSON* stats_json(const vd_growth* g, const vd_growth_def* def, double wa
   cJSON_AddNumberToObject(o, "time", s.time);
   cJSON_AddNumberToObject(o, "height", s.height);
   cJSON_AddNumberToObject(o, "rest_height", s.height0);
+  cJSON_AddNumberToObject(o, "drawn_height", s.drawn_height);
   cJSON_AddNumberToObject(o, "max_displacement", s.max_displacement);
   cJSON_AddNumberToObject(o, "tip_displacement", s.tip_displacement);
   cJSON_AddNumberToObject(o, "max_stress", s.max_stress);
   cJSON_AddNumberToObject(o, "broken_branches", s.nbroken);
   cJSON_AddBoolToObject(o, "uprooted", s.uprooted);
+  cJSON_AddBoolToObject(o, "anchorage_failed", s.anchor_failed);
+  cJSON_AddNumberToObject(o, "anchorage_load", s.anchor_load);
   cJSON_AddBoolToObject(o, "collapsed", s.collapsed);
   cJSON_AddBoolToObject(o, "diverged", s.diverged);
   cJSON_AddNumberToObject(o, "momentum_error", s.momentum_error);
@@ -385,7 +388,8 @@ static cJSON* stats_json(const vd_growth* g, const vd_growth_def* def, double wa
     cJSON_AddNumberToObject(e, "time", ev[k].time);
     cJSON_AddNumberToObject(e, "segment", ev[k].segment);
     cJSON_AddStringToObject(e, "label", ev[k].label);
-    cJSON_AddNumberToObject(e, ev[k].kind == VD_MSS_UPROOT ? "tilt" : "stress", ev[k].stress);
+    cJSON_AddNumberToObject(e, ev[k].kind == VD_MSS_UPROOT ? "tilt" : ev[k].kind == VD_MSS_ANCHOR ? "share" : "stress",
+                            ev[k].stress);
     cJSON_AddNumberToObject(e, "limit", ev[k].limit);
     cJSON_AddItemToArray(arr, e);
   }

@@ -77,6 +77,12 @@ expect "grow rods" 0 "$V" sim "$TREE" --grow --model rods --ages 3 --substeps 10
 json_check "rods grown" "d['model'] == 'rods' and d['height'] > 1.5 and not d['collapsed']"
 expect "grow soil loam" 0 "$V" sim "$TREE" --grow --model mrl --soil loam --ages 3 --substeps 10 --stats
 json_check "loam holds" "not d['uprooted'] and d['height'] > 1.5"
+# the soil's anchorage in 15 m/s wind: loam (method 2) stands, loam by eq. 12 gives way and the
+# tree is uprooted (an event), collapsed against its drawn height
+expect "grow wind loam" 0 "$V" sim "$TREE" --grow --model mrl --soil loam --wind 15,0,0 --ages 3 --stats
+json_check "wind loam stands" "not d['uprooted'] and not d['anchorage_failed'] and 0 < d['anchorage_load'] < 0.01 and not d['collapsed'] and d['height'] > 0.8 * d['drawn_height']"
+expect "grow wind pang" 0 "$V" sim "$TREE" --grow --model mrl --soil loam --soil-method pang --wind 15,0,0 --ages 3 --stats
+json_check "wind pang uproots" "d['uprooted'] and d['anchorage_failed'] and d['collapsed'] and [e['kind'] for e in d['events']][:2] == ['anchorage', 'uproot']"
 expect "grow bastien" 0 "$V" sim "$TREE" --grow --model mss --gravitropism bastien --ages 3 --substeps 10 --stats
 expect "grow hopea" 0 "$V" sim "$SRC/data/hopea.lpy" --grow --model mrl --species hopea-odorata --ages 12 --substeps 5 --stats
 json_check "hopea grown" "d['ages'] == 12 and d['height'] > 6 and not d['collapsed'] and not d['uprooted']"

@@ -102,6 +102,40 @@ if /usr/bin/python3 -c 'import json,sys; m = json.load(open(sys.argv[1]))["modul
 else
   bad "lstring json"
 fi
+# --animate / --frames: a frame per step (the axiom first), -o the last; --call runs the file's
+# check() in the same interpreter after the run, a failed assert fails the run and no frame stays
+cat >"$T/anim.lpy" <<'LPY'
+n = 0
+def check():
+    assert n == 3, n
+Axiom: A
+derivation length: 2
+production:
+A --> F(1) A
+interpretation:
+A:
+  global n
+  n += 1
+  produce
+endlsystem
+LPY
+expect "grow --frames --call" 0 "$V" grow "$T/anim.lpy" --frames "$T/f%02d.json" -o "$T/last.json" --call check
+if /usr/bin/python3 -c 'import json,sys; t = sys.argv[1]; n = [len(json.load(open(t + "/f%02d.json" % k))["segments"]["r0"]) for k in range(3)]; assert n == [0, 1, 2], n; assert len(json.load(open(t + "/last.json"))["segments"]["r0"]) == 2' "$T" && [ ! -e "$T/f03.json" ]; then
+  ok "frames per step"
+else
+  bad "frames per step"
+fi
+rm -f "$T"/f0*.json
+expect "--call without --animate sees one interpretation" 2 "$V" grow "$T/anim.lpy" --stats --call check
+expect_err "failed assert names the line" "anim.lpy:3:.*assert"
+expect "failed check leaves no frame" 2 "$V" grow "$T/anim.lpy" --frames "$T/f%02d.obj" --call check -n 1
+if ls "$T"/f0* >/dev/null 2>&1; then bad "no frame left"; else ok "no frame left"; fi
+expect "--call a missing function" 2 "$V" grow "$T/anim.lpy" --animate --call nothere
+expect_err "missing function named" "no function 'nothere'"
+expect "--frames without a number field" 2 "$V" grow "$T/anim.lpy" --frames "$T/f.json"
+expect "--frames with two fields" 2 "$V" grow "$T/anim.lpy" --frames "$T/f%d%d.json"
+expect "--frames of an unknown format" 2 "$V" grow "$T/anim.lpy" --frames "$T/f%d.txt"
+expect "--animate on a plant file" 2 "$V" grow "$T/last.json" --animate --stats
 # a turtle fault names the rule's line (issue 12 item 7)
 printf 'Axiom: A\nproduction:\nA --> F(1e308 * 10)\n' >"$T/bad.lpy"
 if "$V" grow "$T/bad.lpy" -o "$T/bad.json" 2>&1 | grep -q "bad.lpy:3: turtle: module 0 'F'"; then ok "turtle error names the line"; else bad "turtle error names the line"; fi

@@ -161,3 +161,114 @@ TEST(growth, seed_findings_on_hopea) {
     vd_free(r, sizeof *r * (size_t)n);
   }
 }
+
+// the tree in a soil and 15 m/s wind: def's soil and PTF intercept shift (ln of how much weaker
+// than the pedotransfer function the soil is), 3 years of 50 substeps (the seed's; a tree needs
+// about half a second to fall)
+static vd_growth* grow_soil(vd_lsystem* ls, const char* soil, double weaker, vd_soil_method method, vd_error* e) {
+  vd_growth_def def = vd_growth_def_default();
+  def.model = VD_GROWTH_MRL;
+  def.opt.wind = vd_v3(15, 0, 0);
+  if (vd_soil_preset(soil, &def.mss.soil)) return NULL;
+  def.mss.soil.method = method;
+  def.mss.soil.ptf[0] -= log(weaker);
+  vd_growth* g = NULL;
+  if (vd_growth_create(ls, &def, &g, e)) return NULL;
+  for (int k = 0; k < 3; k++)
+    if (vd_growth_step(g, e)) {
+      vd_growth_destroy(g);
+      return NULL;
+    }
+  return g;
+}
+
+static int has_event(const vd_growth* g, int kind) {
+  int n;
+  const vd_growth_event* ev = vd_growth_events(g, &n);
+  for (int k = 0; k < n; k++)
+    if (ev[k].kind == kind) return 1;
+  return 0;
+}
+
+TEST(growth, soil_strong_stands_weak_uproots) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  // loam by the pedotransfer function: the crown's anchorage is far from used, the tree stands
+  // as tall as clamped, and its roots carry no stem moment (the soil takes it)
+  vd_growth* g = grow_soil(ls, "loam", 1, VD_SOIL_IMHOFF2016, &e);
+  REQUIRE(g);
+  vd_growth_stats s;
+  vd_growth_get_stats(g, &s);
+  CHECK(s.anchor_load > 0 && s.anchor_load < 0.01);
+  CHECK(!s.anchor_failed && !s.uprooted && !s.collapsed);
+  CHECK(s.drawn_height > 1.5 && s.height > 0.8 * s.drawn_height);
+  const vd_mss_data* d = NULL;
+  const vd_mss_model* m = vd_growth_mss(g, &d);
+  REQUIRE(m && d);
+  CHECK(m->crown >= 0 && m->anchor_moment > 0 && m->anchor_force > 0);
+  double root_stress = 0;
+  for (int q = 0; q < m->ninter; q++)
+    if (m->node_flags[m->spring_node[2 * q + 1]] & VD_MSS_ROOT) root_stress = fmax(root_stress, d->spring_stress[q]);
+  CHECK(root_stress < 1e6);  // Pa: the wind on the stem does not bend the roots
+  vd_growth_destroy(g);
+  // the same loam by eq. 12 (millinewtons per node): the root plate gives way, the tree tips
+  // over onto the ground and is uprooted; it has collapsed against its drawn height
+  g = grow_soil(ls, "loam", 1, VD_SOIL_PANG2023, &e);
+  REQUIRE(g);
+  vd_growth_get_stats(g, &s);
+  CHECK(s.anchor_failed && s.anchor_load > 1 && s.uprooted);
+  CHECK(has_event(g, VD_MSS_ANCHOR) && has_event(g, VD_MSS_UPROOT));
+  CHECK(s.collapsed && s.height < VD_GROWTH_COLLAPSE * s.drawn_height);
+  CHECK(!s.diverged && s.height >= 0);
+  vd_growth_destroy(g);
+  vd_lsys_destroy(ls);
+}
+
+TEST(growth, loam_and_clay_differ_at_capacity) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  // both soils 1000 times weaker than their pedotransfer function (a loosened, soaked soil):
+  // the sapling's wind moment uses about half of loam's anchorage and more than clay's
+  // (SR 0.96 vs 0.25 MPa by da Silva & Kay 1997): loam stands, clay gives way
+  vd_growth_stats s[2];
+  const char* soil[2] = {"loam", "clay"};
+  for (int k = 0; k < 2; k++) {
+    vd_growth* g = grow_soil(ls, soil[k], 1000, VD_SOIL_IMHOFF2016, &e);
+    REQUIRE(g);
+    vd_growth_get_stats(g, &s[k]);
+    vd_growth_destroy(g);
+  }
+  CHECK(s[0].anchor_load > 0.1 && s[0].anchor_load < 1 && !s[0].anchor_failed && !s[0].collapsed);
+  CHECK(s[1].anchor_load > 1 && s[1].anchor_failed && s[1].uprooted && s[1].collapsed);
+  // the share used scales with 1 / SR: clay's is loam's times SR_loam / SR_clay
+  vd_soil a, b;
+  REQUIRE(vd_soil_preset("loam", &a) == VD_OK && vd_soil_preset("clay", &b) == VD_OK);
+  double ratio = vd_soil_max_force(&a, 0.1, 0.01, 1) / vd_soil_max_force(&b, 0.1, 0.01, 1);
+  CHECK_NEAR(s[1].anchor_load / s[0].anchor_load, ratio, 0.05 * ratio);
+  vd_lsys_destroy(ls);
+}
+
+TEST(growth, collapse_against_drawn_height) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  // a clamped tree: the drawn height is the turtle's, above the rest height the physics keeps
+  vd_growth* g = grow_tree(ls, VD_GROWTH_MRL, 3, 15, &e);
+  REQUIRE(g);
+  vd_growth_stats s;
+  vd_growth_get_stats(g, &s);
+  CHECK(s.drawn_height > 1.5);
+  CHECK(s.height <= s.drawn_height * 1.01 && s.height > VD_GROWTH_COLLAPSE * s.drawn_height && !s.collapsed);
+  vd_growth_destroy(g);
+  // tipped over by a failed anchorage the rest shape leans with the tree (stress-free growth),
+  // so height / rest height stays near 1; against the drawn height it has collapsed
+  g = grow_soil(ls, "loam", 1, VD_SOIL_PANG2023, &e);
+  REQUIRE(g);
+  vd_growth_get_stats(g, &s);
+  CHECK(s.height0 < 0.6 * s.drawn_height);
+  CHECK(s.collapsed);
+  vd_growth_destroy(g);
+  vd_lsys_destroy(ls);
+}

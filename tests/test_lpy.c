@@ -469,3 +469,144 @@ TEST(lpy, turtle_takes_vectors_python_engine) {
   // an object that is no vector is an error naming it
   CHECK_STATUS(grow_end("Axiom: @M([1]) F(1)\n", VD_LSYS_PYTHON, &b, &e), VD_ERR_TYPE, e);
 }
+
+// ---------------------------------------------------------------------------------------------
+// animation (vd_lsys_animate, L-Py's Lsystem.animate) and calling the file's functions
+
+typedef struct frames_seen {
+  int n, frame[16], nseg[16];
+} frames_seen;
+
+static int see_frame(void* user, int frame, const vd_lstring* s, const vd_plant_spec* plant) {
+  (void)s;
+  frames_seen* f = user;
+  if (f->n < 16) f->frame[f->n] = frame, f->nseg[f->n] = plant->nseg, f->n++;
+  return 0;
+}
+
+// animate src with an engine: the frames seen, the final plant's segments and global `n`
+static vd_status animate_text(const char* src, vd_lsys_engine engine, frames_seen* f, int* nseg, double* n,
+                              vd_error* e) {
+  vd_lsystem* ls;
+  memset(f, 0, sizeof *f);
+  vd_status st = vd_lsys_parse_engine(src, strlen(src), "anim.lpy", engine, &ls, e);
+  if (st) return st;
+  vd_lsys_def d = vd_lsys_def_default();
+  d.max_ops = 10000000;
+  d.frame = see_frame;
+  d.frame_user = f;
+  vd_lstring s = vd_lstring_empty();
+  vd_plant_spec* p = vd_plant_spec_create();
+  st = vd_lsys_animate(ls, &d, &s, p, e);
+  *nseg = p->nseg;
+  if (!st && vd_lsys_get_global(ls, "n", n)) *n = -1;
+  if (!st) st = vd_lsys_call(ls, "check", e);
+  vd_plant_spec_destroy(p);
+  vd_lstring_free(&s);
+  vd_lsys_destroy(ls);
+  return st;
+}
+
+TEST(lpy, animate_draws_every_step) {
+  // the interpretation rule counts its calls: the axiom's frame, then one per step; check()
+  // reads the count as the run left it
+  const char* src =
+      "n = 0\n"
+      "def check():\n  assert n == 4 and not isAnimationEnabled()\n"
+      "def StartEach():\n  assert isAnimationEnabled() and isFrameDisplayed()\n"
+      "Axiom: A\nderivation length: 3\nproduction:\nA --> F(1) A\n"
+      "interpretation:\nA:\n  global n\n  n += 1\n  produce\nendlsystem\n";
+  for (int engine = VD_LSYS_NATIVE; engine <= VD_LSYS_PYTHON; engine++) {
+    if (engine == VD_LSYS_PYTHON && !vd_lsys_python_available(NULL, 0)) break;
+    frames_seen f;
+    int nseg;
+    double n;
+    vd_error e = {0};
+    CHECK_STATUS(animate_text(src, (vd_lsys_engine)engine, &f, &nseg, &n, &e), VD_OK, e);
+    CHECK_INT(f.n, 4);
+    for (int k = 0; k < f.n; k++) {
+      CHECK_INT(f.frame[k], k);
+      CHECK_INT(f.nseg[k], k);  // frame k: the string after k steps
+    }
+    CHECK_INT(nseg, 3);
+    CHECK_NEAR(n, 4, 0);
+  }
+  // frameDisplay(False) during a step skips its frame; the final plant is drawn all the same;
+  // a step where no rule matches still runs (and has its frame)
+  const char* skip =
+      "n = 0\ndef check():\n  assert n == 4, n\n"
+      "def StartEach():\n  frameDisplay(getIterationNb() != 2)\n"
+      "Axiom: A(0)\nderivation length: 3\nproduction:\nA(x) :\n  if x < 1:\n    produce F(1) A(x + 1)\n"
+      "interpretation:\nA(x):\n  global n\n  n += 1\n  produce\nendlsystem\n";
+  frames_seen f;
+  int nseg;
+  double n;
+  vd_error e = {0};
+  CHECK_STATUS(animate_text(skip, VD_LSYS_NATIVE, &f, &nseg, &n, &e), VD_OK, e);
+  CHECK_INT(f.n, 3);
+  CHECK_INT(f.frame[2], 2);  // frames 0, 1, 2; 3 skipped
+  CHECK_INT(nseg, 1);
+  CHECK_NEAR(n, 4, 0);  // frames 0, 1, 2 and the final string, drawn for *plant
+}
+
+TEST(lpy, animate_reuses_the_scene_a_hook_returns) {
+  if (!vd_lsys_python_available(NULL, 0)) return;
+  // EndEach(lstring, lscene) in an animation: the scene is drawn before the call; the frame
+  // keeps it when the hook returns it (alone or with the string) or nothing, else draws again
+  static const struct {
+    const char* ret;
+    int draws;
+  } cases[] = {
+      {"return lstring, lscene", 2}, {"return lscene", 2},          {"pass", 2},
+      {"return lstring", 3},         {"return lstring, None", 3},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char src[1024];
+    snprintf(src, sizeof src,
+             "n = 0\ndef check():\n  pass\n"
+             "def EndEach(lstring, lscene):\n  %s\n"
+             "Axiom: B C\nderivation length: 1\nproduction:\nC --> C\n"
+             "interpretation:\nB:\n  global n\n  n += 1\n  produce F(1)\nendlsystem\n",
+             cases[k].ret);
+    frames_seen f;
+    int nseg;
+    double n;
+    vd_error e = {0};
+    CHECK_STATUS(animate_text(src, VD_LSYS_PYTHON, &f, &nseg, &n, &e), VD_OK, e);
+    CHECK_INT(f.n, 2);
+    CHECK_INT(nseg, 1);
+    if (n != cases[k].draws) vdt_fail(__FILE__, __LINE__, "'%s': %g draws, expected %d", cases[k].ret, n, cases[k].draws);
+  }
+  // a scene the hook made itself cannot be a frame: refused, not ignored
+  frames_seen f;
+  int nseg;
+  double n;
+  vd_error e = {0};
+  CHECK_STATUS(animate_text("def EndEach(lstring, lscene):\n  return Scene()\nAxiom: A\nproduction:\nA --> A\n",
+                            VD_LSYS_PYTHON, &f, &nseg, &n, &e),
+               VD_ERR_UNSUPPORTED, e);
+  if (!strstr(e.msg, "scene of its own")) vdt_fail(__FILE__, __LINE__, "message '%s'", e.msg);
+}
+
+TEST(lpy, call_a_function_of_the_file) {
+  for (int engine = VD_LSYS_NATIVE; engine <= VD_LSYS_PYTHON; engine++) {
+    if (engine == VD_LSYS_PYTHON && !vd_lsys_python_available(NULL, 0)) break;
+    vd_lsystem* ls;
+    vd_error e = {0};
+    const char* src = "k = 0\ndef ok():\n  assert k == 2\ndef bad():\n  assert k == 3\n"
+                      "def EndEach():\n  global k\n  k += 1\nAxiom: A\nderivation length: 2\nproduction:\nA --> A\n";
+    CHECK_STATUS(vd_lsys_parse_engine(src, strlen(src), "call.lpy", (vd_lsys_engine)engine, &ls, &e), VD_OK, e);
+    CHECK_INT(vd_lsys_call(ls, "ok", &e), VD_ERR_ARG);  // before any run
+    vd_lsys_def d = vd_lsys_def_default();
+    vd_lstring s = vd_lstring_empty();
+    CHECK_STATUS(vd_lsys_derive(ls, &d, &s, &e), VD_OK, e);
+    CHECK_STATUS(vd_lsys_call(ls, "ok", &e), VD_OK, e);
+    memset(&e, 0, sizeof e);
+    CHECK(vd_lsys_call(ls, "bad", &e) != VD_OK && e.line == 5);  // the failed assert's line
+    memset(&e, 0, sizeof e);
+    CHECK_INT(vd_lsys_call(ls, "missing", &e), VD_ERR_NAME);
+    if (!strstr(e.msg, "no function 'missing'")) vdt_fail(__FILE__, __LINE__, "message '%s'", e.msg);
+    vd_lstring_free(&s);
+    vd_lsys_destroy(ls);
+  }
+}

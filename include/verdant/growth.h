@@ -77,15 +77,22 @@ vd_growth_def vd_growth_def_default(void);
 // stress-free growth (the rest of def is left as it is).
 void vd_growth_def_paper(vd_growth_def* def);
 
+// A tree whose height falls below this share of its drawn height has collapsed (fallen over or
+// bent down): a standing tree under gravity and a storm keeps most of its height.
+#define VD_GROWTH_COLLAPSE 0.5
+
 // One event of a growth run.
 typedef struct vd_growth_event {
-  int kind;            // VD_MSS_BREAK or VD_MSS_UPROOT (rods: fractures are VD_MSS_BREAK)
+  int kind;            // VD_MSS_BREAK, VD_MSS_UPROOT or VD_MSS_ANCHOR (rods: fractures are
+                       // VD_MSS_BREAK)
   int age;             // age step in which it happened
   double time;         // simulation time (s)
   int node;            // plant node at the base of the broken internode (uproot: the base)
   int segment;         // plant segment that broke, -1 for uprooting
-  double stress;       // stress at breaking (Pa); uproot: the tilt (rad)
-  double limit;        // modulus of rupture (Pa); uproot: the tilt limit (rad)
+  double stress;       // stress at breaking (Pa); uproot: the tilt (rad); anchor: share of the
+                       // anchorage (-)
+  double limit;        // modulus of rupture (Pa); uproot: the tilt limit (rad); anchor: the
+                       // crown's moment (N m)
   int removed;         // plant nodes removed with the broken branch
   char label[VD_LABEL_NAME_MAX];  // label name of the broken segment
 } vd_growth_event;
@@ -98,7 +105,10 @@ typedef struct vd_growth_stats {
   int nphys;                // physics nodes now (mass-spring nodes or rod nodes)
   int nrigid;               // nodes in the rigid body (mrl)
   double height;            // height of the highest stem node above the base (m)
-  double height0;           // the same in the rest shape (m)
+  double height0;           // the same in the rest shape (m): the shape the physics returns to,
+                            // which follows a lasting lean (stress-free growth)
+  double drawn_height;      // the same as the turtle draws the L-string now: unloaded, as grown,
+                            // without physics (m)
   double max_displacement;  // largest distance of a node from its rest position (m)
   double tip_displacement;  // ... of the end of the main stem (m)
   double max_stress;        // largest internode stress (Pa)
@@ -106,9 +116,13 @@ typedef struct vd_growth_stats {
   double kinetic_energy;    // (J)
   int nbroken;              // branches broken so far
   int uprooted;             // 1 after uprooting
-  int collapsed;            // 1 when the height fell below half its rest height, or diverged
+  int anchor_failed;        // 1 once the root crown's anchorage gave way (soil, mss/mrl)
+  double anchor_load;       // largest share of the crown's anchorage used, |M| / M_a or |F| / F_a
+                            // (-; 0 without a soil)
+  int collapsed;            // 1 when the height fell below VD_GROWTH_COLLAPSE x the drawn height,
+                            // or diverged
   int diverged;             // 1 when the state is not finite or the tree left its size (higher
-                            // than 1.5 x its rest height, or a node moved more than twice it)
+                            // than 1.5 x its drawn height, or a node moved more than twice it)
   double momentum_error;    // largest |change of total momentum| at a growth event (eq. 1, the
                             // mass update, eqs. 6-7), relative to sum m |v| (-)
   double angular_error;     // mrl: largest |L eq. 8 - L true| at a join, relative (-)

@@ -158,6 +158,11 @@ typedef struct vd_lsys_def {
   // Nullable: called after each step with (step, steps, modules); return non-zero to stop.
   int (*progress)(void* user, int step, int steps, int64_t modules);
   void* progress_user;  // passed to progress
+  // Nullable: vd_lsys_animate calls it with every frame it shows: the frame number (0: the
+  // axiom, k: the string after step k), the derived string and the plant it draws; return
+  // non-zero to stop the animation there.
+  int (*frame)(void* user, int frame, const vd_lstring* s, const vd_plant_spec* plant);
+  void* frame_user;     // passed to frame
 } vd_lsys_def;
 
 // Default derivation settings (see vd_lsys_def).
@@ -206,6 +211,23 @@ int vd_lsys_derivation_length(const vd_lsystem* ls);
 // `derivation length` (or def->steps) production steps with decomposition; the result is the
 // derived string (before interpretation) in *out, which is overwritten.
 vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err);
+// Animate, as L-Py's Lsystem.animate(): derive as vd_lsys_derive does and interpret after
+// every step. A frame is drawn (interpretation rules, StartInterpretation/EndInterpretation,
+// then the turtle with default settings, the file's labels named) from the axiom before the
+// Start hook, then from the string after each step whose frame is displayed (frameDisplay(False)
+// during a step skips its frame); def->frame sees each. A Python EndEach(lstring, lscene) or
+// End(lstring, lscene) gets the frame's scene, drawn before the call, and the frame reuses it
+// when the hook returns it (alone or as (lstring, lscene)) or returns nothing; any other
+// result draws the string again. Every step runs, a step where no rule matches included
+// (L-Py's animate derives one step at a time). *out is the final string and *plant (cleared
+// first) its plant, as the last frame showed it (drawn once more when the last step's frame
+// was skipped). isAnimationEnabled() is true meanwhile.
+vd_status vd_lsys_animate(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_plant_spec* plant,
+                          vd_error* err);
+// Call the function `name` of the file's global namespace without arguments, after a run (it
+// sees the globals as the run left them): a check() of the file's own asserts. VD_ERR_NAME when
+// the file has no such function; a failed assert or any exception is an error with its line.
+vd_status vd_lsys_call(vd_lsystem* ls, const char* name, vd_error* err);
 // Derive step by step (growth loops): begin resets the globals (with --set overrides), runs the
 // Start hook and puts the axiom into *out; each vd_lsys_derive_step then applies one production
 // step with decomposition (StartEach/EndEach hooks) to s in place and sets s->src[j] to the

@@ -765,6 +765,8 @@ vd_mss_opt vd_mss_opt_default(void);
 #define VD_MSS_SOIL 2u    // in the soil: held up to node_soil (N)
 #define VD_MSS_TIP 4u     // a bud: nothing grows from it (phototropism acts here)
 #define VD_MSS_ROOT 8u    // on a root
+#define VD_MSS_CROWN 16u  // the root crown of a plant rooted in a soil: held, with its rotation
+                          // resisted, while the stem's wrench is within the anchorage
 
 // The mass-spring model of one plant: read-only between age steps. Arrays live in one block.
 typedef struct vd_mss_model {
@@ -811,13 +813,19 @@ typedef struct vd_mss_model {
   int base;               // the base node of the stem (where the roots meet it), -1 if none
   double height0;         // rest height of the highest node above the base (m)
   double total_mass;      // sum of node masses (kg)
+  int crown;              // the root crown node (VD_MSS_CROWN), -1 if none
+  double anchor_force;    // anchorage of the crown: sum of its root nodes' resistances (N)
+  double anchor_moment;   // ... and the moment they can give about it, sum F_max,i |x_i - x_c| (N m)
+  double ground;          // with a crown: the ground (z, m) that stem nodes rest on, not pass
   size_t nbytes;          // size of the single allocation
 } vd_mss_model;
 
 // One event of a mass-spring run.
 typedef enum vd_mss_event_kind {
   VD_MSS_BREAK = 0,   // an internode broke: the subtree beyond it is removed
-  VD_MSS_UPROOT       // the base tilted beyond the uprooting angle after its roots gave way
+  VD_MSS_UPROOT,      // the base tilted beyond the uprooting angle after its roots gave way
+  VD_MSS_ANCHOR       // the stem's wrench on the root crown exceeded the soil's anchorage: the
+                      // root plate gave way (the crown turns freely from then on)
 } vd_mss_event_kind;
 
 typedef struct vd_mss_event {
@@ -825,8 +833,10 @@ typedef struct vd_mss_event {
   double time;            // simulation time (s)
   int node;               // break: the node at the base of the broken internode; uproot: base
   int spring;             // break: the internode; uproot: -1
-  double stress;          // break: its stress (Pa); uproot: tilt (rad)
-  double limit;           // break: its modulus of rupture (Pa); uproot: the tilt limit (rad)
+  double stress;          // break: its stress (Pa); uproot: tilt (rad); anchor: the larger of
+                          // moment / anchor_moment and force / anchor_force (-)
+  double limit;           // break: its modulus of rupture (Pa); uproot: the tilt limit (rad);
+                          // anchor: the crown's moment (N m)
   int removed;            // break: nodes removed with the subtree
 } vd_mss_event;
 
@@ -854,6 +864,9 @@ typedef struct vd_mss_data {
   vd_rigid rb;            // the rigid part (rb.n = 0: none)
   double uproot_tilt;     // tilt of the base that counts as uprooting (rad)
   int uprooted;           // 1 after the uprooting event
+  int anchor_failed;      // 1 once the root crown's anchorage gave way (VD_MSS_ANCHOR)
+  double anchor_load;     // largest share of the anchorage the stem has used: max over substeps
+                          // of |M| / anchor_moment and |F| / anchor_force (-)
   vd_mss_event* event;    // events (nevent, capacity cap_event)
   int nevent, cap_event;
   int64_t cg_iterations;  // conjugate-gradient iterations over all substeps

@@ -162,6 +162,8 @@ struct vd_growth {
   carry c;
   vd_rigid rb;
   int uprooted;
+  int anchor_failed;
+  double anchor_load;
   // events and summaries
   vd_growth_event* ev;
   int nev, cap_ev;
@@ -416,6 +418,7 @@ static vd_status build_physics(vd_growth* g, vd_error* err) {
   g->md->time = g->time;
   g->md->uproot_tilt = def->uproot_tilt;
   g->md->uprooted = g->uprooted;
+  g->md->anchor_failed = g->anchor_failed;
   return VD_OK;
 }
 
@@ -814,6 +817,8 @@ static vd_status carry_out(vd_growth* g, vd_error* err) {
   if (g->md) {
     g->rb = g->md->rb;
     g->uprooted = g->md->uprooted;
+    g->anchor_failed = g->md->anchor_failed;
+    g->anchor_load = fmax(g->anchor_load, g->md->anchor_load);
   }
   return VD_OK;
 }
@@ -937,6 +942,7 @@ static void collect_events(vd_growth* g) {
       g->nbroken++;
     }
     if (e->kind == VD_MSS_UPROOT) snprintf(ge.label, sizeof ge.label, "%s", "uproot");
+    if (e->kind == VD_MSS_ANCHOR) snprintf(ge.label, sizeof ge.label, "%s", "anchorage");
     add_event(g, &ge);
   }
   g->mss_events_seen = g->md->nevent;
@@ -1079,6 +1085,22 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
 // ---------------------------------------------------------------------------------------------
 // results
 
+// the highest stem node above the stem's base as the turtle draws the string now (m)
+static double drawn_height(const vd_growth* g) {
+  const vd_plant_spec* s = g->spec;
+  double z0 = HUGE_VAL, z1 = -HUGE_VAL;
+  for (int j = 0; j < s->nseg; j++) {
+    const vd_label* l = vd_plant_find_label(s, s->seg[j].label);
+    vd_organ o = l ? l->organ : VD_ORGAN_OTHER;
+    if (o != VD_ORGAN_STEM && o != VD_ORGAN_OTHER) continue;
+    for (int e = 0; e < 2; e++) {
+      double z = s->node[e ? s->seg[j].node1 : s->seg[j].node0].z;
+      z0 = fmin(z0, z), z1 = fmax(z1, z);
+    }
+  }
+  return z0 < HUGE_VAL ? z1 - z0 : 0;
+}
+
 void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
   memset(out, 0, sizeof *out);
   out->age = g->age;
@@ -1090,6 +1112,9 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
   out->substeps = g->substeps;
   out->nbroken = g->nbroken;
   out->uprooted = g->uprooted;
+  out->anchor_failed = g->anchor_failed;
+  out->anchor_load = g->anchor_load;
+  out->drawn_height = drawn_height(g);
   if (g->mm) {
     const vd_mss_model* m = g->mm;
     const vd_mss_data* d = g->md;
@@ -1105,6 +1130,8 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
     out->cg_iterations = d->cg_iterations;
     out->unstable = d->nonfinite + g->unstable;
     out->uprooted = d->uprooted;
+    out->anchor_failed = d->anchor_failed;
+    out->anchor_load = fmax(g->anchor_load, d->anchor_load);
   } else if (g->rm) {
     const vd_sim_model* m = g->rm;
     const vd_sim_data* d = g->rd;
@@ -1135,9 +1162,11 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
       vd_free(st, sizeof(double) * (size_t)(g->plant->nseg ? g->plant->nseg : 1));
     }
   }
+  // judged against the drawn height, which no lean of the rest shape moves
+  double h0 = out->drawn_height > 0 ? out->drawn_height : out->height0;
   out->diverged = !isfinite(out->height) || !isfinite(out->max_displacement) ||
-                  (out->height0 > 0 && (out->height > 1.5 * out->height0 || out->max_displacement > 2 * out->height0));
-  out->collapsed = out->diverged || (out->height0 > 0 && out->height < 0.5 * out->height0);
+                  (h0 > 0 && (out->height > 1.5 * h0 || out->max_displacement > 2 * h0));
+  out->collapsed = out->diverged || (h0 > 0 && out->height < VD_GROWTH_COLLAPSE * h0);
 }
 
 vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err) {

@@ -486,6 +486,17 @@ vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant) 
   return st;
 }
 
+// an animation frame: plant (cleared) drawn from s, the file's labels named
+vd_status lsys_draw(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant) {
+  vd_plant_spec_clear(plant);
+  if (!ls->max_depth[SEC_INTERPRETATION]) ls->max_depth[SEC_INTERPRETATION] = 1;
+  vd_status st = lsys_scene(ls, s, plant);
+  for (int i = 0; !st && i < ls->nlabel; i++) st = vd_plant_set_label(plant, ls->label_id[i], ls->label_name[i]);
+  if (!st) st = vd_plant_complete_labels(plant);
+  if (st && ls->err->status == VD_OK) vm_error(ls, st, 0, 0, "out of memory");
+  return st;
+}
+
 // L-Py's environmental programs: before a step whose rules read query modules, the turtle
 // interprets the string and fills ?P ?H ?U ?L ?R with its position and frame (in the modules
 // the interpretation rules leave as they are)
@@ -526,7 +537,7 @@ static vd_lsys_def run_def(vd_lsystem* ls, const vd_lsys_def* def, lsys_pass* P)
 // index, hooks, axiom, Start hook and the axiom's decomposition; *early is set when L-Py returns
 // at once (no rule or no axiom)
 static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out, vd_lstring* tmp, lsys_pass* P,
-                           int* steps, int* early) {
+                           int* steps, int* early, vd_plant_spec* anim, int* stop) {
   vd_status st = VD_OK;
   *early = 0;
   if (ls->py) {
@@ -580,6 +591,12 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
     vd_free(frame, sizeof(value) * (size_t)nl);
   }
   if (st) return st;
+  // an animation shows the axiom first, before the Start hook (L-Py's animate)
+  if (anim) {
+    if ((st = lsys_draw(ls, out, anim))) return st;
+    if (d->frame && d->frame(d->frame_user, 0, out, anim)) *stop = 1;
+    if ((st = lsys_build_index(ls, 0, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
+  }
   // L-Py returns at once, without calling any hook, when there is no rule or no axiom (and
   // "Early return when no matching" is on, its default)
   if ((!has_rules(ls) || out->n == 0) && ls->opt_early_return) {
@@ -587,8 +604,9 @@ static vd_status run_setup(vd_lsystem* ls, const vd_lsys_def* d, vd_lstring* out
     return VD_OK;
   }
   ls->iteration = 0;
+  if (*stop) return VD_OK;
   if ((st = call_hook(ls, ls->hook_start))) return st;
-  if (ls->py && (st = lsys_py_hook(ls, "Start", out, tmp, d->max_modules))) return st;
+  if (ls->py && (st = lsys_py_hook(ls, "Start", out, tmp, d->max_modules, NULL, NULL))) return st;
   if (ls->opt_axiom_decomposition && !lsys_section_empty(ls, SEC_DECOMPOSITION)) {
     int dm = 0;
     if ((st = rewrite_section(ls, SEC_DECOMPOSITION, out, tmp, P, &dm))) return st;
@@ -605,7 +623,7 @@ static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, v
   ls->frame_displayed = last;
   vd_status st = call_hook(ls, ls->hook_starteach);
   if (st) return st;
-  if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, tmp, P->max_modules))) return st;
+  if (ls->py && (st = lsys_py_hook(ls, "StartEach", out, tmp, P->max_modules, NULL, NULL))) return st;
   // useGroup() and backward() take effect at the next step
   if ((st = lsys_build_index(ls, ls->current_group, ls->backward))) return vm_error(ls, st, 0, 0, "out of memory");
   if (!lsys_section_empty(ls, SEC_PRODUCTION)) {
@@ -625,30 +643,50 @@ static vd_status run_step(vd_lsystem* ls, int step, int last, vd_lstring* out, v
   return VD_OK;
 }
 
-vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+// the End hooks of an animation: *have tells whether anim holds the string's scene
+static vd_status end_hooks(vd_lsystem* ls, vd_lstring* out, vd_lstring* tmp, int64_t max_modules, vd_plant_spec* anim,
+                           int* have) {
+  if (ls->hook_end >= 0) *have = 0;  // a native End returns nothing: the frame draws the string
+  vd_status st = call_hook(ls, ls->hook_end);
+  if (!st && ls->py) st = lsys_py_hook(ls, "End", out, tmp, max_modules, anim, have);
+  return st;
+}
+
+// vd_lsys_derive, and vd_lsys_animate when anim (its plant) is given
+static vd_status derive_run(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_plant_spec* anim,
+                            vd_error* err) {
   vd_error local = {0};
   ls->err = err ? err : &local;
   lsys_pass P;
   vd_lsys_def d = run_def(ls, def, &P);
   ls->last_def = d;
   ls->has_last_def = 1;
+  ls->animating = anim != NULL;
   vd_lstring tmp = vd_lstring_empty();
-  int steps = 0, early = 0;
-  vd_status st = run_setup(ls, &d, out, &tmp, &P, &steps, &early);
-  if (st || early) goto done;
-  int matching = 1, step = 0;
+  int steps = 0, early = 0, stop = 0;
+  // anim holds the plant of the current string (frames: the string after a step is drawn, or
+  // the scene an EndEach or End returned is kept)
+  int have = 0;
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, &steps, &early, anim, &stop);
+  if (st) goto done;
+  have = early || stop;
+  if (early || stop) goto done;
+  int matching = 1, step = 0, ended = 0;
   // DiscardNewString() (L-Py's __lpyfuture__) drops a step's result for the string at the end
   // of the step before; it works through the EndEach that module provides (or decorates)
   int discard = global_slot(ls, "DiscardNewString", 16, 0) >= 0 &&
                 (ls->hook_endeach < 0 || ls->funcs[ls->hook_endeach]->discard_wrapped);
   int has_saved = 0;
-  for (; (matching || !ls->opt_early_return) && step < steps; step++) {
-    if ((st = run_step(ls, step, step == steps - 1, out, &tmp, &P, &matching))) goto done;
+  // an animation derives one step at a time, as L-Py's: no early return when nothing matched
+  for (; (matching || !ls->opt_early_return || anim) && step < steps; step++) {
+    have = 0;
+    if ((st = run_step(ls, step, anim || step == steps - 1, out, &tmp, &P, &matching))) goto done;
     if (!(discard && ls->discard_requested) && (st = call_hook(ls, ls->hook_endeach))) goto done;
-    if (ls->py && (st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules))) goto done;
+    if (ls->py && (st = lsys_py_hook(ls, "EndEach", out, &tmp, d.max_modules, anim, &have))) goto done;
     if (discard) {
       if (ls->discard_requested) {
         ls->discard_requested = 0;
+        have = 0;
         if (has_saved) lstr_swap(out, &P.saved);
       } else {
         if (!lsys_lstring_copy(&P.saved, out)) {
@@ -660,12 +698,70 @@ vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out
     }
     // the Python engine's objects no module refers to any more (a saved string keeps its own)
     if (ls->py && !has_saved) lsys_py_gc(ls, out);
-    if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) break;
-    if (ls->stop_requested) break;  // Stop(): L-Py ends here, without End()
+    if (d.progress && d.progress(d.progress_user, step + 1, steps, out->n)) stop = 1;
+    if (anim) {
+      // L-Py's animate: End runs inside the last step, before its frame
+      if (step + 1 == steps && !ls->stop_requested) {
+        ended = 1;
+        if ((st = end_hooks(ls, out, &tmp, d.max_modules, anim, &have))) goto done;
+      }
+      if (ls->frame_displayed) {
+        if (!have && (st = lsys_draw(ls, out, anim))) goto done;
+        have = 1;
+        if (d.frame && d.frame(d.frame_user, step + 1, out, anim)) stop = 1;
+      }
+    }
+    if (stop || ls->stop_requested) break;  // Stop(): L-Py ends here, without End()
   }
-  if (step == steps && (st = call_hook(ls, ls->hook_end))) goto done;
-  if (ls->py && step == steps && (st = lsys_py_hook(ls, "End", out, &tmp, d.max_modules))) goto done;
+  if (step == steps && !ended) {
+    if (anim) {
+      st = end_hooks(ls, out, &tmp, d.max_modules, anim, &have);
+    } else {
+      st = call_hook(ls, ls->hook_end);
+      if (!st && ls->py) st = lsys_py_hook(ls, "End", out, &tmp, d.max_modules, NULL, NULL);
+    }
+  }
 done:
+  // the plant of the final string, when the last frame did not show it
+  if (!st && anim && !have) st = lsys_draw(ls, out, anim);
+  ls->animating = 0;
+  return end_run(ls, st, &tmp, &P);
+}
+
+vd_status vd_lsys_derive(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_error* err) {
+  return derive_run(ls, def, out, NULL, err);
+}
+
+vd_status vd_lsys_animate(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring* out, vd_plant_spec* plant,
+                          vd_error* err) {
+  vd_plant_spec_clear(plant);
+  return derive_run(ls, def, out, plant, err);
+}
+
+vd_status vd_lsys_call(vd_lsystem* ls, const char* name, vd_error* err) {
+  vd_error local = {0};
+  ls->err = err ? err : &local;
+  lsys_pass P;
+  run_def(ls, ls->has_last_def ? &ls->last_def : NULL, &P);  // the run's interpreter budget
+  vd_lstring tmp = vd_lstring_empty();
+  vd_status st = VD_OK;
+  if (ls->py) lsys_py_enter(ls);  // end_run leaves
+  if (!ls->has_last_def) {
+    st = vm_error(ls, VD_ERR_ARG, 0, 0, "%s(): call it after a derivation", name);
+  } else if (ls->py) {
+    st = lsys_py_call(ls, name);
+  } else {
+    int fi = find_hook(ls, name);
+    if (fi < 0) {
+      st = vm_error(ls, VD_ERR_NAME, 0, 0, "the file defines no function '%s'", name);
+    } else if (ls->funcs[fi]->nparam != 0) {
+      st = vm_error(ls, VD_ERR_ARG, ls->funcs[fi]->line, 1, "%s() takes parameters: only a function without any can be called",
+                    name);
+    } else {
+      value r;
+      st = vm_call_func(ls, fi, 0, NULL, &r, ls->funcs[fi]->line, 1);
+    }
+  }
   return end_run(ls, st, &tmp, &P);
 }
 
@@ -678,7 +774,8 @@ vd_status vd_lsys_derive_begin(vd_lsystem* ls, const vd_lsys_def* def, vd_lstrin
   ls->has_last_def = 1;
   vd_lstring tmp = vd_lstring_empty();
   int early = 0;
-  vd_status st = run_setup(ls, &d, out, &tmp, &P, NULL, &early);
+  int stop = 0;
+  vd_status st = run_setup(ls, &d, out, &tmp, &P, NULL, &early, NULL, &stop);
   return end_run(ls, st, &tmp, &P);
 }
 
@@ -700,7 +797,7 @@ vd_status vd_lsys_derive_step(vd_lsystem* ls, const vd_lsys_def* def, vd_lstring
   for (int64_t i = 0; !st && s->src && i < s->n; i++) s->src[i] = i;
   if (!st) st = run_step(ls, ls->steps_done, 0, s, &tmp, &P, &matching);
   if (!st) st = call_hook(ls, ls->hook_endeach);
-  if (!st && ls->py) st = lsys_py_hook(ls, "EndEach", s, &tmp, d.max_modules);
+  if (!st && ls->py) st = lsys_py_hook(ls, "EndEach", s, &tmp, d.max_modules, NULL, NULL);
   if (!st && d.progress) d.progress(d.progress_user, ls->steps_done, ls->steps_done, s->n);
   return end_run(ls, st, &tmp, &P);
 }

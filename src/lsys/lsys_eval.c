@@ -411,10 +411,13 @@ static vd_status call_builtin(vd_lsystem* ls, int b, int n, const value* a, valu
       *out = (value){V_NONE, 0};
       break;
     case B_ISFORWARD: *out = (value){V_BOOL, !ls->backward}; break;
-    // the scene is made once, after the last step: frameDisplay() has nothing to change
-    case B_FRAMEDISPLAY: *out = (value){V_NONE, 0}; break;
+    // frameDisplay(False): an animation skips the step's frame
+    case B_FRAMEDISPLAY:
+      ls->frame_displayed = n == 0 || x != 0;
+      *out = (value){V_NONE, 0};
+      break;
     case B_ISFRAMEDISPLAYED: *out = (value){V_BOOL, ls->frame_displayed}; break;
-    case B_ISANIMATIONENABLED: *out = (value){V_BOOL, 0}; break;
+    case B_ISANIMATIONENABLED: *out = (value){V_BOOL, ls->animating}; break;
     case B_DISCARDNEWSTRING:
       ls->discard_requested = 1;
       *out = (value){V_NONE, 0};

@@ -351,7 +351,9 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int iteration;
   int stop_requested;
   int backward;            // derive right to left (backward()); new right contexts apply
-  int frame_displayed;     // the step is the last one (L-Py draws a frame then)
+  int frame_displayed;     // the step is the last one, or any step of an animation (L-Py draws a
+                           // frame then); frameDisplay(False) clears it
+  int animating;           // vd_lsys_animate runs (isAnimationEnabled())
   int discard_requested;   // DiscardNewString(): the step's result is dropped
   lsys_cur cur;            // the rule being applied (Python engine: InLeftContext, InRightContext)
   lsys_cpat* cpat;         // InLeftContext / InRightContext patterns parsed so far (ncpat)
@@ -582,13 +584,22 @@ vd_status lsys_py_apply_rule(vd_lsystem* ls, const rule* r, const value* frame, 
 vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds);
 // call hook name (Start, End, StartEach, EndEach, ...) with the arguments it declares; s is
 // the current string (an End hook may return a new one). Missing hooks are fine.
-vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules);
+// scene (Nullable: an animation's frame): a hook that declares a second parameter, in a step
+// whose frame is displayed, gets the scene drawn into it first; *kept (Nullable) is then set to
+// whether the hook kept that scene (returned it, alone or second of a pair, or nothing) and to
+// 0 when the hook ran without keeping one (left as is when there is no such hook)
+vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules,
+                       vd_plant_spec* scene, int* kept);
+// call the file's global function name without arguments (vd_lsys_call)
+vd_status lsys_py_call(vd_lsystem* ls, const char* name);
 // call hook name (StartInterpretation, EndInterpretation) with what it produces appended to out,
 // recorded as coming from module src; a hook that declares a parameter gets the turtle (None)
 vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out, int64_t src, int64_t max_modules);
 // the plant the string s draws (interpretation with its hooks, then the turtle), for the scene
 // a Python hook receives (EndEach(lstring, lscene))
 vd_status lsys_scene(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant);
+// an animation frame: plant (cleared) drawn from s as lsys_scene does, the file's labels named
+vd_status lsys_draw(vd_lsystem* ls, const vd_lstring* s, vd_plant_spec* plant);
 // drop objects that no module of s refers to any more (after a step)
 void lsys_py_gc(vd_lsystem* ls, const vd_lstring* s);
 // release every object (a new derivation starts)

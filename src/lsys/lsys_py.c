@@ -371,8 +371,10 @@ static vd_status py_error(vd_lsystem* ls) {
              (double)atomic_load(&g_limit_ms) / 1000.0, (long long)ls->max_ops);
   else if (st == VD_ERR_UNSUPPORTED)
     vm_error(ls, st, line, col, "unsupported: %s: %s", tn, msg ? msg : "");
+  else if (!msg || !*msg)
+    vm_error(ls, st, line, col, "%s", PyErr_GivenExceptionMatches(type, PyExc_AssertionError) ? "assertion failed" : tn);
   else
-    vm_error(ls, st, line, col, "%s: %s", tn, msg ? msg : "");
+    vm_error(ls, st, line, col, "%s: %s", tn, msg);
   Py_XDECREF(s);
   Py_XDECREF(type);
   Py_XDECREF(val);
@@ -862,6 +864,8 @@ static PyObject* vd_scene(PyObject* self, PyObject* noarg) {
     PyErr_SetString(PyExc_RuntimeError, "the scene is only known inside a hook");
     return NULL;
   }
+  // an animation drew the frame's scene before the hook: the same primitives, not drawn again
+  if (ls->py->hook_plant) return scene_prims(ls->py->hook_plant);
   vd_plant_spec* p = vd_plant_spec_create();
   if (!p) return PyErr_NoMemory();
   vm_out* saved = ls->py->out;
@@ -920,11 +924,29 @@ static PyObject* vd_is_backward(PyObject* self, PyObject* noarg) {
   return ls ? PyBool_FromLong(ls->backward) : NULL;
 }
 
-// isFrameDisplayed(): the step is the last one
+// isFrameDisplayed(): the step is the last one, or any step of an animation
 static PyObject* vd_frame_displayed(PyObject* self, PyObject* noarg) {
   (void)self, (void)noarg;
   vd_lsystem* ls = current();
   return ls ? PyBool_FromLong(ls->frame_displayed) : NULL;
+}
+
+// frameDisplay(enabled): whether the step's frame is drawn
+static PyObject* vd_set_frame_displayed(PyObject* self, PyObject* arg) {
+  (void)self;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  int t = PyObject_IsTrue(arg);
+  if (t < 0) return NULL;
+  ls->frame_displayed = t;
+  return py_none();
+}
+
+// isAnimationEnabled(): vd_lsys_animate runs
+static PyObject* vd_animating(PyObject* self, PyObject* noarg) {
+  (void)self, (void)noarg;
+  vd_lsystem* ls = current();
+  return ls ? PyBool_FromLong(ls->animating) : NULL;
 }
 
 // context().options.setSelection(name, value) at run time: the options that change results
@@ -1016,6 +1038,8 @@ static PyMethodDef vd_methods[] = {
     {"set_backward", vd_set_backward, METH_O, "backward() / forward()"},
     {"is_backward", vd_is_backward, METH_NOARGS, "not isForward()"},
     {"frame_displayed", vd_frame_displayed, METH_NOARGS, "isFrameDisplayed"},
+    {"set_frame_displayed", vd_set_frame_displayed, METH_O, "frameDisplay"},
+    {"animating", vd_animating, METH_NOARGS, "isAnimationEnabled"},
     {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
     {"set_option", vd_set_option, METH_VARARGS, "context().options.setSelection"},
     {"set_turtle_angle", vd_set_turtle_angle, METH_O, "context().turtle.setAngleIncrement"},
@@ -1286,14 +1310,16 @@ vd_status lsys_py_produce_hook(vd_lsystem* ls, const char* name, vd_lstring* out
   return st;
 }
 
-vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules) {
+vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules,
+                       vd_plant_spec* scene, int* kept) {
   lsys_py* py = ls->py;
   if (!py->ns) return VD_OK;
   PyObject* f = PyDict_GetItemString(py->ns, name);  // borrowed
   if (!f || !PyCallable_Check(f)) return VD_OK;
+  if (kept) *kept = 0;
   int want = arity(f);
   PyObject* args[2] = {NULL, NULL};
-  int n = 0;
+  int n = 0, drawn = 0;
   if (want >= 1) {
     PyObject* items = items_of(ls, s, 0, s->n);
     args[0] = items ? shim_call("_vd_lstring", items) : NULL;
@@ -1302,10 +1328,18 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
     n = 1;
   }
   if (want >= 2) {
-    args[1] = shim_call("_vd_lazy_scene", NULL);  // made from s when the hook reads it
+    // an animation's frame: L-Py draws the scene before the hook (and shows it when kept)
+    vd_status st = VD_OK;
+    if (scene && ls->frame_displayed) {
+      vm_out* saved = py->out;
+      st = lsys_draw(ls, s, scene);
+      py->out = saved;
+      drawn = !st;
+    }
+    args[1] = st ? NULL : shim_call("_vd_lazy_scene", NULL);  // made from s when the hook reads it
     if (!args[1]) {
       Py_DECREF(args[0]);
-      return py_error(ls);
+      return st ? st : py_error(ls);
     }
     n = 2;
   }
@@ -1320,12 +1354,31 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   lstr_clear(scratch);
   vm_out* saved = py->out;
   const vd_lstring* saved_s = py->hook_s;
+  const vd_plant_spec* saved_plant = py->hook_plant;
   py->out = &vo;  // an nproduce in a hook has nowhere to go but is not an error
   py->hook_s = s;
+  py->hook_plant = drawn ? scene : NULL;
   PyObject* r = PyObject_Vectorcall(f, args, (size_t)n, NULL);
   py->out = saved;
   py->hook_s = saved_s;
+  py->hook_plant = saved_plant;
   Py_DECREF(f);
+  PyObject* scene_type = PyDict_GetItemString(g_shim, "Scene");  // borrowed
+  // which scene the frame shows (L-Py's __apply_post_process): the given one when the hook
+  // returns nothing, the scene, or (lstring, scene); none (the string is drawn) otherwise; a
+  // scene the hook made itself cannot be drawn here
+  PyObject* rs = r && PyTuple_Check(r) && PyTuple_GET_SIZE(r) == 2 ? PyTuple_GET_ITEM(r, 1)
+                 : r && scene_type && PyObject_IsInstance(r, scene_type) == 1 ? r
+                                                                               : NULL;
+  if (kept) *kept = drawn && r && (r == Py_None || (rs && rs == args[1]));
+  if (r && drawn && rs && rs != args[1] && rs != Py_None) {
+    for (int i = 0; i < n; i++) Py_DECREF(args[i]);
+    Py_DECREF(r);
+    return vm_error(ls, VD_ERR_UNSUPPORTED, 0, 0,
+                    "unsupported: %s returned a scene of its own in an animation (verdant draws the frames from the "
+                    "L-string; return the scene it was given, the L-string or nothing)",
+                    name);
+  }
   // a hook that changed the L-string it was given in place (lstring[0][0] = 2) and returned
   // nothing: the changed string is the result, as the hook saw L-Py's own string
   if (r == Py_None && n >= 1) {
@@ -1343,7 +1396,6 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
     Py_DECREF(r);
     r = first;
   }
-  PyObject* scene_type = PyDict_GetItemString(g_shim, "Scene");  // borrowed
   if (r != Py_None && r != Py_True && r != Py_False && !(scene_type && PyObject_IsInstance(r, scene_type) == 1)) {
     // the hook returned a new string: it replaces the current one
     PyObject* items = shim_call("_vd_items", r);
@@ -1359,6 +1411,22 @@ vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstri
   }
   Py_DECREF(r);
   return st;
+}
+
+vd_status lsys_py_call(vd_lsystem* ls, const char* name) {
+  lsys_py* py = ls->py;
+  PyObject* f = py->ns ? PyDict_GetItemString(py->ns, name) : NULL;  // borrowed
+  if (!f || !PyCallable_Check(f))
+    return vm_error(ls, VD_ERR_NAME, 0, 0, "the file defines no function '%s'", name);
+  Py_INCREF(f);
+  vm_out* saved = py->out;
+  py->out = NULL;
+  PyObject* r = PyObject_CallNoArgs(f);
+  py->out = saved;
+  Py_DECREF(f);
+  if (!r) return py_error(ls);
+  Py_DECREF(r);
+  return VD_OK;
 }
 
 vd_status lsys_py_vec3(vd_lsystem* ls, double x, double y, double z, double* out) {

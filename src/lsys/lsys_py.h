@@ -60,6 +60,7 @@ struct lsys_py {
   PyObject* npstate;  // numpy.random's state, when numpy is loaded
   vm_out* out;        // where produce writes now (NULL outside rules and the axiom)
   const vd_lstring* hook_s;  // the string a hook receives (its scene is made from it on demand)
+  const vd_plant_spec* hook_plant;  // its scene, drawn already (an animation frame), or NULL
   // objects referenced by L-strings (handles: slot and epoch, lsys_box_obj)
   PyObject** obj;     // new references; NULL = free slot (capobj)
   int nobj, capobj;   // slots in use up to nobj

@@ -538,17 +538,19 @@ def isForward():
 
 
 def frameDisplay(enabled=True):
-    """Display only: nothing to do without a viewer."""
+    """Whether the step's frame is drawn (an animation skips it when False)."""
+    _vd.set_frame_displayed(bool(enabled))
 
 
 def isFrameDisplayed():
-    """True during the last step (L-Py computes a scene for the hooks then)."""
+    """True during the last step, or any step of an animation (L-Py computes a scene for the
+    hooks then)."""
     return _vd.frame_displayed()
 
 
 def isAnimationEnabled():
-    """No animation runs in verdant."""
-    return False
+    """True while verdant animates (vd_lsys_animate, grow --animate)."""
+    return _vd.animating()
 
 
 class _PatternModuleType(type):

@@ -298,6 +298,7 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
   m->springs = def->springs;
   m->rigid_age = def->rigid_age;
   m->damping = def->damping;
+  m->crown = -1;
   m->node_plant = (int*)(blk + o_nplant), m->node_parent = (int*)(blk + o_nparent);
   m->node_owner = (int*)(blk + o_nowner), m->node_flags = (unsigned*)(blk + o_nflags);
   m->node_rest = (vd_vec3*)(blk + o_nrest), m->node_mass = (double*)(blk + o_nmass);
@@ -396,6 +397,11 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
       // ground of a plant without roots
       int at_ground = base && z <= soil->ground + def->fix_height;
       int clamp = (in_soil && soil->method == VD_SOIL_CLAMP) || (at_ground && (!has_roots || soil->method == VD_SOIL_CLAMP));
+      // the root crown: the base where the roots meet the stem, held by the soil through them
+      if (!clamp && at_ground && has_roots && m->crown < 0) {
+        m->node_flags[i] |= VD_MSS_CROWN;
+        m->crown = i;
+      }
       if (clamp) {
         m->node_flags[i] |= VD_MSS_FIXED;
         nfixed++;
@@ -405,6 +411,20 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
         double area = s >= 0 ? VD_PI * (m->spring_radius[2 * s] + m->spring_radius[2 * s + 1]) * m->spring_l0[s] : 0;
         m->node_soil[i] = vd_soil_max_force(soil, depth, m->node_radius[i], area);
         nsoil++;
+      }
+    }
+    // the crown's anchorage: every root node's resistance, acting across its arm from the crown
+    // (docs/physics.md, "Anchorage"); a crown with no soil node under it is not one
+    m->ground = soil->ground;
+    if (m->crown >= 0) {
+      for (int i = 0; i < nn; i++) {
+        if (!(m->node_flags[i] & VD_MSS_SOIL)) continue;
+        m->anchor_force += m->node_soil[i];
+        m->anchor_moment += m->node_soil[i] * vd_norm(vd_sub(m->node_rest[i], m->node_rest[m->crown]));
+      }
+      if (!nsoil) {
+        m->node_flags[m->crown] &= ~VD_MSS_CROWN;
+        m->crown = -1;
       }
     }
     // a plant held by nothing is clamped at its lowest base
@@ -421,7 +441,11 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
     for (int s = 0; s < ninter; s++) {
       int b = m->spring_node[2 * s], c = m->spring_node[2 * s + 1];
       int a = owner[b] >= 0 ? m->spring_node[2 * owner[b]] : -1, sib = -1;
-      if (a < 0 && first_child[b] >= 0 && first_child[b] != s) sib = first_child[b];
+      // the internodes from a crown or a clamped base hinge on the soil or the clamp (a fixed
+      // arm), not on each other: the soil around the crown takes the stem's moment, not the first
+      // root (the paper's alternate-node springs keep the sibling: they have no fixed arm)
+      int crown = (m->node_flags[b] & (VD_MSS_CROWN | VD_MSS_FIXED)) && def->springs == VD_MSS_MATERIAL;
+      if (a < 0 && !crown && first_child[b] >= 0 && first_child[b] != s) sib = first_child[b];
       int arm = a >= 0 ? a : sib >= 0 ? m->spring_node[2 * sib + 1] : -1;  // the other arm's end
       int j = seg_of[s];
       int woody = p->seg_age[j] >= def->woody_age || is_root(p, j);
@@ -457,7 +481,7 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
         m->hinge_k[h] = e * VD_PI * r * r * r * r / 4 / (0.5 * (lp + lq));
         m->hinge_p0[h] = p0, m->hinge_q0[h] = q0;
         // a free base with nothing to hinge on keeps no hinge (it turns freely)
-        if (arm < 0 && !(m->node_flags[b] & VD_MSS_FIXED)) m->hinge_k[h] = 0;
+        if (arm < 0 && !(m->node_flags[b] & (VD_MSS_FIXED | VD_MSS_CROWN))) m->hinge_k[h] = 0;
         h++;
       }
     }
@@ -675,7 +699,7 @@ static int hinge_linearise(const vd_mss_model* m, const vd_mss_data* d, int h, h
   const int* hn = m->hinge_node + 3 * h;
   hl->a = hn[0], hl->b = hn[1], hl->c = hn[2];
   hl->k = m->hinge_k[h];
-  if (hl->k <= 0) return 0;
+  if (!mss_hinge_on(m, d, h)) return 0;
   if ((hl->a >= 0 && d->removed[hl->a]) || d->removed[hl->b] || d->removed[hl->c]) return 0;
   if ((hl->a < 0 || d->rigid[hl->a]) && d->rigid[hl->b] && d->rigid[hl->c]) return 0;
   vd_vec3 q = vd_sub(d->pos[hl->c], d->pos[hl->b]);
@@ -1098,7 +1122,7 @@ static void solve_kang(const vd_mss_model* m, vd_mss_data* d, mss_work* w, int e
     const int* hn = m->hinge_node + 3 * k;
     int b = hn[1], c = hn[2];
     double lq = vd_norm(vd_sub(m->node_rest[c], m->node_rest[b]));
-    double kt = m->hinge_k[k] / (lq * lq);
+    double kt = mss_hinge_on(m, d, k) ? m->hinge_k[k] / (lq * lq) : 0;
     w->ksum[b] += kt, w->ksum[c] += kt;
   }
   // the neighbours' terms: eq. 3 predicts dv*_j = h F_j / (m_j + h^2 K_j); eq. 4 takes the last
@@ -1127,7 +1151,7 @@ static void solve_kang(const vd_mss_model* m, vd_mss_data* d, mss_work* w, int e
     const int* hn = m->hinge_node + 3 * k;
     int b = hn[1], c = hn[2];
     double lq = vd_norm(vd_sub(m->node_rest[c], m->node_rest[b]));
-    double kt = m->hinge_k[k] / (lq * lq);
+    double kt = mss_hinge_on(m, d, k) ? m->hinge_k[k] / (lq * lq) : 0;
     w->dvs[b] = vd_madd(w->dvs[b], w->cg_z[c], kt);
     w->dvs[c] = vd_madd(w->dvs[c], w->cg_z[b], kt);
   }
@@ -1161,7 +1185,7 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
   double cap_f = 0, cap_m = 0;
   for (int i = 0; i < m->nnode; i++) {
     if (!d->rigid[i] || d->removed[i]) continue;
-    if (m->node_flags[i] & VD_MSS_FIXED) clamped = 1;
+    if ((m->node_flags[i] & VD_MSS_FIXED) || (i == m->crown && mss_crown_held(m, d))) clamped = 1;
     if (m->node_flags[i] & VD_MSS_SOIL) {
       double fm = m->node_soil[i];
       soil_members = 1;
@@ -1174,6 +1198,8 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
     mss_rigid_sync(m, d);
     return 1;
   }
+  // a crown whose anchorage gave way holds nothing: the root plate has failed
+  if (m->crown >= 0 && d->rigid[m->crown]) soil_members = 0;
   int held = 0;
   if (soil_members) {
     // the per-node rule for a whole body: held while the wrench is within the soil's capacity
@@ -1204,6 +1230,32 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
       if (d->rigid[i] && (m->node_flags[i] & VD_MSS_SOIL) && !d->removed[i])
         d->fext[i] = vd_madd(d->fext[i], f, -m->node_soil[i] / cap_f);
   return held;
+}
+
+// The stem's wrench on the root crown (the sections at the foot of its internodes that leave the
+// crown, as vd_mss_stress cuts them) against the crown's anchorage; beyond it the root plate
+// gives way (an event), and the crown turns freely from then on. Reads the subtree sums of the
+// last vd_mss_stress.
+static void anchor_check(const vd_mss_model* m, vd_mss_data* d, const mss_work* w) {
+  int b = m->crown;
+  vd_vec3 f = vd_v3(0, 0, 0), mo = vd_v3(0, 0, 0);
+  for (int s = 0; s < m->ninter; s++) {
+    int c = m->spring_node[2 * s + 1];
+    if (m->spring_node[2 * s] != b || (m->node_flags[c] & VD_MSS_ROOT) || d->spring_broken[s] || d->removed[c]) continue;
+    int rigid = d->rigid[b] && d->rigid[c];
+    vd_vec3 fc = rigid ? w->ftot[c] : vd_scale(w->fsub[c], -1);
+    vd_vec3 mc = rigid ? w->dvs[c] : vd_scale(w->msub[c], -1);
+    f = vd_add(f, fc);
+    mo = vd_add(mo, vd_add(mc, vd_cross(vd_sub(d->pos[c], d->pos[b]), fc)));
+  }
+  double nm = v_norm(mo), nf = v_norm(f);
+  double load = fmax(m->anchor_moment > 0 ? nm / m->anchor_moment : nm > 0 ? INFINITY : 0,
+                     m->anchor_force > 0 ? nf / m->anchor_force : nf > 0 ? INFINITY : 0);
+  if (load > d->anchor_load) d->anchor_load = load;
+  if (!(load > 1)) return;
+  d->anchor_failed = 1;
+  vd_mss_event e = {VD_MSS_ANCHOR, d->time, b, -1, load, nm, 0};
+  mss_event(d, &e);
 }
 
 static double tilt_of(const vd_mss_model* m, const vd_mss_data* d) {
@@ -1247,6 +1299,13 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     w->con[i] = !mss_free(m, d, i);
     d->held[i] = 0;
     w->ftot[i] = vd_add(d->fext[i], w->fint[i]);
+    if (!w->con[i] && i == m->crown && mss_crown_held(m, d)) {
+      // the crown: held while its anchorage lasts (checked after the substep)
+      d->held[i] = 1;
+      w->con[i] = 1;
+      d->vel[i] = vd_v3(0, 0, 0);
+      continue;
+    }
     if (w->con[i] || !(m->node_flags[i] & VD_MSS_SOIL)) continue;
     double fm = m->opt.soil ? m->node_soil[i] : INFINITY, f = v_norm(w->ftot[i]);
     if (f <= fm) {
@@ -1273,6 +1332,14 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     d->pos[i] = vd_madd(d->pos[i], d->vel[i], h);
     if (!finite3(d->pos[i]) || !finite3(d->vel[i])) bad = 1;
   }
+  // the ground of a rooted plant: stem nodes that reach it stop there (an inelastic contact
+  // without sliding), so a tree that tips over lies on it
+  if (m->crown >= 0 && !bad)
+    for (int i = 0; i < nn; i++) {
+      if ((m->node_flags[i] & VD_MSS_ROOT) || !mss_free(m, d, i) || !(d->pos[i].z < m->ground)) continue;
+      d->pos[i].z = m->ground;
+      d->vel[i] = vd_v3(0, 0, 0);
+    }
   // strain limiting (Provot 1995): linearised implicit steps stretch internodes that turn fast
   // (the step moves nodes along tangents); parents first, each internode back within the limit,
   // the correction kept in the velocity as in position-based dynamics
@@ -1307,8 +1374,12 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     d->acc[i] = d->rigid[i] && rb_held ? vd_v3(0, 0, 0) : vd_scale(vd_sub(d->vel[i], w->vel0[i]), 1.0 / h);
   d->time += h;
   d->nstep++;
-  // uprooting: soil nodes holding more than half the root system's resistance gave way, and the
-  // stem's base tilted beyond the limit
+  // stress (breaking reads it) and the crown's wrench against its anchorage
+  int anchor = mss_crown_held(m, d) && m->opt.soil;
+  if (m->opt.breaking || anchor) vd_mss_stress(m, d);
+  if (anchor) anchor_check(m, d, w);
+  // uprooting: the crown's anchorage gave way, or soil nodes holding more than half the root
+  // system's resistance did, and the stem's base tilted beyond the limit
   if (!d->uprooted && m->base >= 0 && m->opt.soil) {
     double total = 0, gave = 0;
     for (int i = 0; i < nn; i++)
@@ -1316,7 +1387,7 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
         total += m->node_soil[i];
         if (d->yielded[i]) gave += m->node_soil[i];
       }
-    double tilt = total > 0 && gave > 0.5 * total ? tilt_of(m, d) : 0;
+    double tilt = d->anchor_failed || (total > 0 && gave > 0.5 * total) ? tilt_of(m, d) : 0;
     if (tilt > d->uproot_tilt) {
       d->uprooted = 1;
       vd_mss_event e = {VD_MSS_UPROOT, d->time, m->base, -1, tilt, d->uproot_tilt, 0};
@@ -1325,7 +1396,6 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
   }
   // breaking: an internode whose stress exceeds its modulus of rupture takes its subtree with it
   if (m->opt.breaking) {
-    vd_mss_stress(m, d);
     int removed_rigid = 0;
     for (int k = 0; k < nn; k++) {
       int c = m->node_order[k], s = m->node_owner[c];

@@ -179,7 +179,7 @@ void mss_internal(const vd_mss_model* m, const vd_mss_data* d, mss_work* w) {
   for (int h = 0; h < m->nhinge; h++) {
     const int* hn = m->hinge_node + 3 * h;
     int a = hn[0], b = hn[1], c = hn[2];
-    if (m->hinge_k[h] <= 0 || (a >= 0 && d->removed[a]) || d->removed[b] || d->removed[c]) continue;
+    if (!mss_hinge_on(m, d, h) || (a >= 0 && d->removed[a]) || d->removed[b] || d->removed[c]) continue;
     if ((a < 0 || d->rigid[a]) && d->rigid[b] && d->rigid[c]) continue;
     vd_vec3 fa, fb, fc;
     hinge_force(m, d, h, &fa, &fb, &fc);

@@ -59,4 +59,16 @@ static inline int mss_free(const vd_mss_model* m, const vd_mss_data* d, int i) {
   return !(m->node_flags[i] & VD_MSS_FIXED) && !d->rigid[i] && !d->removed[i];
 }
 
+// whether the soil holds the root crown now (its anchorage has not given way)
+static inline int mss_crown_held(const vd_mss_model* m, const vd_mss_data* d) {
+  return m->crown >= 0 && !d->anchor_failed && !d->removed[m->crown];
+}
+
+// whether hinge h acts: a stiffness, and not a fixed arm of a crown whose anchorage gave way
+static inline int mss_hinge_on(const vd_mss_model* m, const vd_mss_data* d, int h) {
+  const int* hn = m->hinge_node + 3 * h;
+  if (!(m->hinge_k[h] > 0)) return 0;
+  return !(hn[0] < 0 && (m->node_flags[hn[1]] & VD_MSS_CROWN) && d->anchor_failed);
+}
+
 #endif
