@@ -107,8 +107,9 @@ typedef struct vd_growth_stats {
   double height;            // height of the highest stem node above the base (m)
   double height0;           // the same in the rest shape (m): the shape the physics returns to,
                             // which follows a lasting lean (stress-free growth)
-  double drawn_height;      // the same as the turtle draws the L-string now: unloaded, as grown,
-                            // without physics (m)
+  double drawn_height;      // the same as the turtle draws the L-string: unloaded, as grown,
+                            // without physics; the largest at any age, so branches broken off
+                            // the string do not lower it (m)
   double max_displacement;  // largest distance of a node from its rest position (m)
   double tip_displacement;  // ... of the end of the main stem (m)
   double max_stress;        // largest internode stress (Pa)

@@ -164,6 +164,7 @@ struct vd_growth {
   int uprooted;
   int anchor_failed;
   double anchor_load;
+  double drawn_max;        // the largest drawn height at any age so far (m)
   // events and summaries
   vd_growth_event* ev;
   int nev, cap_ev;
@@ -1023,6 +1024,8 @@ static vd_status end_mss(vd_growth* g, vd_error* err) {
   return VD_OK;
 }
 
+static double drawn_height(const vd_growth* g);
+
 vd_status vd_growth_step(vd_growth* g, vd_error* err) {
   vd_status st = VD_OK;
   // one derivation step; the module ids follow it
@@ -1049,6 +1052,7 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
   g->age++;
   g->nbroken_step = 0;
   if ((st = rebuild(g, 1, err))) return st;
+  g->drawn_max = fmax(g->drawn_max, drawn_height(g));
   if ((st = check_light(g, err))) return st;
   // the substeps
   for (int k = 0; k < g->def.substeps; k++) {
@@ -1087,6 +1091,7 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
 
 // the highest stem node above the stem's base as the turtle draws the string now (m)
 static double drawn_height(const vd_growth* g) {
+  if (!g->spec) return 0;
   const vd_plant_spec* s = g->spec;
   double z0 = HUGE_VAL, z1 = -HUGE_VAL;
   for (int j = 0; j < s->nseg; j++) {
@@ -1114,7 +1119,7 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
   out->uprooted = g->uprooted;
   out->anchor_failed = g->anchor_failed;
   out->anchor_load = g->anchor_load;
-  out->drawn_height = drawn_height(g);
+  out->drawn_height = fmax(g->drawn_max, drawn_height(g));
   if (g->mm) {
     const vd_mss_model* m = g->mm;
     const vd_mss_data* d = g->md;

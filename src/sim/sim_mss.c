@@ -1216,7 +1216,8 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
   }
   // a body nothing holds, stepped explicitly against stiff springs, is unstable (h^2 k / M of
   // hundreds): released, its nodes go on with the springs at the velocities they have
-  if (!held && m->opt.rigid_release) {
+  // (after the crown's anchorage gave way, always: the ground holds only free nodes)
+  if (!held && (m->opt.rigid_release || d->anchor_failed)) {
     for (int i = 0; i < m->nnode; i++) d->rigid[i] = 0;
     memset(b, 0, sizeof *b);
     b->q = vd_quat_identity();
