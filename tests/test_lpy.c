@@ -610,3 +610,47 @@ TEST(lpy, call_a_function_of_the_file) {
     vd_lsys_destroy(ls);
   }
 }
+
+TEST(lpy, produce_with_keyword_parameters_python_engine) {
+  if (!vd_lsys_python_available(NULL, 0)) return;
+  // produce A(**d) places d's values by the names `module A(x, y)` declares; A(a, **d) after
+  // the ones given by position
+  PY_DERIVES("module A(x, y)\nAxiom: A(0, 0)\nproduction:\nA(**p):\n  p['y'] += 1\n  produce A(**p) B\n", 2,
+             "A(0,2)BB");
+  PY_DERIVES("module A(x, y)\nAxiom: A(0, 0)\nproduction:\nA(x, y):\n  produce A(5, **{'y': y + 1})\n", 1, "A(5,1)");
+  // a key that names no parameter, or a parameter without a value: errors at the produce
+  static const char* bad[][2] = {
+      {"A(**p):\n  p['z'] = 1\n  produce A(**p)\n", "no parameter 'z'"},
+      {"A(**p):\n  del p['x']\n  produce A(**p)\n", "no value for parameter 'x'"},
+      {"A(**p):\n  produce B(**p)\n", "module B declares no parameter names"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    char src[512], b[256];
+    snprintf(src, sizeof src, "module A(x, y)\nAxiom: A(0, 0)\nproduction:\n%s", bad[k][0]);
+    vd_error e = {0};
+    CHECK(derive_engine(src, VD_LSYS_PYTHON, 1, b, sizeof b, &e) != VD_OK);
+    if (!strstr(e.msg, bad[k][1]) || e.line < 5) vdt_fail(__FILE__, __LINE__, "'%s' at line %d", e.msg, e.line);
+  }
+}
+
+TEST(lpy, module_inheritance) {
+  // `module B : base = A` with the 'Module inheritance' option: a rule (or context) of A applies
+  // to B too, in file order; without the option B is a module of its own
+  const char* head = "module A(x)\nmodule B(x) : base = A\nmodule E, F : base = (Q, B)\n";
+  const char* body = "Axiom: B(1) A(2) C E(3) F\nderivation length: 1\nproduction:\n"
+                     "A(x) < C --> G(x)\nA(x) --> D(x)\n";
+  const char* opt = "###### INITIALISATION ######\ndef __initialiseContext__(context):\n"
+                    "\tcontext.options.setSelection('Module inheritance', 1)\n";
+  char src[1024];
+  snprintf(src, sizeof src, "%s%s%s", head, body, opt);
+  DERIVES(src, -1, "D(1)D(2)G(2)D(3)F");  // F has no parameter: A(x) does not match it
+  snprintf(src, sizeof src, "%s%s", head, body);
+  DERIVES(src, -1, "B(1)D(2)G(2)E(3)F");
+  if (vd_lsys_python_available(NULL, 0)) {
+    snprintf(src, sizeof src,
+             "%sassert ModuleClass.get('E').issubclass(ModuleClass.get('A'))\n"
+             "assert not ModuleClass.get('A').issubclass(ModuleClass.get('B'))\n%s%s",
+             head, body, opt);
+    PY_DERIVES(src, -1, "D(1)D(2)G(2)D(3)F");
+  }
+}

@@ -103,6 +103,7 @@ void vd_lsys_destroy(vd_lsystem* ls) {
   vd_free(ls->scalar_slot, sizeof(int) * (size_t)ls->nscalar);
   vd_free(ls->scalar_val, sizeof(value) * (size_t)ls->nscalar);
   vd_free(ls->pdecl, sizeof(struct pdecl) * (size_t)ls->cappdecl);
+  vd_free(ls->mbase, sizeof(struct mbase) * (size_t)ls->capbase);
   vd_free(ls->mlist, sizeof(struct mlist) * (size_t)ls->capmlist);
   vd_free(ls->mval, sizeof(value) * (size_t)ls->capmval);
   vd_free(ls->cpat, sizeof(lsys_cpat) * (size_t)ls->capcpat);

@@ -317,6 +317,12 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   int opt_module_matching;      // 0 simple, 1 with *args, 2 with value constraints (default)
   int opt_axiom_decomposition;  // 1: the axiom is decomposed before the first step
   int has_bases;                // a module declaration names base modules (inheritance)
+  int opt_inherit;              // 'Module inheritance' on: a pattern module matches its subclasses
+  // base modules declared with `module B : base = A` / `base = (A, C)`: (sym, base) pairs
+  int nbase, capbase;
+  struct mbase {
+    int32_t sym, base;
+  }* mbase;
   double turtle_angle;          // context.turtle.setAngleIncrement(a): the turtle's default angle (degrees)
   int has_turtle_angle;         // the file set it
   // parameter names declared with `module A(x, t)` (**kwds patterns): symbol, names (string ids)
@@ -590,6 +596,10 @@ vd_status lsys_py_test(vd_lsystem* ls, int fn, value v, int* holds);
 // 0 when the hook ran without keeping one (left as is when there is no such hook)
 vd_status lsys_py_hook(vd_lsystem* ls, const char* name, vd_lstring* s, vd_lstring* scratch, int64_t max_modules,
                        vd_plant_spec* scene, int* kept);
+// is module sym the module anc or a subclass of it (its declared bases, transitively)?
+int lsys_isa(const vd_lsystem* ls, int32_t sym, int32_t anc);
+// the parameter names a symbol declares (module A(x, t)), string ids; count in *n (0: none)
+const int* lsys_declared_names(const vd_lsystem* ls, int32_t sym, int* n);
 // call the file's global function name without arguments (vd_lsys_call)
 vd_status lsys_py_call(vd_lsystem* ls, const char* name);
 // call hook name (StartInterpretation, EndInterpretation) with what it produces appended to out,

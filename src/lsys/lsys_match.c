@@ -146,8 +146,18 @@ static value param_list(vd_lsystem* ls, int name, const double* val, int n) {
   return (value){V_LIST, id};
 }
 
-// the declared parameter names of a symbol (module A(x, t)); count in *n
-static const int* declared_names(const vd_lsystem* ls, int32_t sym, int* n) {
+// depth-first over the declared bases; a cycle (module A : base = B, B : base = A) ends at depth 32
+static int isa_depth(const vd_lsystem* ls, int32_t sym, int32_t anc, int depth) {
+  if (sym == anc) return 1;
+  if (depth >= 32) return 0;
+  for (int i = 0; i < ls->nbase; i++)
+    if (ls->mbase[i].sym == sym && isa_depth(ls, ls->mbase[i].base, anc, depth + 1)) return 1;
+  return 0;
+}
+
+int lsys_isa(const vd_lsystem* ls, int32_t sym, int32_t anc) { return isa_depth(ls, sym, anc, 0); }
+
+const int* lsys_declared_names(const vd_lsystem* ls, int32_t sym, int* n) {
   for (int i = 0; i < ls->npdecl; i++)
     if (ls->pdecl[i].sym == sym) {
       *n = ls->pdecl[i].n;
@@ -161,7 +171,7 @@ static const int* declared_names(const vd_lsystem* ls, int32_t sym, int* n) {
 // with name >= 0 the dict also holds 'name'
 static value named_dict(vd_lsystem* ls, int32_t sym, int name, const double* val, int np, int start) {
   int nn;
-  const int* names = declared_names(ls, sym, &nn);
+  const int* names = lsys_declared_names(ls, sym, &nn);
   int first = np - nn > 0 ? np - nn : 0, count = 0;
   for (int i = start; i < nn; i++) count += first + i < np;
   int key_name = -1;
@@ -190,7 +200,7 @@ static int bind_lists(const mstate* S, const pmod* p, int32_t sym, int name, con
   int hasN = star && x->has_name;
   int P = hasN + p->nparam + hasA + hasK;
   int nn;
-  declared_names(ls, sym, &nn);
+  lsys_declared_names(ls, sym, &nn);
   value A = {V_UNDEF, 0}, K = {V_UNDEF, 0};
   if (!star && np + 2 < P) return 0;
   if (star && np + 3 < P) return 0;
@@ -259,7 +269,7 @@ static int module_match(const mstate* S, const pmod* p, const view* v, int64_t k
   const double* val = s->val + s->par[j];
   int lists = p->x && (p->x->args_slot >= 0 || p->x->kwds_slot >= 0);
   if (p->kind == PK_MOD) {
-    if (s->sym[j] != p->sym) return 0;
+    if (s->sym[j] != p->sym && !(S->ls->opt_inherit && lsys_isa(S->ls, s->sym[j], p->sym))) return 0;
     if (!(lists ? bind_lists(S, p, s->sym[j], -1, val, np) : bind_params(p, val, np, S->frame))) return 0;
     return conds_hold(S, p);
   }

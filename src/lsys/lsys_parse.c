@@ -1994,12 +1994,40 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
   vd_lsystem* ls = P->ls;
   int p = from;
   const char* s = ln->s;
+  int decl[64], ndecl = 0;  // the modules the line declares
   for (;;) {
     while (p < ln->len && is_space(s[p])) p++;
     if (p < ln->len && s[p] == ':') {
-      // `: scale = n` (multiscale) and `: bases = X` (inheritance): noted, used by the options
-      for (int k = p; k + 5 <= ln->len; k++)
-        if (memcmp(s + k, "bases", 5) == 0) ls->has_bases = 1;
+      // `: scale = n` (multiscale, read by the options) and `: base = A` or `base = (A, C)`
+      // (inheritance): the bases of every module of the line
+      for (int k = p + 1; k + 4 <= ln->len; k++) {
+        if (memcmp(s + k, "base", 4) != 0 || isalnum((unsigned char)s[k - 1]) || s[k - 1] == '_' ||
+            (k + 4 < ln->len && (isalnum((unsigned char)s[k + 4]) || s[k + 4] == '_')))
+          continue;
+        int q = k + 4;
+        while (q < ln->len && is_space(s[q])) q++;
+        if (q >= ln->len || s[q] != '=') continue;
+        q++;
+        while (q < ln->len && is_space(s[q])) q++;
+        int group = q < ln->len && (s[q] == '(' || s[q] == '[');
+        if (group) q++;
+        for (;;) {
+          while (q < ln->len && (is_space(s[q]) || s[q] == ',')) q++;
+          int a = q;
+          while (q < ln->len && !is_space(s[q]) && s[q] != ',' && s[q] != ')' && s[q] != ']' && s[q] != '#') q++;
+          if (q == a) break;
+          int b = sym_intern(ls, s + a, q - a, 1);
+          if (b < 0) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+          for (int d = 0; d < ndecl; d++) {
+            if (!vd_grow((void**)&ls->mbase, &ls->capbase, ls->nbase + 1, sizeof(struct mbase)))
+              return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+            ls->mbase[ls->nbase++] = (struct mbase){decl[d], b};
+          }
+          ls->has_bases = 1;
+          if (!group) break;
+        }
+        break;
+      }
       break;
     }
     if (p >= ln->len || s[p] == '#') break;
@@ -2008,6 +2036,7 @@ static vd_status parse_module_decl(parser* P, const pline* ln, int from) {
     if (p == a) return perr(ls, VD_ERR_SYNTAX, ln->lineno, ln->col0 + p, "expected a module name");
     int sym = sym_intern(ls, s + a, p - a, 1);
     if (sym < 0) return perr(ls, VD_ERR_NOMEM, ln->lineno, 1, "out of memory");
+    if (ndecl < 64) decl[ndecl++] = sym;
     while (p < ln->len && is_space(s[p]) && p + 1 < ln->len && (is_space(s[p + 1]) || s[p + 1] == '(')) p++;
     if (p < ln->len && is_space(s[p]) && p + 1 < ln->len && s[p + 1] == '(') p++;
     if (p < ln->len && s[p] == '(') {
@@ -2560,8 +2589,7 @@ vd_status lsys_set_option(vd_lsystem* ls, const char* name, int nlen, long v, in
                   v == 2 ? "As Multi-level AxialTree" : "As Multiscale AxialTree");
     ls->opt_string_matching = v != 0;
   } else if (name_is(name, nlen, "Module inheritance")) {
-    if (v != 0 && ls->has_bases)
-      return perr(ls, VD_ERR_UNSUPPORTED, line, 1, "unsupported: option 'Module inheritance' (modules with bases)");
+    ls->opt_inherit = v != 0;
   }
   return VD_OK;
 }

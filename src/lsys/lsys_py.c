@@ -648,6 +648,60 @@ static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_
 }
 
 // _vd.p(tid, (params), ...): produce / nproduce into the current output; True
+// produce A(a, **d): the values of dict d in the order module A(x, y) declares its parameter
+// names, after the npos given by position (L-Py places keyword parameters by name); every name
+// needs a value, every key a name not given already
+static PyObject* vd_kw(PyObject* self, PyObject* const* args, Py_ssize_t nargs) {
+  (void)self;
+  vd_lsystem* ls = current();
+  if (!ls) return NULL;
+  if (nargs != 3 || !PyLong_Check(args[0]) || !PyLong_Check(args[1])) {
+    PyErr_SetString(PyExc_TypeError, "bad produce call");
+    return NULL;
+  }
+  int sym = (int)PyLong_AsLong(args[0]), npos = (int)PyLong_AsLong(args[1]);
+  const char* mod = vd_lsys_symbol_name(ls, sym);
+  PyObject* d = args[2];
+  if (!PyDict_Check(d))
+    return PyErr_Format(PyExc_TypeError, "produce %s(**...) needs a dict, got %s", mod, Py_TYPE(d)->tp_name);
+  int nn;
+  const int* names = lsys_declared_names(ls, sym, &nn);
+  if (!nn)
+    return PyErr_Format(PyExc_TypeError, "produce %s(**...): module %s declares no parameter names (module %s(x, y))",
+                        mod, mod, mod);
+  int rest = nn > npos ? nn - npos : 0;
+  PyObject* t = PyTuple_New(rest);
+  if (!t) return NULL;
+  for (int k = 0; k < rest; k++) {
+    PyObject* v = PyDict_GetItemString(d, ls->str[names[npos + k]]);  // borrowed
+    if (!v) {
+      Py_DECREF(t);
+      return PyErr_Format(PyExc_TypeError, "produce %s(**...): no value for parameter '%s'", mod,
+                          ls->str[names[npos + k]]);
+    }
+    Py_INCREF(v);
+    PyTuple_SET_ITEM(t, k, v);
+  }
+  if (PyDict_Size(d) != rest) {
+    // a key that is not a declared name, or names a parameter given by position
+    PyObject *key, *val;
+    Py_ssize_t pos = 0;
+    while (PyDict_Next(d, &pos, &key, &val)) {
+      const char* ks = PyUnicode_Check(key) ? PyUnicode_AsUTF8(key) : NULL;
+      int at = -1;
+      for (int k = 0; ks && at < 0 && k < nn; k++)
+        if (!strcmp(ks, ls->str[names[k]])) at = k;
+      if (at < npos) {
+        Py_DECREF(t);
+        PyErr_Clear();
+        if (at >= 0) return PyErr_Format(PyExc_TypeError, "produce %s(**...): parameter %R given twice", mod, key);
+        return PyErr_Format(PyExc_TypeError, "produce %s(**...): module %s has no parameter %R", mod, mod, key);
+      }
+    }
+  }
+  return t;
+}
+
 static PyObject* vd_p(PyObject* self, PyObject* const* args, Py_ssize_t nargs) {
   (void)self;
   vd_lsystem* ls = current();
@@ -931,6 +985,16 @@ static PyObject* vd_frame_displayed(PyObject* self, PyObject* noarg) {
   return ls ? PyBool_FromLong(ls->frame_displayed) : NULL;
 }
 
+// ModuleClass.issubclass: is module a (a name) module b or a subclass of it?
+static PyObject* vd_isa(PyObject* self, PyObject* args) {
+  (void)self;
+  vd_lsystem* ls = current();
+  const char *a, *b;
+  if (!ls || !PyArg_ParseTuple(args, "ss", &a, &b)) return NULL;
+  int sa = vd_lsys_symbol_find(ls, a), sb = vd_lsys_symbol_find(ls, b);
+  return PyBool_FromLong(sa >= 0 && sb >= 0 && lsys_isa(ls, sa, sb));
+}
+
 // frameDisplay(enabled): whether the step's frame is drawn
 static PyObject* vd_set_frame_displayed(PyObject* self, PyObject* arg) {
   (void)self;
@@ -1026,6 +1090,7 @@ static PyObject* vd_in_context(PyObject* self, PyObject* args) {
 
 static PyMethodDef vd_methods[] = {
     {"p", (PyCFunction)(void (*)(void))vd_p, METH_FASTCALL, "produce a template"},
+    {"kw", (PyCFunction)(void (*)(void))vd_kw, METH_FASTCALL, "produce A(**d): d's values in declared order"},
     {"mk", (PyCFunction)(void (*)(void))vd_mk, METH_FASTCALL, "the items of a template"},
     {"parse", vd_parse, METH_O, "modules of an L-string text"},
     {"append", vd_append, METH_O, "append (name, params) items to the production"},
@@ -1040,6 +1105,7 @@ static PyMethodDef vd_methods[] = {
     {"frame_displayed", vd_frame_displayed, METH_NOARGS, "isFrameDisplayed"},
     {"set_frame_displayed", vd_set_frame_displayed, METH_O, "frameDisplay"},
     {"animating", vd_animating, METH_NOARGS, "isAnimationEnabled"},
+    {"isa", vd_isa, METH_VARARGS, "ModuleClass.issubclass"},
     {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
     {"set_option", vd_set_option, METH_VARARGS, "context().options.setSelection"},
     {"set_turtle_angle", vd_set_turtle_angle, METH_O, "context().turtle.setAngleIncrement"},

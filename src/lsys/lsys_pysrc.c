@@ -261,7 +261,13 @@ static void put_call(sbuf* b, const vd_lsystem* ls, const char* fn, int id, cons
     const tmod* tm = &t->mod[m];
     if (!tm->nparam) continue;
     sb_puts(b, ", (");
-    for (int k = 0; k < tm->nparam; k++) sb_printf(b, "%s, ", ls->str[(int)tm->param[k]->k.n]);
+    for (int k = 0; k < tm->nparam; k++) {
+      const char* p = ls->str[(int)tm->param[k]->k.n];
+      // A(a, **d): d's values in the order module A declares its parameter names, after the k
+      // given by position
+      if (p[0] == '*' && p[1] == '*') sb_printf(b, "*__vd_kw(%d, %d, %s), ", (int)tm->sym, k, p + 2);
+      else sb_printf(b, "%s, ", p);
+    }
     sb_puts(b, ")");
   }
   sb_puts(b, ")");

@@ -99,7 +99,7 @@ vd_status lsys_build_index(vd_lsystem* ls, int group, int backward) {
       for (int r = 0; r < ls->nrule; r++) {
         rule* R = ls->rules[r];
         if (!rule_applies(R, s, groups[g], backward)) continue;
-        R->simple = rule_is_simple(R) && !backward && ls->opt_string_matching;
+        R->simple = rule_is_simple(R) && !backward && ls->opt_string_matching && !(ls->opt_inherit && ls->has_bases);
         if (R->left.n || R->right.n || R->nleft.n || R->nright.n) ls->has_context[s] = 1;
         if (!R->simple) ls->has_generic[s] = 1;
         if (has_query_module(&R->pred) || has_query_module(&R->left) || has_query_module(&R->right) ||
@@ -107,7 +107,10 @@ vd_status lsys_build_index(vd_lsystem* ls, int group, int backward) {
           ls->has_query[s] = 1;
         int k = key_symbol(R, backward);
         if (k < 0) nstar++;
-        else first[k + 1]++;
+        else if (ls->opt_inherit && ls->has_bases) {
+          // 'Module inheritance': the rule serves its module's subclasses too
+          for (int q = 0; q < nsym; q++) first[q + 1] += lsys_isa(ls, q, k);
+        } else first[k + 1]++;
       }
     for (int k = 0; k <= nsym; k++) first[k + 1] += first[k] + (int)nstar;
     int64_t total = first[nsym + 1];
@@ -126,7 +129,10 @@ vd_status lsys_build_index(vd_lsystem* ls, int group, int backward) {
         const rule* R = ls->rules[r];
         if (!rule_applies(R, s, groups[g], backward)) continue;
         int k = key_symbol(R, backward);
-        if (k >= 0) {
+        if (k >= 0 && ls->opt_inherit && ls->has_bases) {
+          for (int q = 0; q < nsym; q++)
+            if (lsys_isa(ls, q, k)) ls->rule_list[s][fill[q]++] = r;
+        } else if (k >= 0) {
           ls->rule_list[s][fill[k]++] = r;
         } else {
           for (int q = 0; q <= nsym; q++) ls->rule_list[s][fill[q]++] = r;

@@ -553,6 +553,31 @@ def isAnimationEnabled():
     return _vd.animating()
 
 
+class ModuleClass:
+    """A module's class, as L-Py's ModuleClass: its name and its declared bases
+    (`module B : base = A`)."""
+
+    def __init__(self, name):
+        self.name = name
+
+    @staticmethod
+    def get(name):
+        return ModuleClass(name)
+
+    def issubclass(self, other):
+        """Is this module other's module or one of its subclasses?"""
+        return _vd.isa(self.name, other.name)
+
+    def __eq__(self, other):
+        return isinstance(other, ModuleClass) and other.name == self.name
+
+    def __hash__(self):
+        return hash(self.name)
+
+    def __repr__(self):
+        return "ModuleClass(%r)" % self.name
+
+
 class _PatternModuleType(type):
     @property
     def matchingMethod(cls):
@@ -2716,7 +2741,7 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
-        "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext"]
+        "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext", "ModuleClass"]
 
 _DISPLAY = ["Viewer", "eStatic", "eAnimatedPrimitives", "eAnimatedScene", "pgl_support_extension"]
 _pgl_math = _module("openalea.plantgl.math", _MATH)
@@ -2770,4 +2795,5 @@ BASE = {"__builtins__": _BUILTINS, "__name__": "__lpy__"}
 for _n in _MATH + _SCENEGRAPH + _LPY + _DISPLAY:
     BASE[_n] = globals()[_n]
 BASE["__vd_p"] = _vd.p
+BASE["__vd_kw"] = _vd.kw
 BASE["__vd_mk"] = _vd_mk
