@@ -40,11 +40,6 @@ SCALE = [(r"--count 1000\b", "--count 2"), (r"--count 100\b", "--count 2"), (r"-
          (r"--points 1000000\b", "--points 20000"), (r"--points 100000\b", "--points 5000"),
          (r"--episodes 20\b", "--episodes 2")]
 
-# under the sanitizers (VD_README_CFLAGS set) LeakSanitizer's own tracer dies with SIGSEGV at the
-# exit of `render` of a run folder (sim and harvest runs; since 2026-11-26, not yet understood):
-# those commands and make demo's script run without leak detection here
-lsan = "ASAN_OPTIONS=detect_leaks=0 " if os.environ.get("VD_README_CFLAGS") else ""
-
 blocks = re.findall(r"^```([a-z]*)\n(.*?)^```", readme, re.S | re.M)
 report(len(blocks) >= 8, "README has its code blocks", str(len(blocks)))
 ffmpeg = shutil.which("ffmpeg") is not None
@@ -60,8 +55,7 @@ for kind, body in blocks:
                 r = run(f"make -n -C {src} {cmd[4:].strip()} >/dev/null")
                 report(r.returncode == 0, "make target: " + cmd, r.stderr)
                 if cmd.split()[:2] == ["make", "demo"]:
-                    # see lsan above
-                    r = run(lsan + "bash scripts/demo.sh ./build/verdant")
+                    r = run("bash scripts/demo.sh ./build/verdant")
                     report(r.returncode == 0 and os.path.exists(os.path.join(t, "out/tomato.png")) or
                            "no OpenGL" in r.stderr + r.stdout, "make demo's script", r.stderr + r.stdout)
                 continue
@@ -76,8 +70,7 @@ for kind, body in blocks:
                 continue
             for a, b in SCALE:
                 cmd = re.sub(a, b, cmd)
-            # render of a run folder: see lsan above (LeakSanitizer's tracer dies at exit)
-            r = run((lsan if re.search(r" render \S+/ ", cmd) else "") + cmd)
+            r = run(cmd)
             if "--mp4" in cmd and not ffmpeg:
                 # without ffmpeg the video is skipped with a message (exit 1)
                 report(r.returncode == 1 and "skipped" in r.stderr, cmd, r.stderr)
