@@ -243,6 +243,15 @@ TEST(lpy, in_left_and_right_context) {
   PY_DERIVES("Axiom: B B B A(2) D\nproduction:\nB < A(x) :\n  n = 0\n  while inLeftContext('B'): n += 1\n"
              "  p = {}\n  assert not inRightContext('E(y)', p) and p == {}\n  produce X(n)\n",
              1, "BBBX(2)D");
+  // "As String" matching: each InRightContext goes on after the module it matched (it matched
+  // the same B for ever), after the rule's own right context too; options.find() reads the option
+  const char* str = "Axiom: A B B B A B B\nproduction:\nA > B:\n  n, m = 1, 0\n"
+                    "  while InRightContext(B): n += 1\n  while InLeftContext(B): m += 1\n"
+                    "  assert context().options.find('String matching').currentValue() == 'As String'\n"
+                    "  produce X(n, m)\n"
+                    "###### INITIALISATION ######\ndef __initialiseContext__(context):\n"
+                    "\tcontext.options.setSelection('String matching', 0)\n";
+  PY_DERIVES(str, 1, "X(3,0)BBBX(2,3)BB");
 }
 
 TEST(lpy, scene_argument_of_the_hooks) {

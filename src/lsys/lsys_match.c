@@ -647,6 +647,8 @@ int lsys_rule_match(const lsys_mctx* M, const rule* r, int64_t i, value* frame, 
   }
   int64_t rend = e, rlast = e - 1;
   if (r->right.n && !right_match(&S, &src, e, &rlast, &r->right, 0, r->right.n, &rend, M->string_mode)) return 0;
+  // "As String": an InRightContext goes on after the last module matched, not at it
+  if (r->right.n && M->string_mode) rend = next_module(&src, rend, 0);
   *first = b;
   *end = e;
   if (cur) *cur = (lsys_cur){M, r, lend, rend, rlast};
@@ -667,7 +669,7 @@ int lsys_context_match(vd_lsystem* ls, int right, const pstr* p, value* frame) {
   if (ls->err && ls->err->status) return -1;
   if (!ok) return 0;
   if (right) {
-    c->right = end;
+    c->right = M->string_mode ? next_module(&src, end, 0) : end;  // as in lsys_rule_match
     c->rlast = lm;
   } else {
     c->left = end;

@@ -2588,8 +2588,10 @@ vd_status lsys_set_option(vd_lsystem* ls, const char* name, int nlen, long v, in
                   "unsupported: option 'String matching' = %s (multi-level and multiscale matching)",
                   v == 2 ? "As Multi-level AxialTree" : "As Multiscale AxialTree");
     ls->opt_string_matching = v != 0;
+    ls->rule_index_group = -1;  // the rule index (which rules take the fast matcher) is rebuilt
   } else if (name_is(name, nlen, "Module inheritance")) {
     ls->opt_inherit = v != 0;
+    ls->rule_index_group = -1;  // and its buckets (a rule serves the subclasses)
   }
   return VD_OK;
 }

@@ -872,10 +872,48 @@ class _Options:
     def selection(self, name):
         return self.values.get(name)
 
+    def find(self, name):
+        """An option by its name: currentValue() names its selection (L-Py's LsysOption)."""
+        return _Option(self, name)
+
     def __getattr__(self, name):
         if name.startswith("__"):
             raise AttributeError(name)
         return lambda *a, **k: None
+
+
+# the values of the options that change results, by index, as L-Py names them
+_OPTION_VALUES = {
+    "String matching": ["As String", "As AxialTree", "As Multi-level AxialTree", "As Multiscale AxialTree"],
+    "Module matching": ["Simple", "With Star", "With Star and Value Constraint"],
+    "Early return when no matching": ["Disabled", "Enabled"],
+    "Axiom decomposition": ["Disabled", "Enabled"],
+    "Module inheritance": ["Disabled", "Enabled"],
+}
+_OPTION_DEFAULTS = {"String matching": 1, "Module matching": 1, "Early return when no matching": 1,
+                    "Axiom decomposition": 0, "Module inheritance": 0}
+
+
+class _Option:
+    def __init__(self, options, name):
+        self.options, self.name = options, name
+
+    def selection(self):
+        v = self.options.values.get(self.name, _OPTION_DEFAULTS.get(self.name))
+        if v is None:
+            raise KeyError("option %r: verdant knows the options that change results only" % self.name)
+        return v
+
+    def currentValue(self):
+        v = self.selection()
+        names = _OPTION_VALUES[self.name]
+        return names[v] if isinstance(v, int) and 0 <= v < len(names) else v
+
+    def setSelection(self, value):
+        self.options.setSelection(self.name, value)
+
+    def activateSelection(self):
+        """The selection acts as soon as it is set."""
 
 
 class _TurtleSettings:
