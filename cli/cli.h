@@ -96,6 +96,23 @@ int cli_parse_num(const char* s, double* out);
     }                                                                                              \
     val = argv[++*i];                                                                              \
   } while (0)
+// Inside a command's own argument loop (locals a, val, i, argc, argv and cmd, in a function that
+// returns the exit status): take the option's value into val, or return the usage error (2).
+#define CLI_VAL()                                                                                  \
+  do {                                                                                             \
+    if (i + 1 >= argc) return cli_usage_error(cmd, "%s needs a value", a);                         \
+    val = argv[++i];                                                                               \
+  } while (0)
+// ... and the value as a finite number (cli_parse_num) for which cond holds (cond reads x_) into
+// dst, or the usage error "OPTION expects WHAT, got 'VALUE'".
+#define CLI_NUM(dst, cond, what)                                                                   \
+  do {                                                                                             \
+    CLI_VAL();                                                                                     \
+    double x_;                                                                                     \
+    if (!cli_parse_num(val, &x_) || !(cond))                                                       \
+      return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                        \
+    (dst) = x_;                                                                                    \
+  } while (0)
 // Interrupts: SIGINT and SIGTERM remove the temporary files of the outputs being written (the
 // watched ones), then end the process by the same signal. Call once from main.
 void cli_signals_init(void);

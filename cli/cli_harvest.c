@@ -253,13 +253,9 @@ static void traj_header(FILE* f, int nq) {
 }
 
 static void progress_bar(double t, double total) {
-  int w = 30, fill = total > 0 ? (int)(t / total * w) : w;
-  if (fill > w) fill = w;
-  char bar[64];
-  for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
-  bar[w] = 0;
-  fprintf(stderr, "\rharvesting [%s] %.2f / %.2f s", bar, t, total);
-  fflush(stderr);
+  char text[64];
+  snprintf(text, sizeof text, "%.2f / %.2f s", t, total);
+  cli_progress_bar("harvesting", total > 0 ? t / total : 1, text);
 }
 
 static vd_status on_step(void* user, const vd_harvest* h) {
@@ -686,13 +682,10 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
       if (!es) done++;
       if (o->progress) {
         double el = cli_now() - t0;
-        int wbar = 30, fill = ntodo ? done * wbar / ntodo : wbar;
-        char bar[64];
-        for (int k = 0; k < wbar; k++) bar[k] = k < fill ? '#' : ' ';
-        bar[wbar] = 0;
-        fprintf(stderr, "\rharvest [%s] %d/%d episodes, %.1f episodes/min   ", bar, done, ntodo,
-                el > 0 ? 60 * done / el : 0.0);
-        fflush(stderr);
+        char line[96];
+        snprintf(line, sizeof line, "%d/%d episodes, %.1f episodes/min   ", done, ntodo,
+                 el > 0 ? 60 * done / el : 0.0);
+        cli_progress_bar("harvest", ntodo ? (double)done / ntodo : 1, line);
       }
     }
   }

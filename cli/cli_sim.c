@@ -488,33 +488,22 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
     int r = cli_plant_opt(&o->po, cmd, argc, argv, &i);
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
-#define VAL()                                                                                     \
-  do {                                                                                            \
-    if (i + 1 >= argc) return cli_usage_error(cmd, "%s needs a value", a);                        \
-    val = argv[++i];                                                                              \
-  } while (0)
-#define NUM(dst, cond, what)                                                                      \
-  do {                                                                                            \
-    VAL();                                                                                        \
-    double x_;                                                                                    \
-    if (!parse_num(val, &x_) || !isfinite(x_) || !(cond)) return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val); \
-    (dst) = x_;                                                                                   \
-  } while (0)
     const char* val = NULL;
     if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-      VAL();
+      CLI_VAL();
       o->out = val;
     } else if (!strcmp(a, "--duration")) {
-      NUM(o->duration, x_ >= 0, "a time >= 0 (s)");
+      CLI_NUM(o->duration, x_ >= 0, "a time >= 0 (s)");
       o->duration_set = 1;
     } else if (!strcmp(a, "--dt")) {
-      NUM(o->opt.dt, x_ > 0 && x_ <= 1, "a time step in (0, 1] (s)");
+      CLI_NUM(o->opt.dt, x_ > 0 && x_ <= 1, "a time step in (0, 1] (s)");
     } else if (!strcmp(a, "--iterations")) {
-      NUM(o->opt.iterations, x_ >= 1 && x_ <= 10000 && x_ == floor(x_), "an integer in 1..10000");
+      CLI_NUM(o->opt.iterations, x_ >= 1 && x_ <= 10000 && x_ == floor(x_),
+              "an integer in 1..10000");
     } else if (!strcmp(a, "--threads")) {
-      NUM(o->opt.threads, x_ >= 1 && x_ <= 64 && x_ == floor(x_), "an integer in 1..64");
+      CLI_NUM(o->opt.threads, x_ >= 1 && x_ <= 64 && x_ == floor(x_), "an integer in 1..64");
     } else if (!strcmp(a, "--solver")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "direct")) o->opt.solver = VD_SIM_DIRECT;
       else if (!strcmp(val, "gs")) o->opt.solver = VD_SIM_GS;
       else return cli_usage_error(cmd, "--solver expects direct or gs, got '%s'", val);
@@ -523,15 +512,15 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
     } else if (!strcmp(a, "--statics")) {
       o->statics = 1;
     } else if (!strcmp(a, "--ke-tol")) {
-      NUM(o->ke_tol, x_ > 0, "an energy > 0 (J)");
+      CLI_NUM(o->ke_tol, x_ > 0, "an energy > 0 (J)");
       o->ke_tol_set = 1;
     } else if (!strcmp(a, "--sag-free")) {
       o->def.sag_free = 1;
     } else if (!strcmp(a, "--stake")) {
-      NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
+      CLI_NUM(o->def.stake_spacing, x_ > 0, "a spacing > 0 (m)");
     } else if (!strcmp(a, "--segment-length")) {
       // S for every class, or C=S for class C (model reduction: wood coarser than green stems)
-      VAL();
+      CLI_VAL();
       const char* eq = strchr(val, '=');
       double x_;
       char name[32];
@@ -548,60 +537,62 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       else
         o->def.segment_length = x_;
     } else if (!strcmp(a, "--active-radius")) {
-      NUM(o->def.active_radius, x_ > 0, "a distance > 0 (m)");
+      CLI_NUM(o->def.active_radius, x_ > 0, "a distance > 0 (m)");
     } else if (!strcmp(a, "--active-center")) {
-      VAL();
+      CLI_VAL();
       double v[3];
       if (!parse_list(val, v, 3)) return cli_usage_error(cmd, "--active-center expects X,Y,Z (m), got '%s'", val);
       o->def.active_a = o->def.active_b = vd_v3(v[0], v[1], v[2]);
       o->active_center_set = 1;
     } else if (!strcmp(a, "--active-organ")) {
-      VAL();
+      CLI_VAL();
       char spec[80];
       snprintf(spec, sizeof spec, "%s=0,0,0", val);
       if (strlen(val) > 60 || !parse_pull(spec, &o->active_organ, 0))
         return cli_usage_error(cmd, "--active-organ expects ORGAN or ORGAN#INSTANCE, got '%s'", val);
     } else if (!strcmp(a, "--leaves")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "graph")) o->def.leaf_graphs = 1;
       else if (!strcmp(val, "midrib")) o->def.leaf_graphs = 2;
       else if (!strcmp(val, "rigid")) o->def.leaf_graphs = 0;
       else return cli_usage_error(cmd, "--leaves expects graph, midrib or rigid, got '%s'", val);
     } else if (!strcmp(a, "--leaf-segments")) {
-      NUM(o->def.leaf_segments, x_ >= 1 && x_ <= 1000 && x_ == floor(x_), "an integer in 1..1000");
+      CLI_NUM(o->def.leaf_segments, x_ >= 1 && x_ <= 1000 && x_ == floor(x_),
+              "an integer in 1..1000");
     } else if (!strcmp(a, "--clamp")) {
-      NUM(o->def.clamp_length, x_ >= 0 && x_ <= 1e3, "a length >= 0 (m)");
+      CLI_NUM(o->def.clamp_length, x_ >= 0 && x_ <= 1e3, "a length >= 0 (m)");
     } else if (!strcmp(a, "--max-segments")) {
-      NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_), "an integer in 1..2000000000");
+      CLI_NUM(o->def.max_segments, x_ >= 1 && x_ <= 2e9 && x_ == floor(x_),
+              "an integer in 1..2000000000");
     } else if (!strcmp(a, "--bend-measure")) {
-      VAL();
+      CLI_VAL();
       int b = vd_sim_bend_parse(val);
       if (b < 0) return cli_usage_error(cmd, "--bend-measure expects log or quat, got '%s'", val);
       o->def.bend_measure = (vd_sim_bend)b;
     } else if (!strcmp(a, "--max-steps")) {
-      NUM(o->max_steps, x_ >= 1 && x_ <= 1e15 && x_ == floor(x_), "an integer in 1..1e15");
+      CLI_NUM(o->max_steps, x_ >= 1 && x_ <= 1e15 && x_ == floor(x_), "an integer in 1..1e15");
     } else if (!strcmp(a, "--young")) {
-      VAL();
+      CLI_VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, young), 1, 1)) return EXIT_USAGE;
     } else if (!strcmp(a, "--density")) {
-      VAL();
+      CLI_VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, density), 1, 1)) return EXIT_USAGE;
     } else if (!strcmp(a, "--poisson")) {
-      VAL();
+      CLI_VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, poisson), 1, 0)) return EXIT_USAGE;
     } else if (!strcmp(a, "--break-force")) {
-      VAL();
+      CLI_VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, break_force), 1, 1)) return EXIT_USAGE;
     } else if (!strcmp(a, "--break-moment")) {
-      VAL();
+      CLI_VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, break_moment), 1, 1)) return EXIT_USAGE;
     } else if (!strcmp(a, "--break-strain")) {
-      VAL();
+      CLI_VAL();
       if (!class_value(cmd, a, val, &o->def, offsetof(vd_sim_material, break_cs), 2, 1)) return EXIT_USAGE;
     } else if (!strcmp(a, "--no-fracture")) {
       o->opt.fracture = 0;
     } else if (!strcmp(a, "--gravity") || !strcmp(a, "--wind")) {
-      VAL();
+      CLI_VAL();
       double v[3];
       if (!parse_list(val, v, 3)) return cli_usage_error(cmd, "%s expects X,Y,Z (%s), got '%s'", a, a[2] == 'g' ? "m/s^2" : "m/s", val);
       for (int k = 0; k < 3; k++)
@@ -611,29 +602,29 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       if (a[2] == 'g') o->opt.gravity = o->def.gravity = vd_v3(v[0], v[1], v[2]);
       else o->opt.wind = vd_v3(v[0], v[1], v[2]);
     } else if (!strcmp(a, "--gust")) {
-      VAL();
+      CLI_VAL();
       double v[2];
       if (!parse_list(val, v, 2) || !(v[1] > 0)) return cli_usage_error(cmd, "--gust expects AMPLITUDE,PERIOD (-, s > 0), got '%s'", val);
       o->opt.gust_amplitude = v[0], o->opt.gust_period = v[1];
       o->gust_set = 1;
     } else if (!strcmp(a, "--wind-file")) {
-      VAL();
+      CLI_VAL();
       o->wind_file = val;
     } else if (!strcmp(a, "--no-drag")) {
       o->opt.drag = 0;
     } else if (!strcmp(a, "--stokes")) {
-      NUM(o->opt.stokes_viscosity, x_ >= 0, "a viscosity >= 0 (Pa s)");
+      CLI_NUM(o->opt.stokes_viscosity, x_ >= 0, "a viscosity >= 0 (Pa s)");
     } else if (!strcmp(a, "--damping")) {
-      NUM(o->opt.damping, x_ >= 0, "a time >= 0 (s)");
+      CLI_NUM(o->opt.damping, x_ >= 0, "a time >= 0 (s)");
     } else if (!strcmp(a, "--mass-damping")) {
-      NUM(o->opt.mass_damping, x_ >= 0, "a rate >= 0 (1/s)");
+      CLI_NUM(o->opt.mass_damping, x_ >= 0, "a rate >= 0 (1/s)");
     } else if (!strcmp(a, "--ground")) {
-      NUM(o->ground, 1, "a height (m)");
+      CLI_NUM(o->ground, 1, "a height (m)");
       o->no_ground = 0;
     } else if (!strcmp(a, "--no-ground")) {
       o->no_ground = 1;
     } else if (!strcmp(a, "--collider-mesh")) {
-      VAL();
+      CLI_VAL();
       if (o->nmesh == 8) return cli_usage_error(cmd, "too many --collider-mesh options (8 at most)");
       char* m = o->mesh_path[o->nmesh];
       if (strlen(val) >= sizeof o->mesh_path[0]) return cli_usage_error(cmd, "--collider-mesh: path too long");
@@ -644,7 +635,7 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
       if (colon && parse_list(colon + 1, x, 3)) *colon = 0, at = vd_v3(x[0], x[1], x[2]);
       o->mesh_pos[o->nmesh++] = at;
     } else if (!strcmp(a, "--soil")) {
-      VAL();
+      CLI_VAL();
       vd_soil tmp;
       if (vd_soil_preset(val, &tmp) != VD_OK)
         return cli_usage_error(cmd, "--soil expects clamp, loam, sandy-loam, clay or singapore-residual, got '%s'", val);
@@ -654,39 +645,39 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
     } else if (!strcmp(a, "--no-self-collision")) {
       o->opt.self_collision = 0;
     } else if (!strcmp(a, "--probe")) {
-      VAL();
+      CLI_VAL();
       if (o->nprobe == 16) return cli_usage_error(cmd, "too many --probe options (16 at most)");
       if (!parse_probe(val, &o->probe[o->nprobe]))
         return cli_usage_error(cmd, "--probe expects R:X0,Y0,Z0:X1,Y1,Z1[:T0:T1] (m, s; R > 0, T1 > T0), got '%s'", val);
       o->nprobe++;
     } else if (!strcmp(a, "--pull") || !strcmp(a, "--move")) {
-      VAL();
+      CLI_VAL();
       if (o->npull == 16) return cli_usage_error(cmd, "too many --pull/--move options (16 at most)");
       if (!parse_pull(val, &o->pull[o->npull], a[2] == 'm'))
         return cli_usage_error(cmd, "%s expects ORGAN[#INSTANCE]=X,Y,Z (%s), got '%s'", a, a[2] == 'm' ? "m" : "N", val);
       o->npull++;
     } else if (!strcmp(a, "--ramp")) {
-      NUM(o->ramp, x_ >= 0, "a time >= 0 (s)");
+      CLI_NUM(o->ramp, x_ >= 0, "a time >= 0 (s)");
       o->ramp_set = 1;
     } else if (!strcmp(a, "--frames")) {
-      VAL();
+      CLI_VAL();
       if (strcmp(val, "bin") != 0 && strcmp(val, "jsonl") != 0 && strcmp(val, "none") != 0)
         return cli_usage_error(cmd, "--frames expects bin, jsonl or none, got '%s'", val);
       o->frames = val;
     } else if (!strcmp(a, "--fps")) {
-      NUM(o->fps, x_ > 0 && x_ <= 100000, "a rate in (0, 100000] (1/s)");
+      CLI_NUM(o->fps, x_ > 0 && x_ <= 100000, "a rate in (0, 100000] (1/s)");
       o->fps_set = 1;
     } else if (!strcmp(a, "--final")) {
-      VAL();
+      CLI_VAL();
       if (!cli_has_ext(val, ".json") && !cli_has_ext(val, ".obj") && !cli_has_ext(val, ".ply"))
         return cli_usage_error(cmd, "--final '%s': unknown format (use .json, .obj or .ply)", val);
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
     } else if (!strcmp(a, "--batch")) {
-      NUM(o->batch, x_ >= 1 && x_ <= 1e6 && x_ == floor(x_), "an integer in 1..1000000");
+      CLI_NUM(o->batch, x_ >= 1 && x_ <= 1e6 && x_ == floor(x_), "an integer in 1..1000000");
     } else if (!strcmp(a, "--jobs")) {
-      NUM(o->jobs, x_ >= 1 && x_ <= 1024 && x_ == floor(x_), "an integer in 1..1024");
+      CLI_NUM(o->jobs, x_ >= 1 && x_ <= 1024 && x_ == floor(x_), "an integer in 1..1024");
     } else if (!strcmp(a, "--profile")) {
       o->profile = 1;
     } else if (a[0] == '-' && a[1]) {
@@ -696,8 +687,6 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
     } else {
       return cli_usage_error(cmd, "unexpected argument '%s'", a);
     }
-#undef NUM
-#undef VAL
   }
   return EXIT_OK;
 }

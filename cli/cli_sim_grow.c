@@ -114,33 +114,20 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     if (r < 0) return EXIT_USAGE;
     if (r > 0) continue;
     const char* val = NULL;
-#define VAL()                                                                                     \
-  do {                                                                                            \
-    if (i + 1 >= argc) return cli_usage_error(cmd, "%s needs a value", a);                        \
-    val = argv[++i];                                                                              \
-  } while (0)
-#define NUM(dst, cond, what)                                                                      \
-  do {                                                                                            \
-    VAL();                                                                                        \
-    double x_;                                                                                    \
-    if (!cli_parse_num(val, &x_) || !isfinite(x_) || !(cond))                                     \
-      return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                      \
-    (dst) = x_;                                                                                   \
-  } while (0)
-#define PAIR(d0, d1, cond, what, inf)                                                             \
-  do {                                                                                            \
-    VAL();                                                                                        \
-    double v_[2];                                                                                 \
-    if (!nums(val, v_, 2, inf) || !(cond))                                                        \
-      return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                      \
-    (d0) = v_[0], (d1) = v_[1];                                                                   \
+#define PAIR(d0, d1, cond, what, inf)                                                              \
+  do {                                                                                             \
+    CLI_VAL();                                                                                     \
+    double v_[2];                                                                                  \
+    if (!nums(val, v_, 2, inf) || !(cond))                                                         \
+      return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                        \
+    (d0) = v_[0], (d1) = v_[1];                                                                    \
   } while (0)
     if (!strcmp(a, "--grow")) {
     } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-      VAL();
+      CLI_VAL();
       o->out = val;
     } else if (!strcmp(a, "--final")) {
-      VAL();
+      CLI_VAL();
       if (!cli_has_ext(val, ".json") && !cli_has_ext(val, ".obj") && !cli_has_ext(val, ".ply"))
         return cli_usage_error(cmd, "--final '%s': unknown format (use .json, .obj or .ply)", val);
       o->final = val;
@@ -150,17 +137,18 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       o->ply = 1;
     } else if (!strcmp(a, "--ages")) {
       double x;
-      NUM(x, x_ >= 0 && x_ <= 10000 && x_ == floor(x_), "a whole number of age steps in 0..10000");
+      CLI_NUM(x, x_ >= 0 && x_ <= 10000 && x_ == floor(x_),
+              "a whole number of age steps in 0..10000");
       o->ages = (int)x;
     } else if (!strcmp(a, "--substeps")) {
       double x;
-      NUM(x, x_ >= 1 && x_ <= 1e7 && x_ == floor(x_), "a whole number of substeps >= 1");
+      CLI_NUM(x, x_ >= 1 && x_ <= 1e7 && x_ == floor(x_), "a whole number of substeps >= 1");
       d->substeps = (int)x;
     } else if (!strcmp(a, "--dt")) {
-      NUM(d->opt.dt, x_ > 0 && x_ <= 1e6, "a time step > 0 (s)");
+      CLI_NUM(d->opt.dt, x_ > 0 && x_ <= 1e6, "a time step > 0 (s)");
       d->rod_opt.dt = d->opt.dt;
     } else if (!strcmp(a, "--model")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "mss")) d->model = VD_GROWTH_MSS;
       else if (!strcmp(val, "mrl")) d->model = VD_GROWTH_MRL;
       else if (!strcmp(val, "rods")) d->model = VD_GROWTH_RODS;
@@ -168,26 +156,26 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     } else if (!strcmp(a, "--paper")) {
       vd_growth_def_paper(d);
     } else if (!strcmp(a, "--springs")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "material")) d->mss.springs = VD_MSS_MATERIAL;
       else if (!strcmp(val, "paper")) d->mss.springs = VD_MSS_PAPER;
       else return cli_usage_error(cmd, "--springs expects material or paper, got '%s'", val);
     } else if (!strcmp(a, "--integrator")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "implicit")) d->opt.integrator = VD_MSS_IMPLICIT;
       else if (!strcmp(val, "eq3")) d->opt.integrator = VD_MSS_EQ3;
       else if (!strcmp(val, "eq4")) d->opt.integrator = VD_MSS_EQ4;
       else return cli_usage_error(cmd, "--integrator expects implicit, eq3 or eq4, got '%s'", val);
     } else if (!strcmp(a, "--rigid-age")) {
-      NUM(d->mss.rigid_age, x_ >= 0, "an age >= 0 (years)");
+      CLI_NUM(d->mss.rigid_age, x_ >= 0, "an age >= 0 (years)");
     } else if (!strcmp(a, "--woody-age")) {
-      NUM(d->mss.woody_age, x_ >= 0, "an age >= 0 (years)");
+      CLI_NUM(d->mss.woody_age, x_ >= 0, "an age >= 0 (years)");
     } else if (!strcmp(a, "--k0")) {
       PAIR(d->mss.k0_green, d->mss.k0_wood, v_[0] > 0 && v_[1] > 0, "GREEN,WOOD spring constants > 0 (N/m)", 0);
     } else if (!strcmp(a, "--damping")) {
-      NUM(d->mss.damping, x_ >= 0, "a damping constant c >= 0");
+      CLI_NUM(d->mss.damping, x_ >= 0, "a damping constant c >= 0");
     } else if (!strcmp(a, "--species")) {
-      VAL();
+      CLI_VAL();
       vd_wood w;
       if (vd_wood_species(val, &w) != VD_OK) {
         char list[256] = "";
@@ -205,16 +193,16 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     } else if (!strcmp(a, "--no-breaking")) {
       d->opt.breaking = 0;
     } else if (!strcmp(a, "--eq8")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "paper")) d->paper_eq8 = 1;
       else if (!strcmp(val, "corrected")) d->paper_eq8 = 0;
       else return cli_usage_error(cmd, "--eq8 expects paper or corrected, got '%s'", val);
     } else if (!strcmp(a, "--no-stress-free")) {
       d->stress_free = 0;
     } else if (!strcmp(a, "--strain-limit")) {
-      NUM(d->opt.strain_limit, x_ >= 0 && x_ < 1, "a relative stretch in [0, 1)");
+      CLI_NUM(d->opt.strain_limit, x_ >= 0 && x_ < 1, "a relative stretch in [0, 1)");
     } else if (!strcmp(a, "--gravity") || !strcmp(a, "--wind")) {
-      VAL();
+      CLI_VAL();
       double v[3];
       int g = a[2] == 'g';
       double lim = g ? 1e4 : VD_SIM_MAX_WIND;
@@ -226,26 +214,26 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       PAIR(d->opt.gust_amplitude, d->opt.gust_period, v_[1] > 0, "AMPLITUDE,PERIOD (-, s > 0)", 0);
       d->rod_opt.gust_amplitude = d->opt.gust_amplitude, d->rod_opt.gust_period = d->opt.gust_period;
     } else if (!strcmp(a, "--wind-file")) {
-      VAL();
+      CLI_VAL();
       o->wind_file = val;
     } else if (!strcmp(a, "--wind-model")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "area")) d->opt.wind_model = VD_MSS_WIND_AREA;
       else if (!strcmp(val, "paper")) d->opt.wind_model = VD_MSS_WIND_PAPER;
       else return cli_usage_error(cmd, "--wind-model expects area or paper, got '%s'", val);
     } else if (!strcmp(a, "--drag")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "quadratic")) d->opt.drag = VD_MSS_DRAG_QUADRATIC;
       else if (!strcmp(val, "stokes")) d->opt.drag = VD_MSS_DRAG_STOKES;
       else if (!strcmp(val, "none")) d->opt.drag = VD_MSS_DRAG_NONE;
       else return cli_usage_error(cmd, "--drag expects quadratic, stokes or none, got '%s'", val);
       d->rod_opt.drag = d->opt.drag == VD_MSS_DRAG_QUADRATIC;
     } else if (!strcmp(a, "--cd")) {
-      NUM(d->opt.drag_cd, x_ >= 0, "a drag coefficient >= 0");
+      CLI_NUM(d->opt.drag_cd, x_ >= 0, "a drag coefficient >= 0");
     } else if (!strcmp(a, "--leaf-cd")) {
-      NUM(d->opt.leaf_cd, x_ >= 0, "a drag coefficient >= 0");
+      CLI_NUM(d->opt.leaf_cd, x_ >= 0, "a drag coefficient >= 0");
     } else if (!strcmp(a, "--light")) {
-      VAL();
+      CLI_VAL();
       char buf[256];
       if (strlen(val) >= sizeof buf) return cli_usage_error(cmd, "--light: value too long");
       strcpy(buf, val);
@@ -256,7 +244,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
         return cli_usage_error(cmd, "--light expects X,Y,Z[:K] (m, N m^2), got '%s'", val);
       d->opt.light = 1, d->opt.light_pos = vd_v3(v[0], v[1], v[2]), d->opt.light_k = k;
     } else if (!strcmp(a, "--gravitropism")) {
-      VAL();
+      CLI_VAL();
       double v[2];
       if (!strcmp(val, "none")) {
         d->opt.gravitropism = VD_MSS_GRAVI_NONE;
@@ -270,32 +258,34 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
         return cli_usage_error(cmd, "--gravitropism expects none, sine[:K] or bastien[:BETA,GAMMA], got '%s'", val);
       }
     } else if (!strcmp(a, "--soil")) {
-      VAL();
+      CLI_VAL();
       double ground = d->mss.soil.ground;
       if (vd_soil_preset(val, &d->mss.soil) != VD_OK)
         return cli_usage_error(cmd, "--soil expects clamp, loam, sandy-loam, clay or singapore-residual, got '%s'", val);
       d->mss.soil.ground = ground;
     } else if (!strcmp(a, "--soil-method")) {
-      VAL();
+      CLI_VAL();
       if (!strcmp(val, "imhoff")) d->mss.soil.method = VD_SOIL_IMHOFF2016;
       else if (!strcmp(val, "pang")) d->mss.soil.method = VD_SOIL_PANG2023;
       else return cli_usage_error(cmd, "--soil-method expects imhoff or pang, got '%s'", val);
     } else if (!strcmp(a, "--clay")) {
-      NUM(d->mss.soil.clay, x_ >= 0 && x_ <= 100, "a clay content in [0, 100] (%)");
+      CLI_NUM(d->mss.soil.clay, x_ >= 0 && x_ <= 100, "a clay content in [0, 100] (%)");
     } else if (!strcmp(a, "--organic")) {
-      NUM(d->mss.soil.organic, x_ >= 0 && x_ <= 100, "an organic matter content in [0, 100] (%)");
+      CLI_NUM(d->mss.soil.organic, x_ >= 0 && x_ <= 100,
+              "an organic matter content in [0, 100] (%)");
     } else if (!strcmp(a, "--water")) {
-      NUM(d->mss.soil.water, x_ > 0 && x_ <= 1, "a volumetric water content in (0, 1] (m^3/m^3)");
+      CLI_NUM(d->mss.soil.water, x_ > 0 && x_ <= 1,
+              "a volumetric water content in (0, 1] (m^3/m^3)");
     } else if (!strcmp(a, "--bulk-density")) {
-      NUM(d->mss.soil.bulk_density, x_ > 0 && x_ < 3, "a bulk density in (0, 3) (Mg/m^3)");
+      CLI_NUM(d->mss.soil.bulk_density, x_ > 0 && x_ < 3, "a bulk density in (0, 3) (Mg/m^3)");
     } else if (!strcmp(a, "--poisson")) {
-      NUM(d->mss.soil.poisson, x_ >= 0 && x_ < 0.5, "a Poisson ratio in [0, 0.5)");
+      CLI_NUM(d->mss.soil.poisson, x_ >= 0 && x_ < 0.5, "a Poisson ratio in [0, 0.5)");
     } else if (!strcmp(a, "--ptf")) {
-      VAL();
+      CLI_VAL();
       if (!nums(val, d->mss.soil.ptf, 8, 0)) return cli_usage_error(cmd, "--ptf expects 8 numbers C0,C1,C2,D0,D1,D2,E0,E1, got '%s'", val);
     } else if (!strcmp(a, "--uproot-tilt")) {
       double deg;
-      NUM(deg, x_ > 0 && x_ < 180, "an angle in (0, 180) (degrees)");
+      CLI_NUM(deg, x_ > 0 && x_ < 180, "an angle in (0, 180) (degrees)");
       d->uproot_tilt = deg * VD_PI / 180;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error(cmd, "unknown option '%s'", a);
@@ -305,8 +295,6 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       return cli_usage_error(cmd, "unexpected argument '%s'", a);
     }
 #undef PAIR
-#undef NUM
-#undef VAL
   }
   return EXIT_OK;
 }

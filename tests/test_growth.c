@@ -43,19 +43,23 @@ TEST(growth, derive_step_matches_derive) {
   vd_lsys_destroy(ls);
 }
 
-static vd_growth* grow_tree(vd_lsystem* ls, vd_growth_model model, int ages, double wind, vd_error* e) {
-  vd_growth_def def = vd_growth_def_default();
-  def.model = model;
-  def.substeps = 10;
-  def.opt.wind = vd_v3(wind, 0, 0);
+static vd_growth* grow_def(vd_lsystem* ls, const vd_growth_def* def, int ages, vd_error* e) {
   vd_growth* g = NULL;
-  if (vd_growth_create(ls, &def, &g, e)) return NULL;
+  if (vd_growth_create(ls, def, &g, e)) return NULL;
   for (int k = 0; k < ages; k++)
     if (vd_growth_step(g, e)) {
       vd_growth_destroy(g);
       return NULL;
     }
   return g;
+}
+
+static vd_growth* grow_tree(vd_lsystem* ls, vd_growth_model model, int ages, double wind, vd_error* e) {
+  vd_growth_def def = vd_growth_def_default();
+  def.model = model;
+  def.substeps = 10;
+  def.opt.wind = vd_v3(wind, 0, 0);
+  return grow_def(ls, &def, ages, e);
 }
 
 TEST(growth, tree_mss_and_mrl_conserve_momentum) {
@@ -172,14 +176,7 @@ static vd_growth* grow_soil(vd_lsystem* ls, const char* soil, double weaker, vd_
   if (vd_soil_preset(soil, &def.mss.soil)) return NULL;
   def.mss.soil.method = method;
   def.mss.soil.ptf[0] -= log(weaker);
-  vd_growth* g = NULL;
-  if (vd_growth_create(ls, &def, &g, e)) return NULL;
-  for (int k = 0; k < 3; k++)
-    if (vd_growth_step(g, e)) {
-      vd_growth_destroy(g);
-      return NULL;
-    }
-  return g;
+  return grow_def(ls, &def, 3, e);
 }
 
 static int has_event(const vd_growth* g, int kind) {
