@@ -197,13 +197,18 @@ SIM_INLINE void qmul_lanes(lane* restrict a, lane* restrict b, lane* restrict c,
 // t = |Im q| / Re q <= 0.1 (its series); elsewhere need[l] = 1 and the caller calls quat_log
 SIM_INLINE void qlog_lanes(lane* restrict q, lane* restrict v, lane need) {
   L {
-    double sg = q[0][l] < 0 ? -1.0 : 1.0;
+    // (-0: sg = -1, w = +0 instead of 1 and -0: not ok either way; copysign keeps the loop
+    // free of branches, a comparison was threaded into them once inlined)
+    double sg = copysign(1.0, q[0][l]);
     double w = sg * q[0][l], x = sg * q[1][l], y = sg * q[2][l], z = sg * q[3][l];
     double s2 = x * x + y * y + z * z, w2 = w * w;
-    int ok = w > 0 && s2 <= 0.01 * w2;
-    double k = 2 * sim_atan_ratio(ok ? s2 / w2 : 0.0) / (ok ? w : 1.0);
+    // operands picked, not operations, all in doubles: a conditional division, or an int
+    // flag, keeps the loop scalar
+    double ok = w > 0 ? 1.0 : 0.0;
+    ok = s2 <= 0.01 * w2 ? ok : 0.0;
+    double k = 2 * sim_atan_ratio((ok > 0 ? s2 : 0.0) / (ok > 0 ? w2 : 1.0)) / (ok > 0 ? w : 1.0);
     v[0][l] = k * x, v[1][l] = k * y, v[2][l] = k * z;
-    need[l] = ok ? 0.0 : 1.0;
+    need[l] = 1.0 - ok;
   }
 }
 
@@ -226,28 +231,72 @@ SIM_INLINE void qrot_lanes(lane* restrict q, lane* restrict v, lane need) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// the step's frame velocities, SIM_W segments at a time (the log map's series vectorises)
+// the frames' prediction and velocities, SIM_W segments at a time (the maps' series vectorise).
+// Whole groups move between the segments' quaternions and the lanes by interleaved loads and
+// stores in lane loops (vector permutes): lanes filled or read one scalar at a time made the
+// vector code wait on store forwarding.
+
+// lanes of SIM_W consecutive quaternions (n < SIM_W: the rest repeat the first)
+SIM_INLINE void quat_lanes(const vd_quat* restrict src, int n, lane* restrict q) {
+  if (n == SIM_W) {
+    const double* restrict a = (const double*)src;
+    L q[0][l] = a[4 * l], q[1][l] = a[4 * l + 1], q[2][l] = a[4 * l + 2], q[3][l] = a[4 * l + 3];
+    return;
+  }
+  for (int l = 0; l < SIM_W; l++) {
+    vd_quat c = src[l < n ? l : 0];
+    q[0][l] = c.w, q[1][l] = c.x, q[2][l] = c.y, q[3][l] = c.z;
+  }
+}
+
+// segments [t0, t1) of a dynamic step with the loads kept in the residual (the direct solver):
+// seg_prev = the frame, the frame turned by h omega (fixed ones kept): quat_rotate_by's bytes
+SIM_CLONES void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h, int t0, int t1) {
+  memcpy(w->seg_prev + t0, d->seg_quat + t0, (size_t)(t1 - t0) * sizeof(vd_quat));
+  for (int b = t0; b < t1; b += SIM_W) {
+    int n = t1 - b < SIM_W ? t1 - b : SIM_W;
+    // a last short group goes through a padded copy (the lane loops stay free of branches)
+    vd_quat qb[SIM_W];
+    vd_vec3 ob[SIM_W];
+    const double *qs = (const double*)(d->seg_quat + b), *os = (const double*)(d->seg_omega + b);
+    double* qo = (double*)(d->seg_quat + b);
+    if (n < SIM_W) {
+      for (int l = 0; l < SIM_W; l++) qb[l] = d->seg_quat[b + (l < n ? l : 0)], ob[l] = d->seg_omega[b + (l < n ? l : 0)];
+      qs = (const double*)qb, os = (const double*)ob, qo = (double*)qb;
+    }
+    lane q[4], v[3], need;
+    L q[0][l] = qs[4 * l], q[1][l] = qs[4 * l + 1], q[2][l] = qs[4 * l + 2], q[3][l] = qs[4 * l + 3];
+    L v[0][l] = os[3 * l] * h, v[1][l] = os[3 * l + 1] * h, v[2][l] = os[3 * l + 2] * h;
+    qrot_lanes(q, v, need);
+    L qo[4 * l] = q[0][l], qo[4 * l + 1] = q[1][l], qo[4 * l + 2] = q[2][l], qo[4 * l + 3] = q[3][l];
+    if (n < SIM_W) memcpy(d->seg_quat + b, qb, (size_t)n * sizeof(vd_quat));
+    // fixed frames stay; turns beyond the series' range take the scalar map
+    for (int l = 0; l < n; l++) {
+      int t = b + l;
+      if (m->seg_flags[t] & VD_SIM_FIXED) d->seg_quat[t] = w->seg_prev[t];
+      else if (need[l] > 0) d->seg_quat[t] = quat_rotate_by(w->seg_prev[t], vd_scale(d->seg_omega[t], h));
+    }
+  }
+}
 
 SIM_CLONES void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work* w, double s, int t0, int t1) {
   for (int b = t0; b < t1; b += SIM_W) {
     int n = t1 - b < SIM_W ? t1 - b : SIM_W;
     lane q[4], qp[4], dq[4], v[3], need;
-    for (int l = 0; l < SIM_W; l++) {
-      int t = b + (l < n ? l : 0);
-      vd_quat a = d->seg_quat[t], c = w->seg_prev[t];
-      q[0][l] = a.w, q[1][l] = a.x, q[2][l] = a.y, q[3][l] = a.z;
-      qp[0][l] = c.w, qp[1][l] = c.x, qp[2][l] = c.y, qp[3][l] = c.z;
-    }
+    quat_lanes(d->seg_quat + b, n, q);
+    quat_lanes(w->seg_prev + b, n, qp);
     qmul_lanes(q, qp, dq, 1, -1);
     qlog_lanes(dq, v, need);
+    if (n == SIM_W) {
+      double* restrict o = (double*)(d->seg_omega + b);
+      L o[3 * l] = v[0][l] * s, o[3 * l + 1] = v[1][l] * s, o[3 * l + 2] = v[2][l] * s;
+    } else {
+      for (int l = 0; l < n; l++) d->seg_omega[b + l] = vd_v3(v[0][l] * s, v[1][l] * s, v[2][l] * s);
+    }
     for (int l = 0; l < n; l++) {
       int t = b + l;
-      if (m->seg_flags[t] & VD_SIM_FIXED) {
-        d->seg_omega[t] = vd_v3(0, 0, 0);
-        continue;
-      }
-      vd_vec3 r = need[l] > 0 ? quat_log((vd_quat){dq[0][l], dq[1][l], dq[2][l], dq[3][l]}) : vd_v3(v[0][l], v[1][l], v[2][l]);
-      d->seg_omega[t] = vd_scale(r, s);
+      if (m->seg_flags[t] & VD_SIM_FIXED) d->seg_omega[t] = vd_v3(0, 0, 0);
+      else if (need[l] > 0) d->seg_omega[t] = vd_scale(quat_log((vd_quat){dq[0][l], dq[1][l], dq[2][l], dq[3][l]}), s);
     }
   }
 }
@@ -310,6 +359,16 @@ PROF_NOINLINE static void gather_in(const vd_sim_model* m, const vd_sim_data* d,
   }
 }
 
+// what the linearisation of a block passes to its elimination alone (on the stack)
+typedef struct sim_fw {
+  lane c[6];    // damped constraint values c': stretch rows in world axes (m), bend (1/m)
+  lane al[9];   // damped compliances alpha~': stretch (upper 3x3, world), bend (diagonal)
+  lane lf[6];   // the joint's multipliers: stretch as R lambda_s / l0 (world), bend
+  lane mi[3];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib
+  lane d3[3];   // the frame's d3
+  lane ok;      // 1 while both factorisations of the lane held
+} sim_fw;
+
 // bend-twist strain and its Jacobian dC/dpsi of the lanes (sim_bend_strain, lane-parallel);
 // lanes whose log needs libm are recomputed by sim_bend_strain itself
 SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane* restrict dc) {
@@ -319,7 +378,7 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
   L {
     double dot = qr[0][l] * in->st->q0[0][l] + qr[1][l] * in->st->q0[1][l] + qr[2][l] * in->st->q0[2][l] + qr[3][l] * in->st->q0[3][l];
     double sg = dot < 0 ? -1.0 : 1.0;
-    for (int k = 0; k < 4; k++) qr[k][l] *= sg;
+    qr[0][l] *= sg, qr[1][l] *= sg, qr[2][l] *= sg, qr[3][l] *= sg;
   }
   if (kind == VD_SIM_BEND_QUAT) {
     L {
@@ -368,9 +427,10 @@ SIM_INLINE void bend_lanes(vd_sim_bend kind, sim_in* in, lane* restrict cb, lane
 
 // linearise a block from its gathered inputs: body matrix (mass + ties) I and the inertia, the
 // residual g with -J^T lambda, the joint's values, compliances and Jacobians (world stretch rows)
-PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, double h, double gam, vd_sim_bend kind) {
+PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_fw* restrict fw, sim_in* in, double h, double gam,
+                                               vd_sim_bend kind) {
   double h2 = h * h, ig = 1.0 / (1 + gam);
-  lane *rt = b->rt, rp[9], dq[4], dth[3], need, cb[3], dc[9];
+  lane rt[9], rp[9], dq[4], dth[3], need, cb[3], dc[9];
   rot_lanes(in->qt, rt);
   for (int k = 0; k < 4; k++) L b->qt[k][l] = in->qt[k][l];
   L b->l0[l] = in->st->l0[l];
@@ -391,12 +451,11 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
     L acb[k][l] = (in->bend[l] > 0 ? in->st->cb[k][l] : 1.0) / h2;
   }
   // body: world inertia ib I + (it - ib) d3 d3^T; g_t = I (dth - h om) - h^2 (tau - om x I om)
-  lane* d3 = b->d3;
   lane ci, iw[6], dt[3], io[3], tq[3], il0;
   L ci[l] = in->st->it[l] - in->st->ib[l], il0[l] = 1.0 / in->st->l0[l];
-  L d3[0][l] = rt[2][l], d3[1][l] = rt[5][l], d3[2][l] = rt[8][l];
+  L fw->d3[0][l] = rt[2][l], fw->d3[1][l] = rt[5][l], fw->d3[2][l] = rt[8][l];
   for (int i = 0; i < 3; i++)
-    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->st->ib[l] : 0.0) + ci[l] * d3[i][l] * d3[k][l];
+    for (int k = i; k < 3; k++) L iw[SYM[i][k]][l] = (i == k ? in->st->ib[l] : 0.0) + ci[l] * fw->d3[i][l] * fw->d3[k][l];
   for (int k = 0; k < 3; k++) L dt[k][l] = dth[k][l] - h * in->om[k][l];
   for (int i = 0; i < 3; i++) {
     L io[i][l] = iw[SYM[i][0]][l] * in->om[0][l] + iw[SYM[i][1]][l] * in->om[1][l] + iw[SYM[i][2]][l] * in->om[2][l];
@@ -414,12 +473,12 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
       v[k][l] = (cs + acs[k][l] * in->lam[k][l] + gam * (cs - in->cp[k][l])) * ig;
     }
   for (int i = 0; i < 3; i++) {
-    L b->lf[i][l] = (rt[3 * i][l] * in->lam[0][l] + rt[3 * i + 1][l] * in->lam[1][l] + rt[3 * i + 2][l] * in->lam[2][l]) * il0[l];
-    L b->c[i][l] = in->st->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
+    L fw->lf[i][l] = (rt[3 * i][l] * in->lam[0][l] + rt[3 * i + 1][l] * in->lam[1][l] + rt[3 * i + 2][l] * in->lam[2][l]) * il0[l];
+    L fw->c[i][l] = in->st->l0[l] * (rt[3 * i][l] * v[0][l] + rt[3 * i + 1][l] * v[1][l] + rt[3 * i + 2][l] * v[2][l]);
   }
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L b->al[SYM[i][k]][l] = in->st->l0[l] * in->st->l0[l] * ig *
+      L fw->al[SYM[i][k]][l] = in->st->l0[l] * in->st->l0[l] * ig *
                               (rt[3 * i][l] * acs[0][l] * rt[3 * k][l] + rt[3 * i + 1][l] * acs[1][l] * rt[3 * k + 1][l] +
                                rt[3 * i + 2][l] * acs[2][l] * rt[3 * k + 2][l]);
   // bend-twist: G = dC/dpsi R_p^T (zero when inactive)
@@ -430,15 +489,15 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   for (int k = 0; k < 3; k++)
     L {
       double c = in->bend[l] * cb[k][l];
-      b->c[3 + k][l] = (c + acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
-      b->al[6 + k][l] = acb[k][l] * ig;
-      b->lf[3 + k][l] = in->lam[3 + k][l];
+      fw->c[3 + k][l] = (c + acb[k][l] * in->lam[3 + k][l] + gam * (c - in->cp[3 + k][l])) * ig;
+      fw->al[6 + k][l] = acb[k][l] * ig;
+      fw->lf[3 + k][l] = in->lam[3 + k][l];
     }
   // g = M (y - y_n - h v_n) - h^2 f - J^T lambda, J^T lambda = [f; f x E + G^T lambda_b]
   lane fxe[3];
-  CROSS(fxe, b->lf, in->e);
+  CROSS(fxe, fw->lf, in->e);
   for (int k = 0; k < 3; k++) {
-    L b->g[k][l] = in->mass[l] * in->dx[k][l] - h2 * in->fe[k][l] - b->lf[k][l] + in->tieg[k][l];
+    L b->g[k][l] = in->mass[l] * in->dx[k][l] - h2 * in->fe[k][l] - fw->lf[k][l] + in->tieg[k][l];
     L b->g[3 + k][l] = b->g[3 + k][l] - h2 * tq[k][l] - fxe[k][l] -
                        (gm[k][l] * in->lam[3][l] + gm[3 + k][l] * in->lam[4][l] + gm[6 + k][l] * in->lam[5][l]);
     L b->e[k][l] = in->e[k][l];
@@ -448,7 +507,7 @@ PROF_NOINLINE SIM_INLINE_PROF void eval_block(sim_blk* restrict b, sim_in* in, d
   L {
     double mt = in->mass[l] + in->tieh[l];
     b->h[S00][l] = mt, b->h[S11][l] = mt, b->h[S22][l] = mt;
-    b->mi[0][l] = 1.0 / mt, b->mi[1][l] = 1.0 / in->st->ib[l], b->mi[2][l] = 1.0 / in->st->it[l] - 1.0 / in->st->ib[l];
+    fw->mi[0][l] = 1.0 / mt, fw->mi[1][l] = 1.0 / in->st->ib[l], fw->mi[2][l] = 1.0 / in->st->it[l] - 1.0 / in->st->ib[l];
   }
   for (int k = 0; k < 6; k++) L b->h[15 + k][l] = iw[k][l];
 }
@@ -500,17 +559,43 @@ static void held_terms(const vd_sim_model* m, const vd_sim_data* d, const sim_wo
   }
 }
 
-// add the children's contributions to slot s's body (lane l of block b), in their fixed order
-PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, sim_blk* restrict b, int l, int s) {
-  double* restrict bh = &b->h[0][l];  // element i of the lane at bh[SIM_W * i]; g follows h
-  for (int k = p->kid_start[s]; k < p->kid_start[s + 1]; k++) {
-    int c = p->kid_slot[k];
-    if (d->seg_broken[p->slot_seg[c]]) continue;  // it hangs from its spare now
-    const sim_blk* cb = &p->blk[c / SIM_W];
-    const double* restrict ch = &cb->dh[0][c % SIM_W];
-    const double* restrict cg = &cb->dg[0][c % SIM_W];
-    _Pragma("GCC unroll 21") for (int i = 0; i < 21; i++) bh[SIM_W * i] += ch[SIM_W * i];
-    _Pragma("GCC unroll 6") for (int i = 0; i < 6; i++) b->g[i][l] += cg[SIM_W * i];
+// add the children's contributions to the bodies of block bi, each body's in their fixed order:
+// round j adds every lane's j-th child, loaded lane-parallel (gathers) from the child's block,
+// whose stores are long done; adding lane by lane with scalar loads of the lanes the block's
+// linearisation had just written as vectors stalled on store forwarding (a fifth of the step)
+SIM_INLINE void gather_kids(const vd_sim_data* d, const sim_plan* p, sim_blk* restrict b, int bi) {
+  const double* restrict dh = &p->kid[0].dh[0][0];
+  const double* restrict dg = &p->kid[0].dg[0][0];
+  // the rounds and the lanes' children come from the plan (indices computed here and stored a
+  // scalar at a time would make the vector loads below wait for them), unless a child broke
+  int broken = 0;
+  for (int k = p->kid_start[bi * SIM_W]; k < p->kid_start[bi * SIM_W + SIM_W]; k++) broken |= d->seg_broken[p->slot_seg[p->kid_slot[k]]];
+  ptrdiff_t dyn_off[SIM_W];
+  lane dyn_use;
+  for (int r = p->kround[bi]; r < p->kround[bi + 1]; r++) {
+    const ptrdiff_t* restrict off = p->koff + (size_t)SIM_W * r;
+    const double* restrict use = p->kuse + (size_t)SIM_W * r;
+    if (broken) {
+      int j = r - p->kround[bi];
+      for (int l = 0; l < SIM_W; l++) {
+        int s = bi * SIM_W + l;
+        int c = j < p->kid_start[s + 1] - p->kid_start[s] ? p->kid_slot[p->kid_start[s] + j] : -1;
+        int on = c >= 0 && !d->seg_broken[p->slot_seg[c]];  // a broken child hangs from its spare now
+        dyn_use[l] = on ? 1.0 : 0.0;
+        dyn_off[l] = on ? off[l] : 0;
+      }
+      off = dyn_off, use = dyn_use;
+    }
+    for (int i = 0; i < 21; i++)
+      L {
+        double v = dh[off[l] + SIM_W * i];
+        b->h[i][l] = use[l] > 0 ? b->h[i][l] + v : b->h[i][l];
+      }
+    for (int i = 0; i < 6; i++)
+      L {
+        double v = dg[off[l] + SIM_W * i];
+        b->g[i][l] = use[l] > 0 ? b->g[i][l] + v : b->g[i][l];
+      }
   }
 }
 
@@ -519,19 +604,19 @@ PROF_NOINLINE static void gather_lane(const vd_sim_data* d, const sim_plan* p, s
 
 // forward elimination of a block: H^-1, S = J H^-1 J^T + alpha^, r, S^-1 and the contribution
 // to the parent; tip: the body matrix is (mass) I and the inertia, its inverse written down
-SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
+SIM_INLINE void forward_kernel(sim_blk* restrict b, sim_fw* restrict fw, sim_kid* restrict kc, const int tip) {
   // H^-1 and S^-1 are written where the block keeps them (a tip's straight into b->h)
   lane hl[21], sm[21], ok, *hi = tip ? b->h : hl, *si = b->s;
   L ok[l] = 1.0;
   if (tip) {
     // (m I)^-1 and R diag(1/ib, 1/ib, 1/it) R^T = (1/ib) I + (1/it - 1/ib) d3 d3^T
     for (int k = 0; k < 15; k++) L hi[k][l] = 0;
-    L hi[S00][l] = b->mi[0][l];
-    L hi[S11][l] = b->mi[0][l];
-    L hi[S22][l] = b->mi[0][l];
+    L hi[S00][l] = fw->mi[0][l];
+    L hi[S11][l] = fw->mi[0][l];
+    L hi[S22][l] = fw->mi[0][l];
     for (int i = 0; i < 3; i++)
       for (int k = i; k < 3; k++)
-        L hi[15 + SYM[i][k]][l] = (i == k ? b->mi[1][l] : 0.0) + b->mi[2][l] * b->d3[i][l] * b->d3[k][l];
+        L hi[15 + SYM[i][k]][l] = (i == k ? fw->mi[1][l] : 0.0) + fw->mi[2][l] * fw->d3[i][l] * fw->d3[k][l];
   } else {
     inv6s(b->h, hi, ok);
   }
@@ -560,7 +645,7 @@ SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
   // S_ss = Ha + Q + Q^T + Z [E]x^T + alpha^_s; S_sb = (Hb + Z) G^T; S_bb = G Hd G^T + alpha^_b
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L sm[SYM[i][k]][l] = ha[SYM[i][k]][l] + q[3 * i + k][l] + q[3 * k + i][l] + zx[3 * i + k][l] + b->al[SYM[i][k]][l];
+      L sm[SYM[i][k]][l] = ha[SYM[i][k]][l] + q[3 * i + k][l] + q[3 * k + i][l] + zx[3 * i + k][l] + fw->al[SYM[i][k]][l];
   lane bz[9], vg[9];
   for (int k = 0; k < 9; k++) L bz[k][l] = hb[k][l] + z[k][l];
   for (int i = 0; i < 3; i++)
@@ -571,41 +656,41 @@ SIM_INLINE void forward_kernel(sim_blk* restrict b, const int tip) {
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
       L sm[15 + SYM[i][k]][l] = vg[3 * i][l] * g[3 * k][l] + vg[3 * i + 1][l] * g[3 * k + 1][l] + vg[3 * i + 2][l] * g[3 * k + 2][l];
-  L sm[15 + S00][l] += b->al[6][l];
-  L sm[15 + S11][l] += b->al[7][l];
-  L sm[15 + S22][l] += b->al[8][l];
+  L sm[15 + S00][l] += fw->al[6][l];
+  L sm[15 + S11][l] += fw->al[7][l];
+  L sm[15 + S22][l] += fw->al[8][l];
   // r = -c' + J H^-1 g: hg = H^-1 g = (u, w); r_s = -c_s + u + E x w, r_b = -c_b + G w
   lane hg[6], ew[3], r[6];
   mul6s(hi, b->g, hg);
   CROSS(ew, e, hg + 3);
   for (int i = 0; i < 3; i++) {
-    L r[i][l] = -b->c[i][l] + hg[i][l] + ew[i][l];
-    L r[3 + i][l] = -b->c[3 + i][l] + g[3 * i][l] * hg[3][l] + g[3 * i + 1][l] * hg[4][l] + g[3 * i + 2][l] * hg[5][l];
+    L r[i][l] = -fw->c[i][l] + hg[i][l] + ew[i][l];
+    L r[3 + i][l] = -fw->c[3 + i][l] + g[3 * i][l] * hg[3][l] + g[3 * i + 1][l] * hg[4][l] + g[3 * i + 2][l] * hg[5][l];
   }
   inv6s(sm, si, ok);
   // contribution J_p^T S^-1 J_p = [[S^-1_A, S^-1_B G], [., G^T S^-1_D G]] and to g_p:
   // [(S^-1 r)_s + f; G^T ((S^-1 r)_b + lambda_b)]
   lane *sa = si, *sb = si + 6, *sd = si + 15;
   lane ug[9], sr[6], pb[3];
-  for (int k = 0; k < 6; k++) L b->dh[k][l] = sa[k][l];
+  for (int k = 0; k < 6; k++) L kc->dh[k][l] = sa[k][l];
   for (int i = 0; i < 3; i++)
     for (int k = 0; k < 3; k++) {
-      L b->dh[6 + 3 * i + k][l] = sb[3 * i][l] * g[k][l] + sb[3 * i + 1][l] * g[3 + k][l] + sb[3 * i + 2][l] * g[6 + k][l];
+      L kc->dh[6 + 3 * i + k][l] = sb[3 * i][l] * g[k][l] + sb[3 * i + 1][l] * g[3 + k][l] + sb[3 * i + 2][l] * g[6 + k][l];
       L ug[3 * i + k][l] = sd[SYM[i][0]][l] * g[k][l] + sd[SYM[i][1]][l] * g[3 + k][l] + sd[SYM[i][2]][l] * g[6 + k][l];
     }
   for (int i = 0; i < 3; i++)
     for (int k = i; k < 3; k++)
-      L b->dh[15 + SYM[i][k]][l] = g[i][l] * ug[k][l] + g[3 + i][l] * ug[3 + k][l] + g[6 + i][l] * ug[6 + k][l];
+      L kc->dh[15 + SYM[i][k]][l] = g[i][l] * ug[k][l] + g[3 + i][l] * ug[3 + k][l] + g[6 + i][l] * ug[6 + k][l];
   mul6s(si, r, sr);
   for (int k = 0; k < 3; k++) {
-    L b->dg[k][l] = sr[k][l] + b->lf[k][l];
-    L pb[k][l] = sr[3 + k][l] + b->lf[3 + k][l];
+    L kc->dg[k][l] = sr[k][l] + fw->lf[k][l];
+    L pb[k][l] = sr[3 + k][l] + fw->lf[3 + k][l];
   }
-  for (int k = 0; k < 3; k++) L b->dg[3 + k][l] = g[k][l] * pb[0][l] + g[3 + k][l] * pb[1][l] + g[6 + k][l] * pb[2][l];
+  for (int k = 0; k < 3; k++) L kc->dg[3 + k][l] = g[k][l] * pb[0][l] + g[3 + k][l] * pb[1][l] + g[6 + k][l] * pb[2][l];
   if (!tip)
     for (int k = 0; k < 21; k++) L b->h[k][l] = hi[k][l];
   for (int k = 0; k < 6; k++) L b->r[k][l] = r[k][l];
-  L b->ok[l] = ok[l];
+  L fw->ok[l] = ok[l];
 }
 
 // back substitution of a block, the parents' updates in dyp: dl = S^-1 (r + [dx_p; G dth_p]),
@@ -637,7 +722,7 @@ PROF_NOINLINE SIM_INLINE_PROF void back_kernel(sim_blk* restrict b, lane* restri
 // a spare node hangs only from the joint that broke onto it (lane l of block b): solve it now,
 // H = (m + ties) I + S^-1_A, dx = -H^-1 g; 0 when singular
 static int solve_spare(const vd_sim_model* m, const vd_sim_data* d, const sim_work* w, const sim_step_ctx* ctx,
-                       const sim_blk* b, int l, int t) {
+                       const sim_kid* b, int l, int t) {
   const sim_plan* p = &w->plan;
   int k = m->seg_spare[t] - m->nnode, n = m->nnode + k;
   double h = ctx->h, h2 = h * h;
@@ -663,25 +748,26 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
   sim_plan* p = &w->plan;
   for (int bi = b0; bi < b1; bi++) {
     sim_blk* b = &p->blk[bi];
+    sim_kid* kc = &p->kid[bi];
     sim_in in;
+    sim_fw fw;
     in.st = &p->stat[bi];
     gather_in(m, d, w, ctx, &in, bi);
-    eval_block(b, &in, ctx->h, ctx->gamma, m->bend_measure);
+    eval_block(b, &fw, &in, ctx->h, ctx->gamma, m->bend_measure);
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l;
-      if (p->slot_seg[s] < 0) continue;
-      if (p->held_start[s + 1] > p->held_start[s]) held_terms(m, d, w, ctx, b, l, s);
-      gather_lane(d, p, b, l, s);
+      if (p->slot_seg[s] >= 0 && p->held_start[s + 1] > p->held_start[s]) held_terms(m, d, w, ctx, b, l, s);
     }
+    gather_kids(d, p, b, bi);
     if (p->tip_block[bi])
-      forward_kernel(b, 1);
+      forward_kernel(b, &fw, kc, 1);
     else
-      forward_kernel(b, 0);
+      forward_kernel(b, &fw, kc, 0);
     for (int l = 0; l < SIM_W; l++) {
       int t = p->slot_seg[bi * SIM_W + l];
       if (t < 0) continue;
-      if (!(b->ok[l] > 0)) return 0;
-      if (d->seg_broken[t] && !solve_spare(m, d, w, ctx, b, l, t)) return 0;
+      if (!(fw.ok[l] > 0)) return 0;
+      if (d->seg_broken[t] && !solve_spare(m, d, w, ctx, kc, l, t)) return 0;
     }
   }
   return 1;
@@ -691,8 +777,27 @@ SIM_CLONES static int forward_range(const vd_sim_model* m, vd_sim_data* d, sim_w
 SIM_CLONES static void back_range(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, int b0, int b1) {
   sim_plan* p = &w->plan;
   lane dyp[6];
+  const double* restrict base = (const double*)p->blk;
   for (int bi = b1 - 1; bi >= b0; bi--) {
     sim_blk* b = &p->blk[bi];
+    // the parents' updates, lane-parallel from the plan's offsets (as gather_kids), unless a
+    // joint of the block broke: its lane takes its spare node's update
+    int broken = 0;
+    for (int l = 0; l < SIM_W; l++) {
+      int t = p->slot_seg[bi * SIM_W + l];
+      broken |= t >= 0 && d->seg_broken[t];
+    }
+    if (!broken) {
+      const ptrdiff_t* restrict off = p->poff + bi * SIM_W;
+      const double* restrict use = p->puse + bi * SIM_W;
+      for (int k = 0; k < 6; k++)
+        L {
+          double v = base[off[l] + SIM_W * k];
+          dyp[k][l] = use[l] > 0 ? v : 0.0;
+        }
+      back_kernel(b, dyp);
+      continue;
+    }
     for (int l = 0; l < SIM_W; l++) {
       int s = bi * SIM_W + l, t = p->slot_seg[s], ps = p->par_slot[s];
       for (int k = 0; k < 6; k++) dyp[k][l] = 0;
@@ -737,11 +842,12 @@ SIM_CLONES static double trust_scale(const sim_plan* p) {
 SIM_CLONES static void apply_blocks(const vd_sim_model* m, vd_sim_data* d, sim_plan* p, double scale, int b0, int b1) {
   for (int bi = b0; bi < b1; bi++) {
     sim_blk* b = &p->blk[bi];
-    lane v[3], need, ls[3];
+    lane v[3], need, ls[3], rt[9];
+    rot_lanes(b->qt, rt);  // the frame's rotation at the linearisation, as eval_block had it
     for (int k = 0; k < 3; k++) L v[k][l] = scale * b->dy[3 + k][l];
     qrot_lanes(b->qt, v, need);
     for (int k = 0; k < 3; k++)
-      L ls[k][l] = scale * (b->l0[l] * (b->rt[k][l] * b->dl[0][l] + b->rt[3 + k][l] * b->dl[1][l] + b->rt[6 + k][l] * b->dl[2][l]));
+      L ls[k][l] = scale * (b->l0[l] * (rt[k][l] * b->dl[0][l] + rt[3 + k][l] * b->dl[1][l] + rt[6 + k][l] * b->dl[2][l]));
     for (int l = 0; l < SIM_W; l++) {
       int t = p->slot_seg[bi * SIM_W + l];
       if (t < 0) continue;

@@ -5,6 +5,7 @@
 #define VERDANT_SIM_INTERNAL_H
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "verdant/sim.h"
@@ -211,6 +212,9 @@ typedef struct sim_self {
 // one free segment: its end node and its frame (6 dofs); its joint is the segment's
 // stretch-shear rows (in world axes here) and its bend-twist rows with the parent. Symmetric
 // 6x6 matrices are stored as [A (3x3 upper: 00 01 02 11 12 22) | B (3x3 row-major) | D (upper)].
+// It holds what the back substitution and the update read (the forward elimination's other
+// quantities live on its stack, the contributions to the parents in sim_kid): the blocks of a
+// plant stream through the caches three times an iteration.
 typedef struct sim_blk {
   double h[21][SIM_W];   // body matrix H, then its inverse
   double s[21][SIM_W];   // joint Schur matrix S = J H^-1 J^T + alpha~', then its inverse
@@ -218,20 +222,18 @@ typedef struct sim_blk {
   double r[6][SIM_W];    // joint right-hand side
   double e[3][SIM_W];    // segment vector x_end - x_start (m)
   double gm[9][SIM_W];   // bend-twist Jacobian G (1/m, row-major)
-  double c[6][SIM_W];    // damped constraint values c': stretch rows in world axes (m), bend (1/m)
-  double al[9][SIM_W];   // damped compliances alpha~': stretch (upper 3x3, world), bend (diagonal)
-  double lf[6][SIM_W];   // the joint's multipliers: stretch as R lambda_s / l0 (world), bend
-  double mi[3][SIM_W];   // tips: 1 / (mass + ties), 1 / ib, 1 / it - 1 / ib
-  double d3[3][SIM_W];   // the frame's d3
-  double dh[21][SIM_W];  // contribution J_p^T S^-1 J_p to the parent's H
-  double dg[6][SIM_W];   // contribution to the parent's g
   double dy[6][SIM_W];   // body update (m, rad)
   double dl[6][SIM_W];   // multiplier update (world stretch rows, bend rows)
-  double ok[SIM_W];      // 1 while both factorisations of the lane held
   double qt[4][SIM_W];   // the frame at the linearisation
-  double rt[9][SIM_W];   // its rotation matrix
   double l0[SIM_W];      // rest length (m)
 } sim_blk;
+
+// A block's contributions to its bodies' parents, apart from the blocks (fewer cache lines
+// between a child's elimination and its parent's).
+typedef struct sim_kid {
+  double dh[21][SIM_W];  // contribution J_p^T S^-1 J_p to the parent's H
+  double dg[6][SIM_W];   // contribution to the parent's g
+} sim_kid;
 
 // What a block's bodies and joints keep from the model (lane by lane), so that a step gathers
 // only the state. Padding lanes hold a unit body and joint.
@@ -257,8 +259,13 @@ typedef struct sim_plan {
   int* slot_seg;             // segment of each slot, -1 for padding (nslot)
   int* seg_slot;             // slot of each segment, -1 when fixed (nseg)
   int* par_slot;             // slot of the parent body, -1 when kinematic or padding (nslot)
+  ptrdiff_t* poff;           // where the parent's update dy of slot s starts, in doubles from blk (0 without)
+  double* puse;              // 1 where slot s has a parent body, else 0 (nslot, nslot)
   int* kid_start;            // children of slot s: kid_slot[kid_start[s] .. kid_start[s + 1]) (nslot + 1)
   int* kid_slot;             // (nbody)
+  int* kround;               // block b adds its children in rounds kround[b] .. kround[b + 1]: round r adds
+  ptrdiff_t* koff;           // each lane's j-th child, at koff[SIM_W r + l] in sim_kid's doubles (0 and
+  double* kuse;              // kuse 0 where none) (nblock + 1, nround x SIM_W, nround x SIM_W)
   unsigned char* tip_block;  // 1 when block b holds tips (no children) only (nblock)
   double* tie_h;             // ties on each slot's node, then on each spare: sum of h^2 / compliance (nslot + nspare)
   double* tie_g;             // ... and their residual sum c h^2 / compliance ((nslot + nspare) x 3)
@@ -267,6 +274,7 @@ typedef struct sim_plan {
   int* held_seg;             // held_start[s + 1]), their joints hold the body (nslot + 1, nheld)
   double* held_lin;          // their linearisation this iteration: a, G, c', alpha~' (nheld x 30)
   sim_blk* blk;              // the blocks (nblock, 64-byte aligned inside mem)
+  sim_kid* kid;              // their contributions to the parents (nblock, 64-byte aligned)
   sim_stat* stat;            // their model data (nblock, 64-byte aligned)
   void* mem;                 // one allocation for all of the above
   size_t nbytes;             // its size
@@ -357,6 +365,10 @@ int sim_solve_direct(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
 // The frames' velocities at the end of a step, lane-parallel (sim_direct.c; the same bytes as
 // the scalar log map): segments [t0, t1) get omega = s log(q conj(q_prev)) (fixed ones 0).
 void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work* w, double s, int t0, int t1);
+// The frames' prediction of a dynamic step without the loads (the direct solver's): segments
+// [t0, t1) keep their frame in seg_prev and turn by h omega (fixed ones stay), lane-parallel
+// with the same bytes as quat_rotate_by.
+void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h, int t0, int t1);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
 // 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division

@@ -260,6 +260,17 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     size_t o_hl = TAKE(((size_t)nheld + 1) * 30 * sizeof(double));
     size_t o_bk = TAKE((size_t)nblock * sizeof(sim_blk) + 64);
     size_t o_st = TAKE((size_t)nblock * sizeof(sim_stat) + 64);
+    size_t o_kc = TAKE((size_t)nblock * sizeof(sim_kid) + 64);
+    // rounds of children: the most children of a body in each block
+    int nround = 0;
+    for (int bk = 0; bk < nblock; bk++)
+      for (int l = 0, most = 0; l < SIM_W; l++) {
+        int t = b.order[bk * SIM_W + l], nk = t >= 0 ? b.kstart[t + 1] - b.kstart[t] : 0;
+        if (nk > most) nround += nk - most, most = nk;
+      }
+    size_t o_po = TAKE((size_t)nslot * sizeof(ptrdiff_t)), o_pu = TAKE((size_t)nslot * sizeof(double));
+    size_t o_kr = TAKE(((size_t)nblock + 1) * I), o_ko = TAKE(((size_t)nround + 1) * SIM_W * sizeof(ptrdiff_t));
+    size_t o_ku = TAKE(((size_t)nround + 1) * SIM_W * sizeof(double));
 #undef TAKE
     char* mem = vd_calloc(1, top);
     if (!mem) {
@@ -277,6 +288,10 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
     p->blk = (sim_blk*)(mem + o_bk + ((64 - (a & 63)) & 63));
     a = (uintptr_t)(mem + o_st);
     p->stat = (sim_stat*)(mem + o_st + ((64 - (a & 63)) & 63));
+    a = (uintptr_t)(mem + o_kc);
+    p->kid = (sim_kid*)(mem + o_kc + ((64 - (a & 63)) & 63));
+    p->poff = (ptrdiff_t*)(mem + o_po), p->puse = (double*)(mem + o_pu);
+    p->kround = (int*)(mem + o_kr), p->koff = (ptrdiff_t*)(mem + o_ko), p->kuse = (double*)(mem + o_ku);
     memcpy(p->tip_block, b.tips, (size_t)nblock);
     for (int t = 0; t < ns; t++) p->seg_slot[t] = -1;
     for (int s = 0; s < nslot; s++) {
@@ -293,6 +308,30 @@ vd_status sim_plan_build(const vd_sim_model* m, int nthread, sim_plan* p) {
       for (int k = b.kstart[t]; k < b.kstart[t + 1]; k++) p->kid_slot[nk++] = p->seg_slot[b.kids[k]];
     }
     p->kid_start[nslot] = nk;
+    for (int s = 0; s < nslot; s++) {
+      int ps = p->par_slot[s];
+      p->puse[s] = ps >= 0;
+      p->poff[s] = ps < 0 ? 0
+                          : (ptrdiff_t)(ps / SIM_W) * (ptrdiff_t)(sizeof(sim_blk) / sizeof(double)) +
+                                (ptrdiff_t)(offsetof(sim_blk, dy) / sizeof(double)) + ps % SIM_W;
+    }
+    // the rounds (koff and kuse are zero from the allocation)
+    int nr = 0;
+    for (int bk = 0; bk < nblock; bk++) {
+      p->kround[bk] = nr;
+      int most = 0;
+      for (int l = 0; l < SIM_W; l++) {
+        int s = bk * SIM_W + l, n = p->kid_start[s + 1] - p->kid_start[s];
+        most = n > most ? n : most;
+        for (int j = 0; j < n; j++) {
+          int c = p->kid_slot[p->kid_start[s] + j];
+          p->koff[SIM_W * (nr + j) + l] = (ptrdiff_t)(c / SIM_W) * (ptrdiff_t)(sizeof(sim_kid) / sizeof(double)) + c % SIM_W;
+          p->kuse[SIM_W * (nr + j) + l] = 1;
+        }
+      }
+      nr += most;
+    }
+    p->kround[nblock] = nr;
     // held children by slot, in segment index order
     int nh = 0;
     for (int s = 0; s < nslot; s++) {

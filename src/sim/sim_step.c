@@ -108,6 +108,10 @@ static void predict_segs(void* p, int k, int t0, int t1) {
   sim_work* w = c->w;
   double h = c->h, fl = c->fl;
   (void)k;
+  if (!c->statics && fl == 0) {
+    sim_frame_predict(m, d, w, h, t0, t1);
+    return;
+  }
   for (int t = t0; t < t1; t++) {
     w->seg_prev[t] = d->seg_quat[t];
     if (c->statics) {
