@@ -663,3 +663,21 @@ TEST(lpy, module_inheritance) {
     PY_DERIVES(src, -1, "D(1)D(2)G(2)D(3)F");
   }
 }
+
+TEST(lpy, lsystem_inside_a_file_python_engine) {
+  if (!vd_lsys_python_available(NULL, 0)) return;
+  // Lsystem().set(code).iterate(): a nested L-system (the native subset) derived by verdant,
+  // its string an Lstring the rule reads
+  const char* src = "inner = '''\nAxiom: A(1)\nderivation length: 2\nproduction:\nA(x) --> A(x + 1) B('s')\n'''\n"
+                    "Axiom: E\nproduction:\nE:\n  l = Lsystem()\n  l.set(inner)\n  s = l.iterate()\n"
+                    "  assert s[2].name == 'B' and s[2][0] == 's'\n  produce X(len(s), s[0][0], len(l.iterate(1)))\n";
+  PY_DERIVES(src, 1, "X(3,3,2)");
+  // beyond the native subset: refused, at the line of the call
+  vd_error e = {0};
+  char b[256];
+  CHECK_STATUS(derive_engine("Axiom: E\nproduction:\nE:\n  l = Lsystem()\n  l.set('class A: pass\\nAxiom: A')\n"
+                             "  l.iterate()\n  produce X\n",
+                             VD_LSYS_PYTHON, 1, b, sizeof b, &e),
+               VD_ERR_UNSUPPORTED, e);
+  if (!strstr(e.msg, "Lsystem inside a file") || e.line != 6) vdt_fail(__FILE__, __LINE__, "'%s' line %d", e.msg, e.line);
+}

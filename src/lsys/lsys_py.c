@@ -985,6 +985,55 @@ static PyObject* vd_frame_displayed(PyObject* self, PyObject* noarg) {
   return ls ? PyBool_FromLong(ls->frame_displayed) : NULL;
 }
 
+// the (name, params) items of a native lsystem's string: numbers and strings
+static PyObject* native_items(const vd_lsystem* ls, const vd_lstring* s) {
+  PyObject* list = PyList_New((Py_ssize_t)s->n);
+  for (int64_t i = 0; list && i < s->n; i++) {
+    int np = vd_lstring_nparam(s, i);
+    PyObject* params = PyTuple_New(np);
+    for (int k = 0; params && k < np; k++) {
+      double v = s->val[s->par[i] + k];
+      const char* str = vd_lsys_value_str(ls, v);
+      PyObject* o = str ? PyUnicode_FromString(str)
+                    : v == floor(v) && fabs(v) < 9007199254740992.0 ? PyLong_FromDouble(v)
+                                                                    : PyFloat_FromDouble(v);
+      if (!o) Py_CLEAR(params);
+      else PyTuple_SET_ITEM(params, k, o);
+    }
+    PyObject* it = params ? Py_BuildValue("(sN)", vd_lsys_symbol_name(ls, s->sym[i]), params) : NULL;
+    if (!it) Py_CLEAR(list);
+    else PyList_SET_ITEM(list, (Py_ssize_t)i, it);
+  }
+  return list;
+}
+
+// Lsystem().set(code); iterate(n) inside a file: a nested L-system of the native subset derived
+// n steps (-1: its derivation length), seeded 0; its string as items
+static PyObject* vd_nested(PyObject* self, PyObject* args) {
+  (void)self;
+  vd_lsystem* outer = current();
+  const char* code;
+  Py_ssize_t len;
+  int steps;
+  if (!outer || !PyArg_ParseTuple(args, "s#i", &code, &len, &steps)) return NULL;
+  vd_lsystem* ls;
+  vd_error e = {0};
+  vd_status st = vd_lsys_parse_engine(code, (size_t)len, "Lsystem", VD_LSYS_NATIVE, &ls, &e);
+  if (st == VD_ERR_UNSUPPORTED)
+    return PyErr_Format(PyExc_NotImplementedError,
+                        "an Lsystem inside a file runs L-Py's simple Python subset only (%s)", e.msg);
+  if (st) return PyErr_Format(PyExc_ValueError, "Lsystem: line %d: %s", e.line, e.msg);
+  vd_lsys_def d = vd_lsys_def_default();
+  d.steps = steps;
+  d.max_ops = outer->max_ops;
+  vd_lstring s = vd_lstring_empty();
+  st = vd_lsys_derive(ls, &d, &s, &e);
+  PyObject* r = st ? PyErr_Format(PyExc_ValueError, "Lsystem: line %d: %s", e.line, e.msg) : native_items(ls, &s);
+  vd_lstring_free(&s);
+  vd_lsys_destroy(ls);
+  return r;
+}
+
 // ModuleClass.issubclass: is module a (a name) module b or a subclass of it?
 static PyObject* vd_isa(PyObject* self, PyObject* args) {
   (void)self;
@@ -1106,6 +1155,7 @@ static PyMethodDef vd_methods[] = {
     {"set_frame_displayed", vd_set_frame_displayed, METH_O, "frameDisplay"},
     {"animating", vd_animating, METH_NOARGS, "isAnimationEnabled"},
     {"isa", vd_isa, METH_VARARGS, "ModuleClass.issubclass"},
+    {"nested", vd_nested, METH_VARARGS, "an Lsystem inside a file"},
     {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
     {"set_option", vd_set_option, METH_VARARGS, "context().options.setSelection"},
     {"set_turtle_angle", vd_set_turtle_angle, METH_O, "context().turtle.setAngleIncrement"},

@@ -553,6 +553,26 @@ def isAnimationEnabled():
     return _vd.animating()
 
 
+class Lsystem:
+    """An L-system inside a file (L-Py's Lsystem): its code (L-Py's simple Python subset) is
+    derived by verdant's native engine, seeded 0; iterate()/derive() give its string."""
+
+    def __init__(self, filename=None):
+        self.code = ""
+        if filename:
+            with open(filename, encoding="utf-8") as f:
+                self.code = f.read()
+
+    def set(self, code):
+        self.code = code
+
+    def iterate(self, n=None):
+        return Lstring._from_items(_vd.nested(self.code, -1 if n is None else int(n)))
+
+    def derive(self, n=None):
+        return self.iterate(n)
+
+
 class ModuleClass:
     """A module's class, as L-Py's ModuleClass: its name and its declared bases
     (`module B : base = A`)."""
@@ -2779,7 +2799,8 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
-        "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext", "ModuleClass"]
+        "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext", "ModuleClass",
+        "Lsystem"]
 
 _DISPLAY = ["Viewer", "eStatic", "eAnimatedPrimitives", "eAnimatedScene", "pgl_support_extension"]
 _pgl_math = _module("openalea.plantgl.math", _MATH)
