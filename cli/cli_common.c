@@ -447,6 +447,16 @@ static int write_frame(void* user, int frame, const vd_lstring* s, const vd_plan
     w->st = vd_error_set(w->err, VD_ERR_ARG, w->o->frames, 0, 0, "frame %d: the file name is too long", frame);
     return 1;
   }
+  // no frame may replace the input (another spelling of it, a hard or symbolic link)
+  char files[2][4200];
+  int nf = cli_plant_files(path, files);
+  for (int i = 0; i < nf; i++)
+    if (cli_same_file(files[i], w->o->path)) {
+      w->st = vd_error_set(w->err, VD_ERR_ARG, w->o->frames, 0, 0,
+                           "frame %d: '%s' would replace the input '%s'; choose another pattern", frame, files[i],
+                           w->o->path);
+      return 1;
+    }
   vd_plant_spec* p = vd_plant_spec_copy(plant);
   w->st = p ? name_labels(w->o, w->ls, p, w->err) : vd_error_set(w->err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   if (!w->st) w->st = cli_write_plant(p, path, 0, w->err);

@@ -135,6 +135,13 @@ expect_err "missing function named" "no function 'nothere'"
 expect "--frames without a number field" 2 "$V" grow "$T/anim.lpy" --frames "$T/f.json"
 expect "--frames with two fields" 2 "$V" grow "$T/anim.lpy" --frames "$T/f%d%d.json"
 expect "--frames of an unknown format" 2 "$V" grow "$T/anim.lpy" --frames "$T/f%d.txt"
+# a frame that is the input under another name (a hard link) is refused, the input kept
+cp "$T/anim.lpy" "$T/keep.lpy"
+ln -f "$T/anim.lpy" "$T/g01.json"
+expect "a frame would replace the input" 2 "$V" grow "$T/anim.lpy" --frames "$T/g%02d.json"
+expect_err "frame clash named" "would replace the input"
+if cmp -s "$T/anim.lpy" "$T/keep.lpy" && [ ! -e "$T/g00.json" ]; then ok "input kept, no frame left"; else bad "input kept, no frame left"; fi
+rm -f "$T/g01.json" "$T/keep.lpy"
 expect "--animate on a plant file" 2 "$V" grow "$T/last.json" --animate --stats
 # a turtle fault names the rule's line (issue 12 item 7)
 printf 'Axiom: A\nproduction:\nA --> F(1e308 * 10)\n' >"$T/bad.lpy"
