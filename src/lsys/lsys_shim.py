@@ -91,18 +91,22 @@ _real_import = _builtins.__import__
 _local_modules = {}
 
 
+# modules made for each file, as they hold its state: the import's name -> the key that keeps
+# the file's copy in its globals, the attribute of openalea.lpy, the factory (defined below)
+_PER_FILE_MODULES = {
+    "openalea.lpy.__lpyfuture__": ("__vd_future", "__lpyfuture__", lambda: _future_module()),
+    "openalea.lpy.tableparameterset": ("__vd_tableps", "tableparameterset", lambda: _tableparam_module()),
+}
+
+
 def _vd_import(name, globals=None, locals=None, fromlist=(), level=0):
-    if level == 0 and name == "openalea.lpy.__lpyfuture__" and globals is not None:
-        mod = globals.get("__vd_future")
+    per_file = _PER_FILE_MODULES.get(name) if level == 0 and globals is not None else None
+    if per_file:
+        key, attr, make = per_file
+        mod = globals.get(key)
         if mod is None:
-            mod = globals["__vd_future"] = _future_module()
-        _lpy.__lpyfuture__ = mod
-        return mod if fromlist else OPENALEA["openalea"]
-    if level == 0 and name == "openalea.lpy.tableparameterset" and globals is not None:
-        mod = globals.get("__vd_tableps")
-        if mod is None:
-            mod = globals["__vd_tableps"] = _tableparam_module()
-        _lpy.tableparameterset = mod
+            mod = globals[key] = make()
+        setattr(_lpy, attr, mod)
         return mod if fromlist else OPENALEA["openalea"]
     if level == 0 and (name == "openalea" or name.startswith("openalea.")):
         mod = OPENALEA.get(name)
