@@ -39,7 +39,7 @@ TEST(robot, lite6_kinematics) {
   (void)st;
   double q[6] = {0, 0, 0, 0, 0, 0}, home[6] = {0, 0, M_PI / 2, 0, M_PI / 2, 0};
   for (int k = 0; k < 2; k++) {
-    for (int i = 0; i < 6; i++) h->dk->qpos[h->arm_qpos[i]] = k ? home[i] : q[i];
+    for (int i = 0; i < 6; i++) h->dk->qpos[h->rb->arm_qpos[i]] = k ? home[i] : q[i];
     mj_kinematics(h->m, h->dk);
     int b5 = mj_name2id(h->m, mjOBJ_BODY, "link5"), b6 = mj_name2id(h->m, mjOBJ_BODY, "link6");
     const double* w = h->dk->xpos + 3 * b5;
@@ -73,7 +73,7 @@ TEST(robot, ik_reaches_targets) {
     // a target made by forward kinematics of random joints: reachable by construction
     double qt[6], q[6];
     for (int k = 0; k < 6; k++) {
-      double lo = fmax(h->arm_lo[k], -2.0), hi = fmin(h->arm_hi[k], 2.0);
+      double lo = fmax(h->rb->arm_lo[k], -2.0), hi = fmin(h->rb->arm_hi[k], 2.0);
       qt[k] = vd_rng_uniform(g, lo, hi);
       q[k] = h->q0[k];
     }
@@ -90,7 +90,7 @@ TEST(robot, ik_reaches_targets) {
       CHECK(pe < 1e-3);
       CHECK(re < 1e-2);
     }
-    for (int k = 0; k < 6; k++) CHECK(q[k] >= h->arm_lo[k] - 1e-12 && q[k] <= h->arm_hi[k] + 1e-12);
+    for (int k = 0; k < 6; k++) CHECK(q[k] >= h->rb->arm_lo[k] - 1e-12 && q[k] <= h->rb->arm_hi[k] + 1e-12);
   }
   CHECK(reached >= 16);
   vd_free(g, sizeof *g);
@@ -202,7 +202,7 @@ TEST(robot, stiff_branch_stops_weak_arm) {
 }
 
 // run the scripted method on the truss; summary out
-// stepwise: one vd_harvest_step_scripted at a time instead of vd_harvest_run
+// stepwise: one vd_script_step at a time instead of vd_harvest_run
 static void harvest_truss_by(const char* method, const char* extra, vd_harvest_summary* out, uint64_t* hash,
                              int stepwise) {
   vd_error e = {0};
@@ -217,7 +217,10 @@ static void harvest_truss_by(const char* method, const char* extra, vd_harvest_s
   vd_status st = vd_harvest_create(&s, pm, &h, &e);
   if (st) vdt_fail(__FILE__, __LINE__, "create: %s", e.msg);
   if (!st && !stepwise) st = vd_harvest_run(h, NULL, NULL, &e);
-  while (!st && stepwise && !vd_harvest_done(h)) st = vd_harvest_step_scripted(h, &e);
+  vd_script* c = NULL;
+  if (!st && stepwise) st = vd_script_create(h, &c, &e);
+  while (!st && stepwise && !vd_harvest_done(h)) st = vd_script_step(c, &e);
+  vd_script_destroy(c);
   if (st) vdt_fail(__FILE__, __LINE__, "run: %s", e.msg);
   if (h) vd_harvest_summarize(h, out);
   if (h && getenv("VDT_VERBOSE")) {
@@ -284,7 +287,9 @@ TEST(robot, deterministic) {
   CHECK(c.detached && c.time == a.time && c.steps == a.steps);
 }
 
-TEST(robot, scripted_steps_refused_after_external) {
+TEST(robot, script_and_external_control) {
+  // the scripted controller is a client of the step API: its phases are reported through it;
+  // an external controller may take over between its steps, and a new script begins after a reset
   vd_error e = {0};
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
@@ -292,14 +297,70 @@ TEST(robot, scripted_steps_refused_after_external) {
   vd_harvest* h = NULL;
   CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
   REQUIRE(h);
-  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_OK, e);
-  CHECK_INT(h->phase, VD_PHASE_APPROACH);
+  vd_harvest_obs o;
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.phase, VD_PHASE_EXTERNAL);  // no controller yet
+  CHECK(o.target_instance > 0 && o.target_reason == NULL);
+  vd_script* c = NULL;
+  CHECK_STATUS(vd_script_create(h, &c, &e), VD_OK, e);
+  CHECK_STATUS(vd_script_step(c, &e), VD_OK, e);
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.phase, VD_PHASE_APPROACH);
   vd_harvest_action a = {{0, 0, 0}, {0, 0, 0}, 0};
+  int64_t step = o.step;
   CHECK_STATUS(vd_harvest_step(h, &a, &e), VD_OK, e);
-  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_ERR_ARG, e);
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.step, step + 1);
+  vd_script_destroy(c);
   CHECK_STATUS(vd_harvest_reset(h, 0, &e), VD_OK, e);
-  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_OK, e);
+  CHECK_STATUS(vd_harvest_run(h, NULL, NULL, &e), VD_OK, e);
+  vd_harvest_summary r;
+  vd_harvest_summarize(h, &r);
+  CHECK(r.detached);
+  CHECK_INT(r.events_dropped, 0);
+  // a step after the end is refused
+  CHECK_STATUS(vd_harvest_step(h, &a, &e), VD_ERR_ARG, e);
   vd_harvest_destroy(h);
+  vd_model_destroy(pm);
+  vd_scene_free(&s);
+}
+
+TEST(robot, description_shared_by_episodes) {
+  // one robot description, two episodes with other base poses and grip forces: each the same,
+  // byte for byte, as an episode with a description of its own; a scene naming another robot is
+  // refused
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\", \"speed\": 0.04, \"distance\": 0.1", NULL, &s, &e), VD_OK, e);
+  vd_model* pm = robot_truss(0.012);
+  vd_robot* rb = NULL;
+  CHECK_STATUS(vd_robot_load(&s, &rb, &e), VD_OK, e);
+  REQUIRE(rb);
+  for (int k = 0; k < 2; k++) {
+    s.base_pos.x = 0.45 + 0.01 * k;
+    s.method.grip_force = 3 - k;
+    vd_harvest *h1 = NULL, *h2 = NULL;
+    CHECK_STATUS(vd_harvest_create_with(&s, rb, pm, &h1, &e), VD_OK, e);
+    CHECK_STATUS(vd_harvest_create(&s, pm, &h2, &e), VD_OK, e);
+    REQUIRE(h1 && h2);
+    CHECK_STATUS(vd_harvest_run(h1, NULL, NULL, &e), VD_OK, e);
+    CHECK_STATUS(vd_harvest_run(h2, NULL, NULL, &e), VD_OK, e);
+    vd_harvest_summary a, b;
+    vd_harvest_summarize(h1, &a);
+    vd_harvest_summarize(h2, &b);
+    CHECK(a.time == b.time && a.pull_force == b.pull_force && a.steps == b.steps);
+    CHECK_STR(a.reason, b.reason);
+    const vd_sim_data* d1 = vd_harvest_sim_data(h1);
+    const vd_sim_data* d2 = vd_harvest_sim_data(h2);
+    CHECK(!memcmp(d1->node_pos, d2->node_pos, sizeof(vd_vec3) * (size_t)d1->nnode_all));
+    vd_harvest_destroy(h1);
+    vd_harvest_destroy(h2);
+  }
+  snprintf(s.ee_site, sizeof s.ee_site, "flange");
+  vd_harvest* h = NULL;
+  CHECK_STATUS(vd_harvest_create_with(&s, rb, pm, &h, &e), VD_ERR_ARG, e);
+  CHECK(!h);
+  vd_robot_destroy(rb);
   vd_model_destroy(pm);
   vd_scene_free(&s);
 }
@@ -313,13 +374,19 @@ TEST(robot, unreachable_target) {
   s.base_pos = vd_v3(3, 0, 0.2);
   vd_model* pm = robot_truss(0.012);
   vd_harvest* h = NULL;
-  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_ERR_VALUE, e);
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
   REQUIRE(h);
+  vd_harvest_obs o;
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.target_instance, 0);
+  CHECK(o.target_reason && !strcmp(o.target_reason, "no reachable fruit"));
   CHECK_STATUS(vd_harvest_run(h, NULL, NULL, &e), VD_OK, e);
   CHECK(vd_harvest_done(h));
   vd_harvest_summarize(h, &r);
   CHECK(!r.detached);
   CHECK_STR(r.reason, "no reachable fruit");
+  // the detail names the nearest fruit and how far it is
+  CHECK(strstr(r.detail, "fruit ") && strstr(r.detail, " m from the robot's base"));
   vd_harvest_destroy(h);
   vd_model_destroy(pm);
   vd_scene_free(&s);

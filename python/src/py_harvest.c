@@ -82,12 +82,10 @@ static vd_status episode(vdpy_harvest* o, vd_scene* s, uint64_t target_seed, vd_
     vd_harvest_destroy(o->h);
     o->h = NULL;
     st = vd_harvest_create(&o->scene, o->plant, &o->h, err);
-    if (o->h && st == VD_ERR_VALUE) st = VD_OK;  // an unreachable target is an outcome: done
     if (st) return st;
   }
   memset(err, 0, sizeof *err);
-  st = vd_harvest_reset(o->h, target_seed, err);
-  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) st = VD_OK;  // no reachable fruit: done
+  st = vd_harvest_reset(o->h, target_seed, err);  // no reachable fruit: an outcome, VD_OK
   o->stepped = 0;
   return st;
 }
