@@ -30,7 +30,7 @@ TEST(robot, lite6_kinematics) {
   vd_error e = {0};
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
-  s.base_pos = vd_v3(0, 0, 0), s.base_yaw = 0;
+  s.base_pos = vd_v3(10, 0, 0), s.base_yaw = 0;  // away from the truss (a base inside it is refused)
   vd_model* pm = robot_truss(0.012);
   REQUIRE(pm);
   vd_harvest* h = NULL;
@@ -45,7 +45,7 @@ TEST(robot, lite6_kinematics) {
     const double* w = h->dk->xpos + 3 * b5;
     const double* f = h->dk->xpos + 3 * b6;
     double wx = k ? 0.2276 : 0.087, wz = k ? 0.5307 : 0.2161, fz = k ? 0.4682 : 0.1536;
-    CHECK_NEAR(w[0], wx, 3e-4);
+    CHECK_NEAR(w[0] - 10, wx, 3e-4);
     CHECK_NEAR(w[1], 0, 1e-7);
     CHECK_NEAR(w[2], wz, 3e-4);
     CHECK_NEAR(f[2], fz, 3e-4);
@@ -361,6 +361,30 @@ TEST(robot, description_shared_by_episodes) {
   CHECK_STATUS(vd_harvest_create_with(&s, rb, pm, &h, &e), VD_ERR_ARG, e);
   CHECK(!h);
   vd_robot_destroy(rb);
+  vd_model_destroy(pm);
+  vd_scene_free(&s);
+}
+
+TEST(robot, start_inside_plant_refused) {
+  // the robot's base on the truss's fruit: refused before the first step, naming the geom and
+  // the organ (not a plant blown apart by the first contact)
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  vd_model* pm = robot_truss(0.012);
+  vd_harvest* h = NULL;
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
+  REQUIRE(h);
+  vd_harvest_obs o;
+  vd_harvest_observe(h, &o);
+  vd_vec3 f = o.fruit_pos;
+  vd_harvest_destroy(h);
+  h = NULL;
+  s.base_pos = vd_v3(f.x, f.y, f.z - 0.03);
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_ERR_VALUE, e);
+  CHECK(!h);
+  CHECK(strstr(e.msg, "starts inside the plant: geom '") != NULL);
+  CHECK(strstr(e.msg, "overlaps ") != NULL && strstr(e.msg, " mm at q0") != NULL);
   vd_model_destroy(pm);
   vd_scene_free(&s);
 }

@@ -112,6 +112,46 @@ void vd_harvest_destroy(vd_harvest* h) {
   vd_free(h, sizeof *h);
 }
 
+// Before the first step: no robot geom may start inside the plant (its modelled shape) deeper
+// than START_OVERLAP; the plant would be blown apart by the first contact projection. The error
+// names the geom, the organ and the depth.
+#define START_OVERLAP 1e-3  // (m)
+static vd_status start_pose_check(const vd_harvest* h, vd_error* err) {
+  const vd_sim_model* sm = h->sm;
+  const vd_sim_data* sd = h->sd;
+  for (int k = 0; k < h->ncol; k++) {
+    const vd_collider* c = &h->col[k].shape;
+    vd_vec3 lo, hi;
+    vd_collider_bounds(c, &lo, &hi);
+    double worst = -START_OVERLAP;
+    int seg = -1, sphere = 0;
+    for (int t = 0; t < sm->nseg; t++) {
+      int a = sm->seg_node[2 * t], b = sm->seg_node[2 * t + 1];
+      vd_vec3 pa = sd->node_pos[a], pb = sd->node_pos[b];
+      double r = sm->seg_radius[t];
+      if (fmin(pa.x, pb.x) - r > hi.x || fmax(pa.x, pb.x) + r < lo.x || fmin(pa.y, pb.y) - r > hi.y ||
+          fmax(pa.y, pb.y) + r < lo.y || fmin(pa.z, pb.z) - r > hi.z || fmax(pa.z, pb.z) + r < lo.z)
+        continue;
+      double d = vd_collide_capsule(c, pa, pb, r, r).dist;
+      if (d < worst) worst = d, seg = t, sphere = 0;
+      double rs = sm->node_sphere[b];
+      if (rs > 0 && (d = vd_collide_sphere(c, pb, rs).dist) < worst) worst = d, seg = t, sphere = 1;
+    }
+    if (seg < 0) continue;
+    const mjModel* m = h->m;
+    const char* gname = mj_id2name(m, mjOBJ_GEOM, h->col[k].geom);
+    const char* bname = mj_id2name(m, mjOBJ_BODY, h->col[k].body);
+    return vd_error_set(err, VD_ERR_VALUE, h->scene.path, 0, 0,
+                        "the robot starts inside the plant: geom '%s' (body '%s') overlaps %s %d "
+                        "(%s) by %.1f mm at q0; move robot.base (now %.3f, %.3f, %.3f m) or the plant",
+                        gname ? gname : "(unnamed)", bname ? bname : "(unnamed)",
+                        vd_sim_class_name((vd_sim_class)sm->seg_class[seg]), sm->seg_instance[seg],
+                        sphere ? "its sphere" : "a segment", -worst * 1e3, h->scene.base_pos.x,
+                        h->scene.base_pos.y, h->scene.base_pos.z);
+  }
+  return VD_OK;
+}
+
 vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_harvest** out,
                             vd_error* err) {
   *out = NULL;
@@ -119,9 +159,9 @@ vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_har
   vd_status st = vd_robot_load(scene, &rb, err);
   if (st) return st;
   st = vd_harvest_create_with(scene, rb, plant, out, err);
-  if (st) {
+  if (st || !*out) {
     vd_robot_destroy(rb);
-    return st;
+    return st ? st : vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   (*out)->own_rb = rb;
   return VD_OK;
@@ -181,6 +221,7 @@ vd_status vd_harvest_create_with(const vd_scene* scene, const vd_robot* robot, c
     return st;
   }
   st = vd_harvest_reset(h, 0, err);
+  if (!st) st = start_pose_check(h, err);
   if (st) {
     vd_harvest_destroy(h);
     return st;
