@@ -17,7 +17,7 @@
 // + (-0.4805 - 0.1239 clay + 0.208 OC) ln theta + (3.8521 + 0.0963 clay) ln BD, with organic
 // carbon OC = OM / 1.72 (van Bemmelen). Two of its terms (OC in the exponent of theta, clay in the
 // exponent of BD) are beyond the five of eq. 13, hence the two extra coefficients d2 and e1.
-#include "sim_internal.h"
+#include "sim/sim_internal.h"
 
 // coefficients of the default pedotransfer function (da Silva & Kay 1997, OM = 1.72 OC)
 static const double silva_kay_1997[8] = {-3.6733, -0.1447, 0.7653 / 1.72, -0.4805,

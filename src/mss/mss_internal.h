@@ -4,7 +4,7 @@
 #ifndef VERDANT_SIM_MSS_INTERNAL_H
 #define VERDANT_SIM_MSS_INTERNAL_H
 
-#include "sim_internal.h"
+#include "sim/sim_internal.h"
 
 // Scratch of one state, one block (vd_mss_data::work).
 typedef struct mss_work {

@@ -5,7 +5,7 @@
 #include <errno.h>
 #include <stdlib.h>
 
-#include "sim_internal.h"
+#include "sim/sim_internal.h"
 
 // one number of a row at s (leading blanks allowed): finite, and within +-lim; *end after it
 static int row_number(const char* s, double lim, double* out, const char** end) {

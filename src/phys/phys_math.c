@@ -4,7 +4,7 @@
 #define _POSIX_C_SOURCE 199309L
 #include <time.h>
 
-#include "sim_internal.h"
+#include "sim/sim_internal.h"
 
 double sim_clock(void) {
   struct timespec ts;

@@ -15,7 +15,7 @@
 // falls as 1/d^2). Gravitropism by the sine law (Dumais 2013) pushes every node but the buds
 // across its internode, upward, with gravi_k sin A (A the internode's angle to the vertical);
 // Bastien et al.'s AC model acts on the rest shape instead (sim_mss_stress.c).
-#include "sim_mss_internal.h"
+#include "mss_internal.h"
 
 vd_vec3 vd_wind_at(vd_vec3 mean, double gust_amplitude, double gust_period, const double* series, int nseries,
                    double t) {

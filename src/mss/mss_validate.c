@@ -9,7 +9,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-#include "sim_mss_internal.h"
+#include "mss_internal.h"
 
 int vd_validate_add(vd_validate_list* l, const char* name, const char* form, const char* quantity, double measured,
                     double reference, double tol, int abs_err, const char* note, ...) {
