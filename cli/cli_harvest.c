@@ -164,6 +164,7 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
   cJSON_AddNumberToObject(o, "ik_error", r.ik_error);
   cJSON_AddNumberToObject(o, "track_error", r.track_error);
   cJSON_AddNumberToObject(o, "slip", r.slip);
+  cJSON_AddNumberToObject(o, "grip_force_measured", r.grip_force);
   cJSON_AddNumberToObject(o, "speed", s->method.speed);
   cJSON_AddNumberToObject(o, "distance", s->method.distance);
   cJSON_AddNumberToObject(o, "angle_deg", s->method.angle * 180 / M_PI);

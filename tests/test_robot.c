@@ -365,6 +365,41 @@ TEST(robot, description_shared_by_episodes) {
   vd_scene_free(&s);
 }
 
+TEST(robot, grip_sweep_friction_boundary) {
+  // a friction-limited grasp: the hold may pull across the fingers' closing axis with at most
+  // mu (N_l + N_r), N the finger actuators' measured squeeze (here their force limit). A slow pull
+  // (quasi-static) on the truss's fruit, whose calyx breaks at F_b, detaches it when
+  // 2 mu F_grip > F_b and slips it out of the fingers below: the boundary F_b / (2 mu) within 10 %
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  double fb = s.sim_def.material[VD_SIM_FRUIT].break_force, mu = s.method.grip_friction;
+  double fstar = fb / (2 * mu);
+  vd_scene_free(&s);
+  const double factor[] = {0.8, 0.9, 1.1, 1.2};
+  for (int k = 0; k < 4; k++) {
+    char m[256];
+    snprintf(m, sizeof m, "\"name\": \"pull\", \"speed\": 0.02, \"distance\": 0.1, \"grip_force\": %.6f",
+             factor[k] * fstar);
+    vd_harvest_summary r;
+    harvest_truss(m, NULL, &r, NULL);
+    if (getenv("VDT_VERBOSE"))
+      printf("  grip %.4f N (x%.2f of %.4f): %s, slip %.4f m, measured %.4f N, pull %.4f N\n", factor[k] * fstar,
+             factor[k], fstar, r.reason, r.slip, r.grip_force, r.max_pull_force);
+    CHECK(r.grasped);
+    CHECK_NEAR(r.grip_force, factor[k] * fstar, 1e-6 * fstar);  // the actuators' force limit
+    if (factor[k] < 1) {
+      CHECK_STR(r.reason, "slipped");
+      CHECK(!r.detached);
+      CHECK(r.slip > 0.005);
+      CHECK(r.max_pull_force <= 2 * mu * r.grip_force * 1.02);  // never beyond friction
+    } else {
+      CHECK_STR(r.reason, "detached");
+      CHECK(r.detached);
+    }
+  }
+}
+
 TEST(robot, start_inside_plant_refused) {
   // the robot's base on the truss's fruit: refused before the first step, naming the geom and
   // the organ (not a plant blown apart by the first contact)

@@ -283,7 +283,7 @@ typedef struct vd_harvest_obs {
   int held;                 // 1 while the fruit is held
   int touching[2];          // finger l / r touches the target fruit
   double finger_force[2];   // normal force of each finger on the fruit (N)
-  double grip_force;        // squeeze on the held fruit (N per finger)
+  double grip_force;        // squeeze on the held fruit: the finger actuators' mean force (N)
   vd_vec3 pull_force;       // force of the held fruit on the gripper (N)
   double pull_torque;       // torque of the held fruit on the gripper (N m)
   double slip;              // slip of the held fruit in the grip so far (m)
@@ -339,6 +339,8 @@ typedef struct vd_harvest_summary {
   double ik_error;             // inverse kinematics residual at the grasp pose (m)
   double track_error;          // end-effector distance from the commanded pose at grasp (m)
   double slip;                 // slip in the grip (m)
+  double grip_force;           // the fingers' measured mean squeeze when the fruit came off (or
+                               // when last held) (N)
   double duration;             // simulated time of the episode (s)
   int64_t steps;               // control steps
   int64_t plant_warnings;      // numerical warnings of the plant simulation

@@ -444,7 +444,8 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   h->ik_err = 0;
   h->cmd_scale = 1;
   h->held = h->ever_held = 0, h->tie = -1;
-  h->slip = 0;
+  h->slip = h->tie_slip0 = 0;
+  h->grip_n[0] = h->grip_n[1] = h->grip_at_detach = 0;
   h->pull_force = h->pull_torque = h->robot_force = vd_v3(0, 0, 0);
   h->touching[0] = h->touching[1] = h->touched[0] = h->touched[1] = 0;
   h->finger_force[0] = h->finger_force[1] = 0;
@@ -481,31 +482,41 @@ static void grasp_drive(vd_harvest* h, vd_pose e, vd_vec3* torque) {
   vd_quat want = vd_quat_mul(e.rot, h->hold_rot);
   vd_vec3 tau = vd_sub(vd_scale(quat_log_v(vd_quat_mul(want, vd_quat_conj(sd->seg_quat[t]))), k),
                        vd_scale(sd->seg_omega[t], c));
-  // the grip's friction torque bounds it: mu * 2 F_grip * r
+  // the grip's friction torque bounds it: mu (N_l + N_r) r, the fingers' measured squeeze
   const vd_method_def* md = &h->scene.method;
-  double lim = md->grip_friction * 2 * md->grip_force * f->radius, n = vd_norm(tau);
+  double lim = md->grip_friction * (h->grip_n[0] + h->grip_n[1]) * f->radius, n = vd_norm(tau);
   if (n > lim && n > 0) tau = vd_scale(tau, lim / n);
   sd->seg_torque[t] = tau;
   *torque = tau;
+  // the hold's friction limit inside the plant solve: mu (N_l + N_r) across the closing axis
+  vd_sim_tie* tie = &sd->tie[h->tie];
+  tie->max_force = md->grip_friction * (h->grip_n[0] + h->grip_n[1]);
+  if (!(tie->max_force > 0)) tie->max_force = 1e-9;  // no squeeze: nothing holds
+  tie->axis = vd_quat_rotate(e.rot, vd_v3(0, 1, 0));
 }
 
-// after a plant substep: the tie's force on the gripper; slipping when beyond friction x grip
+// after a plant substep: the tie's force on the gripper and the slip the solve let happen (the
+// tie's target slid inside the solver's iterations where the pull across the closing axis
+// reached mu (N_l + N_r)); the grasp point in the gripper moves with it
 static void grasp_slip(vd_harvest* h, vd_pose e, vd_vec3* force) {
   const robot_fruit* f = &h->fruit[h->target];
-  vd_sim_data* sd = h->sd;
-  vd_vec3 p = sd->node_pos[f->node], tg = sd->tie[h->tie].target;
-  vd_vec3 fg = vd_scale(vd_sub(p, tg), 1.0 / ROBOT_TIE_COMPLIANCE);
-  const vd_method_def* md = &h->scene.method;
-  double lim = md->grip_friction * 2 * md->grip_force, n = vd_norm(fg);
-  if (n > lim) {
-    // the fruit slides in the fingers until the tie pulls with the friction limit
-    vd_vec3 nt = vd_add(p, vd_scale(vd_sub(tg, p), lim / n));
-    h->slip += vd_norm(vd_sub(nt, tg));
-    h->hold_local = vd_quat_rotate(vd_quat_conj(e.rot), vd_sub(nt, e.pos));
-    sd->tie[h->tie].target = nt;
-    fg = vd_scale(fg, lim / n);
+  const vd_sim_tie* t = &h->sd->tie[h->tie];
+  *force = vd_scale(vd_sub(h->sd->node_pos[f->node], t->target), 1.0 / ROBOT_TIE_COMPLIANCE);
+  h->slip = h->tie_slip0 + t->slip;
+  h->hold_local = vd_quat_rotate(vd_quat_conj(e.rot), vd_sub(t->target, e.pos));
+}
+
+// the squeeze finger k's actuator exerts held at position q with target ctrl, at rest (N): its
+// gain and bias (MuJoCo's affine actuator: gain0 ctrl + bias0 + bias1 q) within its force range
+static double finger_squeeze(const mjModel* m, int a, double ctrl, double q) {
+  const mjtNum* g = m->actuator_gainprm + mjNGAIN * a;
+  const mjtNum* b = m->actuator_biasprm + mjNBIAS * a;
+  double f = g[0] * ctrl + b[0] + b[1] * q;
+  if (m->actuator_forcelimited[a]) {
+    const mjtNum* r = m->actuator_forcerange + 2 * a;
+    f = f < r[0] ? r[0] : f > r[1] ? r[1] : f;
   }
-  *force = fg;
+  return fabs(f);
 }
 
 // the finger touches and forces on the target fruit, from the last robot step
@@ -542,10 +553,16 @@ static void grasp_check(vd_harvest* h) {
   h->tie = vd_sim_add_tie(sd, f->node, p, ROBOT_TIE_COMPLIANCE);
   if (h->tie < 0) return;  // out of memory: try again next step
   h->held = h->ever_held = 1;
-  h->slip = 0;
+  h->slip = 0, h->tie_slip0 = 0;
   h->hold_local = vd_quat_rotate(vd_quat_conj(h->ee_quat), vd_sub(p, h->ee_pos));
   h->hold_rot = vd_quat_mul(vd_quat_conj(h->ee_quat), sd->seg_quat[f->seg]);
-  for (int k = 0; k < 2; k++) h->finger_q[k] = h->d->qpos[h->rb->grip_qpos[k]];
+  // the fingers stay where they met the fruit, their servos commanded closed: each squeezes
+  // with its actuator's force there (the grip force limit, unless the fruit holds them early)
+  for (int k = 0; k < 2; k++) {
+    h->finger_q[k] = h->d->qpos[h->rb->grip_qpos[k]];
+    h->grip_n[k] = finger_squeeze(h->m, h->rb->grip_act[k], h->scene.gripper_closed, h->finger_q[k]);
+  }
+  h->grip_at_detach = 0.5 * (h->grip_n[0] + h->grip_n[1]);
   // the fingers hold the fruit through the tie now: they no longer push it
   for (int k = 0; k < h->ncol; k++)
     if (h->col[k].finger >= 0) sd->collider_pass[h->col[k].sim] = f->node;
@@ -558,6 +575,12 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
   mjData* d = h->d;
   vd_sim_data* sd = h->sd;
   vd_mj_trap trap;
+  if (h->held)
+    for (int k = 0; k < 2; k++) {
+      // a held finger stays against the fruit (the fruit is in the plant solve, not in MuJoCo)
+      d->qpos[h->rb->grip_qpos[k]] = h->finger_q[k];
+      d->qvel[h->rb->grip_dof[k]] = 0;
+    }
   if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
   mj_step1(m, d);
   // the arm's controller compensates gravity and the velocity-dependent forces
@@ -646,6 +669,11 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
   if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
   mj_step2(m, d);
   vd_mj_trap_end(&trap);
+  if (h->held) {
+    // the squeeze measured: the finger actuators' force in this step
+    for (int k = 0; k < 2; k++) h->grip_n[k] = fabs(d->actuator_force[h->rb->grip_act[k]]);
+    if (!h->detached) h->grip_at_detach = 0.5 * (h->grip_n[0] + h->grip_n[1]);
+  }
   finger_contacts(h, force);
   grasp_check(h);
   return VD_OK;
@@ -795,7 +823,7 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, const d
     for (int k = 0; k < 2; k++) {
       int act = h->rb->grip_act[k];
       if (h->held) {
-        d->ctrl[act] = h->finger_q[k];
+        d->ctrl[act] = s->gripper_closed;  // squeezing; the fruit holds the finger (robot_step)
         continue;
       }
       double want = s->gripper_open + h->grip_cmd * (s->gripper_closed - s->gripper_open);
@@ -863,7 +891,7 @@ void vd_harvest_observe(const vd_harvest* h, vd_harvest_obs* o) {
   o->held = h->held;
   o->touching[0] = h->touching[0], o->touching[1] = h->touching[1];
   o->finger_force[0] = h->finger_force[0], o->finger_force[1] = h->finger_force[1];
-  o->grip_force = h->held ? h->scene.method.grip_force : 0;
+  o->grip_force = h->held ? 0.5 * (h->grip_n[0] + h->grip_n[1]) : 0;
   o->pull_force = h->pull_force;
   o->pull_torque = vd_norm(h->pull_torque);
   o->slip = h->slip;
@@ -896,6 +924,7 @@ void vd_harvest_summarize(const vd_harvest* h, vd_harvest_summary* o) {
   o->ik_error = h->grasp_ik_err;
   o->track_error = h->grasp_track_err;
   o->slip = h->slip;
+  o->grip_force = h->grip_at_detach;
   o->duration = h->sd->time;
   o->steps = h->step;
   o->plant_warnings = h->sd->nwarning;

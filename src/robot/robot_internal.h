@@ -48,7 +48,7 @@ struct vd_robot {
       arm_act[VD_ROBOT_MAX_JOINTS];
   double arm_lo[VD_ROBOT_MAX_JOINTS], arm_hi[VD_ROBOT_MAX_JOINTS];  // joint limits
   double qd_max[VD_ROBOT_MAX_JOINTS]; // joint speed limit of the command (rad/s or m/s)
-  int grip_act[2], grip_qpos[2], finger_body[2];
+  int grip_act[2], grip_qpos[2], grip_dof[2], finger_body[2];
   robot_geom geom[ROBOT_MAX_COLLIDERS];
   int ngeom;
 };
@@ -108,8 +108,11 @@ struct vd_harvest {
   int held, ever_held, tie;   // holding; tie index in sd->tie
   vd_vec3 hold_local;         // fruit centre in the end-effector frame (m)
   vd_quat hold_rot;           // conj(ee) * fruit stalk frame
-  double finger_q[2];         // finger positions frozen at the grasp (m)
+  double finger_q[2];         // finger positions held at the grasp (m)
+  double grip_n[2];           // each finger's squeeze while held: its actuator's force (N)
+  double grip_at_detach;      // the mean squeeze when the fruit came off, else while last held (N)
   double slip;                // slip so far (m)
+  double tie_slip0;           // slip before the present grasp (m)
   vd_vec3 pull_force;         // held fruit on the gripper (N), last robot step
   vd_vec3 pull_torque;        // ... its torque (N m)
   double pull_at_break;       // its size at the end of the plant step of the last fracture (N)

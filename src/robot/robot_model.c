@@ -100,6 +100,7 @@ static vd_status describe(vd_robot* h, const vd_scene* s, vd_error* err) {
                           "robot: actuator '%s' does not drive a slide or hinge joint", s->gripper[k]);
     h->grip_act[k] = a;
     h->grip_qpos[k] = m->jnt_qposadr[j];
+    h->grip_dof[k] = m->jnt_dofadr[j];
     h->finger_body[k] = m->jnt_bodyid[j];
   }
   // arm: the joints on the path from the site's body to the root, each with a servo
