@@ -62,7 +62,8 @@ static void seg_drag(void* p, int k, int t0, int t1) {
   sim_work* w = c->w;
   double q = c->q;
   (void)k;
-  for (int t = t0; t < t1; t++) {
+  // whole groups lane-parallel (sim_direct.c), the rest here
+  for (int t = sim_seg_drag_lanes(m, d, w, c->wind, q, t0, t1); t < t1; t++) {
     double* sd = w->seg_drag + 5 * t;
     sd[4] = -1;  // no drag
     if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;

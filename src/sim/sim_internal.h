@@ -369,6 +369,9 @@ void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work*
 // [t0, t1) keep their frame in seg_prev and turn by h omega (fixed ones stay), lane-parallel
 // with the same bytes as quat_rotate_by.
 void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h, int t0, int t1);
+// Each segment's air drag into w->seg_drag (sim_forces.c), lane-parallel over whole groups of
+// SIM_W segments from t0 (the same bytes as the scalar loop); returns the first segment not done.
+int sim_seg_drag_lanes(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, vd_vec3 wind, double q, int t0, int t1);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
 // 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division
