@@ -287,7 +287,6 @@ static int parse_action(PyObject* lo, PyObject* ao, PyObject* go, vd_harvest_act
 
 // rules from keywords: weights (7 numbers, vdpy_term_names' order), terminate_on_detach,
 // max_steps (None or 0: none)
-int vdpy_rules_parse(PyObject* weights, int terminate_on_detach, PyObject* max_steps, vdpy_rules* r);
 int vdpy_rules_parse(PyObject* weights, int terminate_on_detach, PyObject* max_steps, vdpy_rules* r) {
   memset(r, 0, sizeof *r);
   if (!vdpy_vec(weights, "weights", VDPY_NTERMS, r->w)) return 0;
@@ -298,7 +297,6 @@ int vdpy_rules_parse(PyObject* weights, int terminate_on_detach, PyObject* max_s
   return 1;
 }
 
-PyObject* vdpy_outcome_tuple(const vdpy_outcome* out);
 PyObject* vdpy_outcome_tuple(const vdpy_outcome* out) {
   PyObject* terms = PyDict_New();
   for (int k = 0; terms && k < VDPY_NTERMS; k++) {
@@ -519,12 +517,14 @@ static PyGetSetDef harvest_getset[] = {
 
 static PyMethodDef harvest_methods[] = {
     {"reset", (PyCFunction)(void (*)(void))harvest_reset, METH_VARARGS | METH_KEYWORDS,
+     "reset($self, /, seed, episode=0, *, randomize=True)\n--\n\n"
      "reset(seed, episode=0, *, randomize=True): start episode `episode` of the scene's\n"
      "randomisation under seed (plant seed, target, method parameters); the plant is regrown\n"
      "when its seed changes, and drawn again (up to 32 draws) while no fruit is reachable.\n"
      "Returns the draws taken; BadValueError naming the scene when none was possible. Without\n"
      "the GIL."},
     {"step", (PyCFunction)(void (*)(void))harvest_step, METH_VARARGS | METH_KEYWORDS,
+     "step($self, /, lin_vel, ang_vel, gripper)\n--\n\n"
      "step(lin_vel, ang_vel, gripper) -> bool: one control step under an end-effector velocity\n"
      "(m/s, rad/s, world frame) and a gripper command in [0, 1] (0 open, 1 closed), without the\n"
      "GIL; False when MuJoCo or the plant failed (the episode is then done)."},
@@ -538,19 +538,27 @@ static PyMethodDef harvest_methods[] = {
     {"close", (PyCFunction)harvest_close, METH_NOARGS,
      "close($self, /)\n--\n\nFree the episode and its plant now; later calls that need them raise."},
     {"run", (PyCFunction)harvest_run, METH_NOARGS,
+     "run($self, /)\n--\n\n"
      "run() -> bool: the scene's scripted controller (approach, grasp, then pull, bend or twist)\n"
      "to the end of the episode, without the GIL, as `verdant harvest` runs it; False when MuJoCo\n"
      "or the plant failed. Only before the first step() of an episode."},
     {"observe", (PyCFunction)harvest_observe, METH_NOARGS,
+     "observe($self, /)\n--\n\n"
      "observe() -> dict: time, phase, joint state q and qd, end-effector pose, target fruit, grasp\n"
      "forces, detachment."},
     {"events", (PyCFunction)(void (*)(void))harvest_events, METH_VARARGS | METH_KEYWORDS,
+     "events($self, /, since=0)\n--\n\n"
      "events(since=0) -> list of dicts: phase, touch, grasp, slip, release, fracture, detach, hit,\n"
      "drop and ik events from index since on."},
-    {"summary", (PyCFunction)harvest_summary, METH_NOARGS, "summary() -> dict: the outcome so far (summary.json)."},
+    {"summary", (PyCFunction)harvest_summary, METH_NOARGS,
+     "summary($self, /)\n--\n\n"
+     "summary() -> dict: the outcome so far (summary.json)."},
     {"cloud", (PyCFunction)(void (*)(void))harvest_cloud, METH_VARARGS | METH_KEYWORDS,
+     "cloud($self, /, **options)\n--\n\n"
      "cloud(**options) -> Cloud: the plant in its current state (Plant.cloud's keywords)."},
-    {"plant", (PyCFunction)harvest_plant, METH_NOARGS, "plant() -> Plant: the plant in its current state."},
+    {"plant", (PyCFunction)harvest_plant, METH_NOARGS,
+     "plant($self, /)\n--\n\n"
+     "plant() -> Plant: the plant in its current state."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -559,7 +567,7 @@ PyTypeObject vdpy_harvest_type = {
     .tp_basicsize = sizeof(vdpy_harvest),
     .tp_dealloc = (destructor)harvest_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
-    .tp_doc = "Harvest(scene): a harvest episode stepped from Python (see verdant.HarvestEnv).",
+    .tp_doc = "Harvest(scene)\n--\n\nHarvest(scene): a harvest episode stepped from Python (see verdant.HarvestEnv).",
     .tp_methods = harvest_methods,
     .tp_getset = harvest_getset,
     .tp_new = harvest_new,

@@ -110,7 +110,6 @@ typedef struct vdpy_sim {
   vd_sdf* sdf[VD_SIM_MAX_COLLIDERS];  // distance grids of mesh colliders (owned)
   double* wind;          // wind series rows (owned, nwind x 4)
   int nwind;
-  double* stress;        // per-segment stress buffer (owned, nseg)
   int busy;              // a thread is stepping it
 } vdpy_sim;
 
@@ -190,6 +189,11 @@ vd_status vdpy_slot_reset(vdpy_slot* o, const vd_scene* base, uint64_t seed, int
 // ready (no successful reset, or the episode is over).
 vd_status vdpy_slot_step(vdpy_slot* o, const vd_harvest_action* a, const vdpy_rules* rules, vdpy_outcome* out,
                          vd_error* err);
+// Rules from Python values: weights (VDPY_NTERMS numbers, vdpy_term_names' order),
+// terminate_on_detach, max_steps (Nullable or None: none); randomize on. 0 with an exception set.
+int vdpy_rules_parse(PyObject* weights, int terminate_on_detach, PyObject* max_steps, vdpy_rules* r);
+// (ok, reward, {term: value}, terminated, truncated, reason) of an outcome.
+PyObject* vdpy_outcome_tuple(const vdpy_outcome* out);
 // Read a scene file or its JSON text (src: str, bytes or path) into *out; NULL with an
 // exception set. Holds the GIL only for the conversion.
 int vdpy_scene_read(PyObject* src, vd_scene* out);
@@ -199,6 +203,8 @@ int vdpy_scene_read(PyObject* src, vd_scene* out);
 // old value).
 typedef struct vdpy_harvest vdpy_harvest;
 extern PyTypeObject vdpy_harvest_type;
+// N harvest episodes stepped in native threads (py_vector.c).
+extern PyTypeObject vdpy_vector_type;
 const vd_data* vdpy_harvest_plant_state(PyObject* harvest, const vd_model** plant,
                                         const vd_sim_collider** col, int* ncol);
 int vdpy_harvest_busy(PyObject* harvest, int set);
@@ -208,6 +214,8 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_load(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_cloud(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_png(PyObject* self, PyObject* args, PyObject* kw);
+// _cloud_unpickle(data, stats): a Cloud from Cloud.__reduce__'s bytes (py_cloud.c).
+PyObject* vdpy_cloud_unpickle(PyObject* self, PyObject* args);
 
 // Grow (or read) the plant file path as grow() does with seed, steps (-1: the file's) and
 // "NAME=VALUE" overrides; *out is a new spec. No Python calls: run it without the GIL.

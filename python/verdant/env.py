@@ -313,18 +313,27 @@ class HarvestEnv(_EnvBase):
             spaces["cloud_xyz"] = Box(-np.inf, np.inf, (self.cloud_points, 3), np.float32)
             spaces["cloud_label"] = Box(0, 2 ** 31 - 1, (self.cloud_points,), np.int32)
         self.observation_space = Dict(spaces)
+        self._kwargs = dict(
+            scene=scene, image=image, masks=masks, cloud=cloud, image_size=image_size,
+            cloud_points=cloud_points, max_lin_vel=max_lin_vel, max_ang_vel=max_ang_vel,
+            reward_weights=reward_weights, max_episode_steps=max_episode_steps,
+            randomize=randomize, terminate_on_detach=terminate_on_detach, render_mode=render_mode)
         if _gym is None:
-            self.spec = EnvSpec(ENV_ID, HarvestEnv, dict(
-                scene=scene, image=image, masks=masks, cloud=cloud, image_size=image_size,
-                cloud_points=cloud_points, max_lin_vel=max_lin_vel, max_ang_vel=max_ang_vel,
-                reward_weights=reward_weights, max_episode_steps=max_episode_steps,
-                randomize=randomize, terminate_on_detach=terminate_on_detach,
-                render_mode=render_mode), max_episode_steps)
+            self.spec = EnvSpec(ENV_ID, HarvestEnv, self._kwargs, max_episode_steps)
 
     # the parts of gymnasium.Env's API that the duck-typed version needs ----------------------
 
     if _gym is None:
-        spec = None
+        _spec = None
+
+        @property
+        def spec(self):
+            """The EnvSpec that makes this environment again (spec.make(**changes))."""
+            return self._spec
+
+        @spec.setter
+        def spec(self, value):
+            self._spec = value
 
         @property
         def unwrapped(self):
@@ -376,6 +385,7 @@ class HarvestEnv(_EnvBase):
         self._state = "new"
         self._draws = self._h.reset(self._seed, max(self._episode, 0), randomize=self.randomize)
         self._state = "running"
+        self._actions = []
         raw = self._h.observe()
         info = self._info(raw, [])
         info["draws"] = self._draws
@@ -392,17 +402,59 @@ class HarvestEnv(_EnvBase):
                                          "velocity, gripper)")
         a = np.clip(a, self.action_space.low, self.action_space.high)
         nev = len(self._h.events())
-        ok, reward, terms, terminated, truncated, reason = self._h.act(
-            a[:3], a[3:6], a[6], self._weights, self.terminate_on_detach, self.max_episode_steps)
+        ok, reward, terms, terminated, truncated, reason = self._act(a)
         raw = self._h.observe()
         info = self._info(raw, self._h.events(nev))
         info["reward_terms"] = terms
         if not ok:
             info["failed"] = True
         if terminated or truncated:
-            self._state = "ended"
             info["summary"], info["reason"] = self._h.summary(), reason
         return self._observation(raw), reward, terminated, truncated, info
+
+    def _act(self, a):
+        out = self._h.act(a[:3], a[3:6], a[6], self._weights, self.terminate_on_detach,
+                          self.max_episode_steps)
+        self._actions.append(a)
+        if out[3] or out[4]:
+            self._state = "ended"
+        return out
+
+    def get_state(self):
+        """The episode so far, as a dict you can keep (pickle, send to another process): its
+        seed, episode index and the actions taken since its reset. set_state() on a HarvestEnv of
+        the same scene and options replays them to the same state, bit for bit (the simulation
+        is deterministic), so the future is the same as not stopping."""
+        if self._state not in ("running", "ended"):
+            raise ResetNeeded("get_state() before a successful reset()")
+        return {"format": "verdant-harvest-state", "version": 1, "seed": self._seed,
+                "episode": self._episode,
+                "actions": np.array(self._actions, np.float64).reshape(-1, 7)}
+
+    def set_state(self, state):
+        """Go to a state of get_state(): the episode's reset, then its actions replayed without
+        observations (one C step each). Returns (observation, info) of the state reached."""
+        if state.get("format") != "verdant-harvest-state" or state.get("version") != 1:
+            raise _verdant.ArgumentError("set_state: not a state of HarvestEnv.get_state()")
+        self._seed, self._episode = int(state["seed"]), int(state["episode"]) - 1
+        obs, info = self.reset()
+        for a in np.asarray(state["actions"], np.float64).reshape(-1, 7):
+            if self._state != "running":
+                raise _verdant.ArgumentError("set_state: the actions run past the episode's end")
+            self._act(a)
+        raw = self._h.observe()
+        return self._observation(raw), self._info(raw, [])
+
+    def __getstate__(self):
+        if self._state == "closed":
+            raise TypeError("a closed HarvestEnv cannot be pickled")
+        return {"kwargs": self._kwargs,
+                "state": self.get_state() if self._state in ("running", "ended") else None}
+
+    def __setstate__(self, d):
+        self.__init__(**d["kwargs"])
+        if d["state"] is not None:
+            self.set_state(d["state"])
 
     def render(self):
         """With render_mode='rgb_array': the scene from the side (uint8 H x W x 3), the plant in
@@ -467,3 +519,8 @@ class HarvestEnv(_EnvBase):
     def __repr__(self):
         i = self._h.info
         return f"<verdant.HarvestEnv {i['scene'] or 'scene'}: {i['method']}, {i['nq']} joints>"
+
+
+if _gym is not None and ENV_ID not in _gym.registry:
+    _gym.register(id=ENV_ID, entry_point="verdant.env:HarvestEnv",
+                  vector_entry_point="verdant.vector:VectorHarvestEnv")
