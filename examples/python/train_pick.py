@@ -10,7 +10,7 @@ early candidates pick the fruit; CEM keeps the best quarter each generation and 
 Gaussian. Success is the target fruit coming off the plant within the episode.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/train_pick.py [--iterations 8]
-        [--population 16] [--threads 2] [--plot train_pick.png]
+        [--population 12] [--threads 2] [--plot train_pick.png]
 
 Prints the success rate and mean return per iteration and writes the curve as a PNG (no
 plotting library needed: a small rasteriser below).
@@ -27,10 +27,10 @@ import verdant
 HERE = os.path.dirname(os.path.abspath(__file__))
 ap = argparse.ArgumentParser()
 ap.add_argument("--scene", default=os.path.join(HERE, "..", "..", "data", "scenes", "mini_pick.json"))
-ap.add_argument("--iterations", type=int, default=8)
-ap.add_argument("--population", type=int, default=16)
+ap.add_argument("--iterations", type=int, default=6)
+ap.add_argument("--population", type=int, default=12)
 ap.add_argument("--elite", type=float, default=0.25, help="fraction kept each iteration")
-ap.add_argument("--steps", type=int, default=400, help="control steps per episode (0.01 s each)")
+ap.add_argument("--steps", type=int, default=600, help="control steps per episode (0.01 s each)")
 ap.add_argument("--threads", type=int, default=2)
 ap.add_argument("--seed", type=int, default=0)
 ap.add_argument("--plot", default="train_pick.png")
@@ -38,7 +38,7 @@ a = ap.parse_args()
 
 # parameters: offset (3, m), gain (1/s), close distance (m), pull direction (3)
 MEAN0 = np.array([0.0, 0.0, 0.0, 2.0, 0.006, 0.0, 0.0, 0.0])
-STD0 = np.array([0.03, 0.03, 0.03, 1.0, 0.004, 1.0, 1.0, 1.0])
+STD0 = np.array([0.015, 0.015, 0.015, 1.0, 0.004, 1.0, 1.0, 1.0])
 
 
 def run_generation(envs, params, seed):

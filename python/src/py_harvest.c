@@ -309,8 +309,10 @@ PyObject* vdpy_outcome_tuple(const vdpy_outcome* out) {
                        out->terminated ? Py_True : Py_False, out->truncated ? Py_True : Py_False, out->reason);
 }
 
+static PyObject* events_list(const vd_harvest* h, int since);
+
 // act(lin_vel, ang_vel, gripper, weights, terminate_on_detach, max_steps) -> (ok, reward, terms,
-// terminated, truncated, reason): one environment step
+// terminated, truncated, reason, events): one environment step, with the events it made
 static PyObject* harvest_act(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   static char* names[] = {"lin_vel", "ang_vel", "gripper", "weights", "terminate_on_detach", "max_steps", NULL};
   PyObject *lo, *ao, *go, *wo, *mo = NULL;
@@ -323,13 +325,23 @@ static PyObject* harvest_act(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   vd_error err = {0};
   vdpy_outcome out;
   vd_status st;
+  int since = o->s.nevents;
   Py_BEGIN_ALLOW_THREADS
   st = vdpy_slot_step(&o->s, &a, &r, &out, &err);
   Py_END_ALLOW_THREADS
   o->busy = 0;
   if (st == VD_ERR_ARG) return vdpy_arg_error("%s", err.msg);
   if (st) return vdpy_raise(st, &err);
-  return vdpy_outcome_tuple(&out);
+  PyObject* t = vdpy_outcome_tuple(&out);
+  PyObject* ev = t ? events_list(o->s.h, since) : NULL;
+  if (!ev) {
+    Py_XDECREF(t);
+    return NULL;
+  }
+  PyObject* all = PySequence_Concat(t, ev = Py_BuildValue("(N)", ev));
+  Py_DECREF(t);
+  Py_XDECREF(ev);
+  return all;
 }
 
 // step(lin_vel, ang_vel, gripper) -> ok: False when the episode failed (then done)
@@ -412,10 +424,15 @@ static PyObject* harvest_events(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   int64_t since = 0;
   if (so && !vdpy_i64(so, "since", 0, INT32_MAX, &since)) return NULL;
   if (!have_episode(o) || !busy_check(o)) return NULL;
+  return events_list(o->s.h, (int)since);
+}
+
+// the events of episode h from index since on, as dicts
+static PyObject* events_list(const vd_harvest* h, int since) {
   const vd_harvest_event* ev;
-  int n = vd_harvest_events(o->s.h, &ev);
+  int n = vd_harvest_events(h, &ev);
   PyObject* list = PyList_New(0);
-  for (int k = (int)since; list && k < n; k++) {
+  for (int k = since; list && k < n; k++) {
     const vd_harvest_event* e = &ev[k];
     PyObject* d = Py_BuildValue("{s:d,s:s,s:d,s:i,s:i,s:s,s:d,s:d,s:s}", "time", e->time, "kind",
                                 vd_harvest_event_name(e->kind), "value", e->value, "segment", e->seg, "instance",
@@ -533,8 +550,8 @@ static PyMethodDef harvest_methods[] = {
      "--\n\n"
      "One environment step (HarvestEnv.step) without the GIL: the action, then the reward of\n"
      "weights (7 numbers: detach, grasp, distance, pull_force, fracture, drop, hit) and the\n"
-     "ending. Returns (ok, reward, terms, terminated, truncated, reason). ArgumentError before a\n"
-     "successful reset and after the episode ended."},
+     "ending. Returns (ok, reward, terms, terminated, truncated, reason, events). ArgumentError\n"
+     "before a successful reset and after the episode ended."},
     {"close", (PyCFunction)harvest_close, METH_NOARGS,
      "close($self, /)\n--\n\nFree the episode and its plant now; later calls that need them raise."},
     {"run", (PyCFunction)harvest_run, METH_NOARGS,

@@ -2,12 +2,17 @@
 // VectorHarvest: N harvest episodes (py_harvest.c's slots) stepped side by side in native threads
 // inside one call, the engine of verdant.VectorHarvestEnv. A step takes the N actions as one
 // (N, 7) array, releases the GIL, steps (or, after an episode ended, resets: Gymnasium's
-// next-step autoreset) every slot on an OpenMP thread with the environment's reward and ending
-// rules, and returns batched observations (N, ...), rewards, terminations and truncations. No
-// Python runs per environment per step. Slot i runs episodes 0, 1, 2, ... of its own seed.
+// next-step autoreset) every slot on min(threads, N) threads with the environment's reward and
+// ending rules, and returns batched observations (N, ...), rewards, terminations and
+// truncations. No Python runs per environment per step. Slot i runs episodes 0, 1, 2, ... of its
+// own seed. The threads are plain POSIX threads made for the call and joined before it returns
+// (a few tens of microseconds against milliseconds of stepping): nothing spins between calls, as
+// OpenMP's waiting workers would on a busy machine.
 #include "py_internal.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 
 typedef struct vdpy_vector {
   PyObject_HEAD
@@ -49,7 +54,7 @@ static PyObject* vector_new(PyTypeObject* type, PyObject* args, PyObject* kw) {
     return NULL;
   int64_t n, t;
   vdpy_rules rules;
-  if (!vdpy_i64(no, "num_envs", 1, 65536, &n) || !vdpy_i64(to, "threads", 1, 1024, &t) ||
+  if (!vdpy_i64(no, "num_envs", 1, 65536, &n) || !vdpy_i64(to, "threads", 1, 64, &t) ||
       !vdpy_rules_parse(wo, tod, mo, &rules))
     return NULL;
   rules.randomize = randomize;
@@ -73,6 +78,35 @@ static PyObject* vector_new(PyTypeObject* type, PyObject* args, PyObject* kw) {
 fail:
   Py_DECREF(o);
   return NULL;
+}
+
+// ---------------------------------------------------------------------------------------------
+// running one function over every slot on the threads
+
+typedef struct pool_job {
+  vdpy_vector* o;
+  void (*fn)(vdpy_vector* o, int i, const void* arg);
+  const void* arg;
+  atomic_int next;  // the next slot to take
+} pool_job;
+
+static void* pool_worker(void* p) {
+  pool_job* j = p;
+  for (int i; (i = atomic_fetch_add(&j->next, 1)) < j->o->n;) j->fn(j->o, i, j->arg);
+  return NULL;
+}
+
+// fn(o, i, arg) for every slot i, slots taken in turn by min(threads, n) threads (the caller is
+// one of them); a thread that cannot be made leaves its share to the others. Without the GIL.
+static void pool_run(vdpy_vector* o, void (*fn)(vdpy_vector*, int, const void*), const void* arg) {
+  pool_job j = {o, fn, arg, 0};
+  int nt = o->threads < o->n ? o->threads : o->n, made = 0;
+  pthread_t th[63];
+  if (nt > 64) nt = 64;
+  for (; made < nt - 1; made++)
+    if (pthread_create(&th[made], NULL, pool_worker, &j)) break;
+  pool_worker(&j);
+  for (int k = 0; k < made; k++) pthread_join(th[k], NULL);
 }
 
 static int busy_check(vdpy_vector* o) {
@@ -173,6 +207,33 @@ done:
   return d;
 }
 
+// slot i to episode 0 of seeds[i]
+static void reset_one(vdpy_vector* o, int i, const void* arg) {
+  const uint64_t* seeds = arg;
+  memset(&o->err[i], 0, sizeof o->err[i]);
+  memset(&o->out[i], 0, sizeof o->out[i]);
+  o->st[i] = vdpy_slot_reset(&o->slot[i], &o->base, seeds[i], 0, o->rules.randomize, &o->err[i]);
+  o->reset_next[i] = 0, o->was_reset[i] = 1;
+}
+
+// slot i one step under its row of the (n, 7) actions, or its next episode when the last ended
+static void step_one(vdpy_vector* o, int i, const void* arg) {
+  const double* r = (const double*)arg + 7 * i;
+  vdpy_slot* s = &o->slot[i];
+  memset(&o->err[i], 0, sizeof o->err[i]);
+  o->was_reset[i] = o->reset_next[i];
+  if (o->reset_next[i]) {  // the episode ended at the last step: the next one, zero reward
+    memset(&o->out[i], 0, sizeof o->out[i]);
+    o->st[i] = vdpy_slot_reset(s, &o->base, s->seed, s->episode + 1, o->rules.randomize, &o->err[i]);
+    o->reset_next[i] = 0;
+    return;
+  }
+  double g = r[6] < 0 ? 0 : r[6] > 1 ? 1 : r[6];
+  vd_harvest_action act = {vd_v3(r[0], r[1], r[2]), vd_v3(r[3], r[4], r[5]), g};
+  o->st[i] = vdpy_slot_step(s, &act, &o->rules, &o->out[i], &o->err[i]);
+  o->reset_next[i] = !o->st[i] && (o->out[i].terminated || o->out[i].truncated);
+}
+
 // reset(seeds) -> (observations, info): episode 0 of seeds[i] in slot i
 static PyObject* vector_reset(vdpy_vector* o, PyObject* args, PyObject* kw) {
   static char* names[] = {"seeds", NULL};
@@ -201,15 +262,8 @@ static PyObject* vector_reset(vdpy_vector* o, PyObject* args, PyObject* kw) {
   }
   Py_DECREF(seq);
   o->busy = 1;
-  int n = o->n;
   Py_BEGIN_ALLOW_THREADS
-#pragma omp parallel for num_threads(o->threads) schedule(dynamic, 1)
-  for (int i = 0; i < n; i++) {
-    memset(&o->err[i], 0, sizeof o->err[i]);
-    memset(&o->out[i], 0, sizeof o->out[i]);
-    o->st[i] = vdpy_slot_reset(&o->slot[i], &o->base, seeds[i], 0, o->rules.randomize, &o->err[i]);
-    o->reset_next[i] = 0, o->was_reset[i] = 1;
-  }
+  pool_run(o, reset_one, seeds);
   Py_END_ALLOW_THREADS
   o->busy = 0;
   PyMem_Free(seeds);
@@ -244,23 +298,7 @@ static PyObject* vector_step(vdpy_vector* o, PyObject* args, PyObject* kw) {
   o->busy = 1;
   int n = o->n;
   Py_BEGIN_ALLOW_THREADS
-#pragma omp parallel for num_threads(o->threads) schedule(dynamic, 1)
-  for (int i = 0; i < n; i++) {
-    vdpy_slot* s = &o->slot[i];
-    memset(&o->err[i], 0, sizeof o->err[i]);
-    o->was_reset[i] = o->reset_next[i];
-    if (o->reset_next[i]) {  // the episode ended at the last step: the next one, zero reward
-      memset(&o->out[i], 0, sizeof o->out[i]);
-      o->st[i] = vdpy_slot_reset(s, &o->base, s->seed, s->episode + 1, o->rules.randomize, &o->err[i]);
-      o->reset_next[i] = 0;
-      continue;
-    }
-    const double* r = x + 7 * i;
-    double g = r[6] < 0 ? 0 : r[6] > 1 ? 1 : r[6];
-    vd_harvest_action act = {vd_v3(r[0], r[1], r[2]), vd_v3(r[3], r[4], r[5]), g};
-    o->st[i] = vdpy_slot_step(s, &act, &o->rules, &o->out[i], &o->err[i]);
-    o->reset_next[i] = !o->st[i] && (o->out[i].terminated || o->out[i].truncated);
-  }
+  pool_run(o, step_one, x);
   Py_END_ALLOW_THREADS
   o->busy = 0;
   Py_DECREF(a);

@@ -401,10 +401,9 @@ class HarvestEnv(_EnvBase):
             raise _verdant.ArgumentError("action: 7 finite numbers (linear velocity, angular "
                                          "velocity, gripper)")
         a = np.clip(a, self.action_space.low, self.action_space.high)
-        nev = len(self._h.events())
-        ok, reward, terms, terminated, truncated, reason = self._act(a)
+        ok, reward, terms, terminated, truncated, reason, events = self._act(a)
         raw = self._h.observe()
-        info = self._info(raw, self._h.events(nev))
+        info = self._info(raw, events)
         info["reward_terms"] = terms
         if not ok:
             info["failed"] = True
