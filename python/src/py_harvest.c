@@ -334,13 +334,11 @@ static PyObject* harvest_act(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   if (st) return vdpy_raise(st, &err);
   PyObject* t = vdpy_outcome_tuple(&out);
   PyObject* ev = t ? events_list(o->s.h, since) : NULL;
-  if (!ev) {
-    Py_XDECREF(t);
-    return NULL;
-  }
-  PyObject* all = PySequence_Concat(t, ev = Py_BuildValue("(N)", ev));
-  Py_DECREF(t);
+  PyObject* one = ev ? PyTuple_Pack(1, ev) : NULL;
+  PyObject* all = one ? PySequence_Concat(t, one) : NULL;
+  Py_XDECREF(t);
   Py_XDECREF(ev);
+  Py_XDECREF(one);
   return all;
 }
 

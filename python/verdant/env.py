@@ -240,9 +240,11 @@ class HarvestEnv(_EnvBase):
     Observation (a dict): q, qd (arm joints), gripper (finger opening, m), ee_pos, ee_quat
     (w, x, y, z), fruit_pos, fruit_vel (the target fruit), held, touching (two fingers),
     finger_force (N), pull_force (the held fruit's pull on the gripper, N), detached; with
-    image=True the wrist camera's picture (rgb, uint8 H x W x 3), with masks=True also its depth
-    (float32, m) and label and instance masks; with cloud=True a labelled point cloud of what the
-    wrist camera's position sees (cloud_xyz float32 (N, 3), cloud_label int32 (N)). The wrist
+    image=True the wrist camera's picture (rgb, uint8 H x W x 3) with its intrinsics camera_K
+    (3 x 3, OpenCV) and pose camera_pose (4 x 4 camera-to-world), with masks=True also its depth
+    (float32, m), label and instance masks and target_visible (the target fruit's visible
+    fraction); with cloud=True a labelled point cloud of what the wrist camera's position sees
+    (cloud_xyz float32 (N, 3), cloud_label and cloud_instance int32 (N)). The wrist
     camera looks along the end-effector's approach axis; pictures show the plant and the robot's
     collision shapes (label 65535), clouds the plant.
 
@@ -303,15 +305,20 @@ class HarvestEnv(_EnvBase):
         self.action_space = _action_space(max_lin_vel, max_ang_vel)
         spaces = _state_spaces(info["nq"])
         w, h = self.image_size
+        self._target_radius = None
         if self.image:
             spaces["rgb"] = Box(0, 255, (h, w, 3), np.uint8)
+            spaces["camera_K"] = Box(-np.inf, np.inf, (3, 3), np.float64)
+            spaces["camera_pose"] = Box(-np.inf, np.inf, (4, 4), np.float64)
         if self.masks:
             spaces["depth"] = Box(0, np.inf, (h, w), np.float32)
             spaces["label"] = Box(0, 65535, (h, w), np.int32)
             spaces["instance"] = Box(0, 2 ** 31 - 1, (h, w), np.int32)
+            spaces["target_visible"] = Box(0, 1, (1,), np.float32)
         if self.cloud:
             spaces["cloud_xyz"] = Box(-np.inf, np.inf, (self.cloud_points, 3), np.float32)
             spaces["cloud_label"] = Box(0, 2 ** 31 - 1, (self.cloud_points,), np.int32)
+            spaces["cloud_instance"] = Box(0, 2 ** 31 - 1, (self.cloud_points,), np.int32)
         self.observation_space = Dict(spaces)
         self._kwargs = dict(
             scene=scene, image=image, masks=masks, cloud=cloud, image_size=image_size,
@@ -502,13 +509,32 @@ class HarvestEnv(_EnvBase):
             f = self._draw(self.image_size, eye=eye, lookat=lookat, up=up, fov=70,
                            depth=self.masks, masks=self.masks)
             obs["rgb"] = f["rgb"]
+            obs["camera_K"], obs["camera_pose"] = f["K"], f["pose"]
             if self.masks:
                 obs["depth"], obs["label"], obs["instance"] = f["depth"], f["label"], f["instance"]
+                obs["target_visible"] = self._visible(raw, f)
         if self.cloud:
             c = self._h.cloud(points=self.cloud_points, scanners=[tuple(eye) + tuple(lookat)],
                               occlusion=True, threads=1, seed=int(raw["step"]))
             obs["cloud_xyz"], obs["cloud_label"] = np.array(c.xyz), np.array(c.label)
+            obs["cloud_instance"] = np.array(c.instance)
         return obs
+
+    def _visible(self, raw, f):
+        """The target's visible fraction: its pixels in the instance mask over the pixels its
+        sphere would cover unoccluded, pi (fx r / z)^2 (r its radius, z its depth along the
+        optical axis), at most 1; 0 behind the camera."""
+        if self._target_radius is None or self._target_radius[0] != raw["target_instance"]:
+            p = self._h.plant()
+            r = p.sphere_radii[p.sphere_instances == raw["target_instance"]]
+            self._target_radius = (raw["target_instance"], float(r.max()) if len(r) else 0.02)
+        pose, K = f["pose"], f["K"]
+        z = float((raw["fruit_pos"] - pose[:3, 3]) @ pose[:3, 2])
+        seen = int(np.count_nonzero(f["instance"] == raw["target_instance"]))
+        if z <= 1e-6:
+            return np.zeros(1, np.float32)
+        full = np.pi * (K[0, 0] * self._target_radius[1] / z) ** 2
+        return np.array([min(1.0, seen / max(full, 1e-9))], np.float32)
 
     def _info(self, raw, events):
         return {"time": raw["time"], "phase": raw["phase"], "target_instance": raw["target_instance"],

@@ -81,6 +81,7 @@ class VectorHarvestEnv(_VecBase):
 
     @property
     def unwrapped(self):
+        """The environment itself (no wrappers)."""
         return self
 
     def reset(self, *, seed=None, options=None):
@@ -119,6 +120,7 @@ class VectorHarvestEnv(_VecBase):
         return self._v.step(a)
 
     def render(self):
+        """Nothing: the vector environment draws no pictures (render_mode None)."""
         return None
 
     def close(self, **kwargs):
