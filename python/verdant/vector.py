@@ -10,7 +10,7 @@ Gymnasium's vector API (reset(seed=...) -> (observations, infos), step(actions) 
 
 The environments are HarvestEnv's (the same reward, ending rules and state observation, one
 piece of C shared by both: python/src/py_harvest.c), stepped by verdant._verdant.VectorHarvest
-(py_vector.c) on `threads` OpenMP threads without the GIL: no Python runs per environment per
+(py_vector.c) on `threads` POSIX threads without the GIL: no Python runs per environment per
 step. Autoreset follows Gymnasium's "next step" mode: the step after an environment's episode
 ended starts its next episode (its observation is the reset's, reward 0, neither terminated nor
 truncated, infos["autoreset"] true). Environment i runs episodes 0, 1, 2, ... of its own seed,
