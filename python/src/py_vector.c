@@ -195,7 +195,10 @@ static PyObject* infos(vdpy_vector* o) {
       memcpy(ROW(terms, i, double), o->out[i].terms, sizeof o->out[i].terms);
       PyObject* s = PyUnicode_FromString(o->out[i].reason);
       if (!s) goto done;
-      *ROW(reason, i, PyObject*) = s;  // the zeroed object array held NULLs: nothing to release
+      PyObject** at = ROW(reason, i, PyObject*);
+      PyObject* old = *at;  // a zeroed object array holds references to the int 0
+      *at = s;
+      Py_XDECREF(old);
     }
     d = Py_BuildValue("{s:O,s:O,s:O,s:O,s:O,s:O,s:O,s:O,s:O}", "episode", ep, "seed", seed, "target_instance",
                       tgt, "draws", draws, "time", time, "autoreset", rs, "reason", reason, "_reason", mask,
