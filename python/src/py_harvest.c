@@ -57,7 +57,7 @@ static int same_method(const vd_method_def* a, const vd_method_def* b) {
 static int no_target(const vd_harvest* h) {
   vd_harvest_obs b;
   vd_harvest_observe(h, &b);
-  return vd_harvest_done(h) || b.phase == VD_PHASE_DONE;
+  return vd_harvest_done(h) || b.target_reason != NULL;  // none chosen at the reset
 }
 
 // the episode of scene s (taken into o->scene): plant grown when its seed differs, episode built
