@@ -80,9 +80,9 @@ int cli_export(int argc, char** argv) {
         return cli_usage_error("export", "--leaf-thickness expects metres in (0, 0.1), got '%s'", val);
     } else if (!strcmp(a, "--links-per-organ")) {
       double n = 0;
-      if (!strcmp(val, "auto"))
+      if (val && !strcmp(val, "auto"))
         def.links_per_organ = 0;
-      else if (!strcmp(val, "rigid"))
+      else if (val && !strcmp(val, "rigid"))
         def.links_per_organ = -1;
       else if (cli_parse_num(val, &n) && n >= 1 && n <= 1e6 && n == floor(n))
         def.links_per_organ = (int)n;

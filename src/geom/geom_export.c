@@ -769,9 +769,15 @@ static vd_status flex_make(flex* f, const vd_model* m, const vd_export_def* def,
   double* comp = vd_malloc(sizeof(double) * 3 * ((size_t)n + 1));
   vd_status st = VD_OK;
   if (!f->lk || !f->seg_link || !f->order || !f->mesh_link || !f->kid0 || !f->next || !size ||
-      !pos || !acc || !comp)
-    st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  if (!st) st = flex_order(f, size, err);
+      !pos || !acc || !comp) {
+    vd_free(size, sizeof(int) * ((size_t)n + 1));
+    vd_free(pos, sizeof(int) * ((size_t)n + 1));
+    vd_free(acc, 10 * sizeof(double) * ((size_t)n + 1));
+    vd_free(comp, sizeof(double) * 3 * ((size_t)n + 1));
+    flex_free(f, n, m->nmesh);
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  st = flex_order(f, size, err);
   if (!st) {
     flex_links(f, def, size, acc, comp, pos);
     for (int i = 0; i < m->nmesh; i++) {
@@ -848,7 +854,7 @@ static vd_status members_make(members* g, const flex* f, int nmesh, vd_error* er
 
 // the frame origin of xlink li, -1 the base (the plant's origin) (m)
 static vd_vec3 link_origin(const flex* f, int li) {
-  return li >= 0 ? f->lk[li].origin : vd_v3(0, 0, 0);
+  return li >= 0 && f->lk ? f->lk[li].origin : vd_v3(0, 0, 0);
 }
 
 // a drawn rod segment's capsule: 0 when it has no shape

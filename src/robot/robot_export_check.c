@@ -50,7 +50,7 @@ static vd_status beam_rods(const beam* b, vd_model** pm, vd_sim_model** sm, vd_e
 
 // the rods' tip (main axis end) settled under gravity (on/off) and a tip force; deflection in z
 static double rods_sag(const vd_sim_model* sm, int gravity, double tip_force, int* ok) {
-  vd_sim_data* d = vd_sim_data_create(sm);
+  vd_sim_data* d = sm ? vd_sim_data_create(sm) : NULL;
   if (!d) return NAN;
   vd_sim_model* m = (vd_sim_model*)sm;  // the run settings are the caller's to change
   vd_vec3 g0 = m->opt.gravity;
@@ -85,20 +85,20 @@ static double mujoco_sag(const char* path, vd_vec3 tip_rest, int gravity, double
     mj_forward(mm, md);
     // the body whose frame origin is nearest the tip (the last link) and the tip in its frame
     int tb = 1;
-    double best = INFINITY, local[3];
+    double best = INFINITY, tip_body[3];
     for (int b = 1; b < mm->nbody; b++) {
       const double* x = md->xpos + 3 * b;
       double dd = hypot(hypot(x[0] - tip_rest.x, x[1] - tip_rest.y), x[2] - tip_rest.z);
       if (dd < best) best = dd, tb = b;
     }
-    double rel[3] = {tip_rest.x - md->xpos[3 * tb], tip_rest.y - md->xpos[3 * tb + 1],
-                     tip_rest.z - md->xpos[3 * tb + 2]};
-    mju_mulMatTVec(local, md->xmat + 9 * tb, rel, 3, 3);
+    double offset[3] = {tip_rest.x - md->xpos[3 * tb], tip_rest.y - md->xpos[3 * tb + 1],
+                        tip_rest.z - md->xpos[3 * tb + 2]};
+    mju_mulMatTVec(tip_body, md->xmat + 9 * tb, offset, 3, 3);
     double last = INFINITY, z = 0;
     for (int k = 0; k < 40000; k++) {
       // the tip force at the tip point: force at the body's centre of mass plus its moment
       double p[3], arm[3], f[3] = {0, 0, -tip_force}, tq[3];
-      mju_mulMatVec(p, md->xmat + 9 * tb, local, 3, 3);
+      mju_mulMatVec(p, md->xmat + 9 * tb, tip_body, 3, 3);
       mju_addTo3(p, md->xpos + 3 * tb);
       mju_sub3(arm, p, md->xipos + 3 * tb);
       mju_cross(tq, arm, f);
