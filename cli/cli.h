@@ -155,6 +155,9 @@ void cli_out_file(const char* what, const char* path);
 // '/') of the files written there, made with their folders as needed; replace: files matching
 // them that an earlier run left and this run does not write are removed when the command succeeds.
 void cli_out_folder(const char* what, const char* dir, const char* const* members, int nmember, int replace);
+// The same, named in messages as shown (a --frames pattern) rather than as the folder.
+void cli_out_pattern(const char* what, const char* shown, const char* dir, const char* const* members, int nmember,
+                     int replace);
 // Compare every declared output with every input and output, check each can be written: 0, or
 // EXIT_USAGE after printing why (nothing touched).
 int cli_out_check(const char* cmd);

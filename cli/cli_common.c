@@ -157,7 +157,7 @@ void cli_out_plant_opts(const cli_plant_opts* o) {
       n = 2;
     }
     const char* members[2] = {glob[0], glob[1]};
-    cli_out_folder("--frames", dir, members, n, 0);
+    cli_out_pattern("--frames", o->frames, dir, members, n, 0);
   }
 }
 

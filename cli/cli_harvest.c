@@ -310,7 +310,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     // no reachable target: a clean outcome, said on stderr
     char buf[1024];
     fprintf(stderr, "verdant harvest: %s\n", vd_error_format(&err, buf, sizeof buf));
-    st = VD_OK;
   }
   // the run folder: a simulation run (for 'verdant render RUN/') plus the harvest's files
   if (o->out) {

@@ -13,7 +13,7 @@
 // this one replaces but does not write). On an error, SIGINT or SIGTERM every temporary file and
 // every folder made goes, so an earlier run folder is left byte-identical. Batches that resume
 // (dataset items, harvest episodes) put each complete item in place with cli_out_publish.
-#define _XOPEN_SOURCE 700
+#define _DEFAULT_SOURCE  // realpath (XSI) beside POSIX 2008
 #include <dirent.h>
 #include <errno.h>
 #include <fnmatch.h>
@@ -63,7 +63,7 @@ static int canon(const char* path, char* out, size_t cap) {
     while (n > 1 && cur[n - 1] == '/') cur[--n] = 0;
     char real[PATH_MAX];
     if (realpath(cur, real)) {
-      int w = snprintf(out, cap, "%s%s%s", real, rest[0] && strcmp(real, "/") ? "/" : "", rest);
+      int w = snprintf(out, cap, "%s%s%s", real, rest[0] && strcmp(real, "/") != 0 ? "/" : "", rest);
       return w > 0 && (size_t)w < cap;
     }
     // not there (yet): take the last part into rest and try the folder above
@@ -112,6 +112,7 @@ typedef struct io_in {
 typedef struct io_out {
   const char* what;                     // the option ("-o", "--lstring")
   char* path;                           // as given
+  const char* shown;                    // the name messages give (path, or a --frames pattern)
   char canon[PATH_MAX];                 // canonical
   int folder;                           // a folder of files (members), else one file
   int replace;                          // folder: its members of an earlier run this one does not write go
@@ -158,6 +159,7 @@ static io_out* add_out(const char* what, const char* path) {
   memset(o, 0, sizeof *o);
   o->what = what;
   o->path = dup_str(path);
+  o->shown = o->path;
   if (!o->path || !canon(path, o->canon, sizeof o->canon)) {
     io_overflow = 1;
     return NULL;
@@ -171,8 +173,14 @@ void cli_out_file(const char* what, const char* path) {
 }
 
 void cli_out_folder(const char* what, const char* dir, const char* const* members, int nmember, int replace) {
+  cli_out_pattern(what, NULL, dir, members, nmember, replace);
+}
+
+void cli_out_pattern(const char* what, const char* shown, const char* dir, const char* const* members, int nmember,
+                     int replace) {
   io_out* o = add_out(what, dir);
   if (!o) return;
+  if (shown && !(o->shown = dup_str(shown))) io_overflow = 1;
   o->folder = 1;
   o->replace = replace;
   for (int k = 0; k < nmember && k < IO_MAX_MEMBER; k++)
@@ -285,22 +293,23 @@ int cli_out_check(const char* cmd) {
     for (int k = 0; k < io_nin; k++)
       if (replaces(o, &io_ins[k])) {
         if (o->folder && strcmp(o->canon, io_ins[k].canon) != 0)
-          return cli_usage_error(cmd, "the output folder '%s' (%s) would replace the input '%s' (%s), a name it writes "
-                                 "there; choose another output folder", o->path, o->what, io_ins[k].path, io_ins[k].what);
+          return cli_usage_error(cmd, "the output%s '%s' (%s) would replace the input '%s' (%s), a name it writes "
+                                 "there; choose another output %s", o->shown == o->path ? " folder" : "s", o->shown,
+                                 o->what, io_ins[k].path, io_ins[k].what, o->shown == o->path ? "folder" : "name");
         return cli_usage_error(cmd, "the output '%s' (%s) would replace the input '%s' (%s); choose another output name",
-                               o->path, o->what, io_ins[k].path, io_ins[k].what);
+                               o->shown, o->what, io_ins[k].path, io_ins[k].what);
       }
     for (int k = 0; k < i; k++)
       if (collide(&io_outs[k], o))
         return cli_usage_error(cmd, "the outputs '%s' (%s) and '%s' (%s) are one file; choose two names",
-                               io_outs[k].path, io_outs[k].what, o->path, o->what);
+                               io_outs[k].shown, io_outs[k].what, o->shown, o->what);
   }
   // one rule: an output that cannot be written is bad usage (2), found before anything runs; a
   // write that fails during the run (a full disk) is a failed run (1)
   for (int i = 0; i < io_nout; i++) {
     char why[PATH_MAX + 128];
     if (writable(&io_outs[i], why, sizeof why))
-      return cli_usage_error(cmd, "cannot write '%s' (%s): %s", io_outs[i].path, io_outs[i].what, why);
+      return cli_usage_error(cmd, "cannot write '%s' (%s): %s", io_outs[i].shown, io_outs[i].what, why);
   }
   return 0;
 }
@@ -381,8 +390,8 @@ static vd_status guard_open(void* user, const char* path, const char* tmp, vd_er
   parent_of(path, parent, sizeof parent);
   struct stat sb;
   if (stat(parent, &sb) != 0 && canon(parent, c, sizeof c) && declared_dir(c)) st = make_dirs(parent, err);
-  // the same file written again: its entry is reused
-  int i = st ? 0 : ent_find(tmp);
+  // the same file written again (its temporary file is there): its entry is reused
+  int i = st || access(tmp, F_OK) != 0 ? -1 : ent_find(tmp);
   if (!st && i >= 0) {
     atomic_store(&ent_at(i)->state, ENT_OPEN);
   } else if (!st) {
