@@ -30,6 +30,9 @@ static void progress(void* user, const char* name) {
 }
 
 int cli_validate(int argc, char** argv) {
+  // validate writes no outputs: its scratch files (a robot, an exported beam) live in private
+  // mkdtemp folders that the library removes before it returns, so no output layer is asked
+  vd_outfile_set_guard(NULL);
   int json = 0, full = 0;
   const char* filter = NULL;
   cli_plant_opts po;

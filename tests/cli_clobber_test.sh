@@ -41,7 +41,7 @@ TABLE[sim --grow]="--grow=N --ages=N --substeps=N --dt=N --model=N --paper=N --w
 TABLE[validate]="--json=N --full=N --case=N --plant=R"
 TABLE[harvest]="-o=D --output=D --stats=N --episodes=N --jobs=N --seed=N --frames=N --duration=N --two-way=N
   --one-way=N --no-progress=N"
-TABLE[export]="-o=W --output=W --name=N --pos=N --leaf-thickness=N --check=N --check-with=R $PLANT_OPTS"
+TABLE[export]="-o=W --output=W --name=N --pos=N --leaf-thickness=N --links-per-organ=N --damping-ratio=N --static=N --check=N --check-with=R $PLANT_OPTS"
 
 # every option a command's --help lists is in its row
 for cmd in "${!TABLE[@]}"; do
