@@ -95,6 +95,21 @@ expect "validate rigid" 0 "$V" validate --case rigid --no-progress
 expect "validate bastien" 0 "$V" validate --case bastien --no-progress
 expect "validate growth momentum" 0 "$V" validate --case growth_momentum --json --no-progress
 json_check "validate json" "len(d) == 2 and all(r['pass'] for r in d)"
+expect "validate grown stem" 0 "$V" validate --case growth_stem --json --no-progress
+json_check "grown stem sags as Euler-Bernoulli" "len(d) == 4 and all(r['pass'] for r in d)"
+
+# issue 26 defect 8: the growth bench's --help prints its usage, runs nothing, writes no CSV
+B="$(dirname "$V")/verdant_bench_growth"
+if [ -x "$B" ]; then
+  csv="$SRC/bench/results/growth-2core.csv"
+  before=$(sha256sum < "$csv" 2>/dev/null)
+  expect "bench growth help" 0 "$B" --help
+  grep -q "usage: verdant_bench_growth" "$T/out" && ok "bench help is usage" || bad "bench help is usage"
+  [ "$(sha256sum < "$csv" 2>/dev/null)" = "$before" ] && ok "bench help keeps the CSV" || bad "bench help rewrote the CSV"
+  expect "bench growth bad argument" 2 "$B" --frobnicate
+else
+  echo "skip: verdant_bench_growth not built"
+fi
 
 # pictures of the ages
 if "$V" render --help >/dev/null 2>&1; then

@@ -63,6 +63,10 @@ typedef struct vd_growth_def {
   int stress_free;        // 1: new wood is laid down without stress on the deformed tree (the
                           // rest shape follows the deformation by the new share of stiffness)
   double uproot_tilt;     // a base tilted this far after its roots gave way is uprooted (rad)
+  int paper_masses;       // mss / mrl: 1 as the seed: new nodes keep the smallest mass (eq. 1)
+                          // and every mass its last year's value for the whole age step, updated
+                          // at its end; 0 (default): each node takes its mass now (its internode,
+                          // leaves and organs this year) before the first substep, momentum kept
 } vd_growth_def;
 
 // Defaults: model mrl, ages 0 (the file's derivation length is the caller's to read), substeps
@@ -72,9 +76,10 @@ typedef struct vd_growth_def {
 vd_growth_def vd_growth_def_default(void);
 
 // The seed's own choices, for reproducing it: paper springs (k0 d / l, alternate-node springs),
-// eq. 3, the paper's wind load (eqs. 9-10 on node cross-sections) with Stokes drag (eq. 11), eq. 8
-// as printed, no strain limiting, a rigid part stepped by RK4 even when nothing holds it, no
-// stress-free growth (the rest of def is left as it is).
+// eq. 3, the paper's wind load (eqs. 9-10 on node cross-sections, C_d 1) with Stokes drag (eq. 11),
+// eq. 8 as printed, no strain limiting, a rigid part stepped by RK4 even when nothing holds it, no
+// stress-free growth, masses updated at the end of each age step (the rest of def is left as it
+// is).
 void vd_growth_def_paper(vd_growth_def* def);
 
 // A tree whose height falls below this share of its drawn height has collapsed (fallen over or

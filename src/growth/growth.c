@@ -206,10 +206,12 @@ void vd_growth_def_paper(vd_growth_def* d) {
   d->opt.integrator = VD_MSS_EQ3;
   d->opt.wind_model = VD_MSS_WIND_PAPER;
   d->opt.drag = VD_MSS_DRAG_STOKES;
+  d->opt.drag_cd = 1;  // sec. 3.3: C_drag set to 1 (Suzuki and Arikawa 2010)
   d->opt.strain_limit = 0;
   d->opt.rigid_release = 0;
   d->paper_eq8 = 1;
   d->stress_free = 0;
+  d->paper_masses = 1;
 }
 
 static void free_nodes(vd_growth* g) {
@@ -451,6 +453,25 @@ static void note_momentum(vd_growth* g, vd_vec3 before, vd_vec3 after, double sc
   if (e > g->momentum_error) g->momentum_error = e;
 }
 
+// every node takes the mass of its model now (internode volume x density, leaves and organs),
+// its momentum kept (v = m_old v_old / m_new); the rigid body keeps p and its angular momentum
+static void mass_update(vd_growth* g) {
+  vd_mss_model* m = g->mm;
+  vd_mss_data* d = g->md;
+  vd_vec3 p0 = vd_mss_momentum(m, d);
+  double sc = mss_scale(m, d);
+  int any_rigid = 0;
+  for (int k = 0; k < m->nnode; k++) {
+    if (d->removed[k]) continue;
+    double mn = m->node_mass[k];
+    if (!d->rigid[k] && !(m->node_flags[k] & VD_MSS_FIXED)) d->vel[k] = vd_scale(d->vel[k], d->mass[k] / mn);
+    any_rigid |= d->rigid[k];
+    d->mass[k] = mn;
+  }
+  if (any_rigid) vd_mss_rigid_update(m, d);
+  note_momentum(g, p0, vd_mss_momentum(m, d), fmax(sc, mss_scale(m, d)));
+}
+
 // the mass-spring state from the carried one: positions, velocities (eq. 1 for new nodes),
 // masses, the rigid body (eqs. 6-8 for nodes that hardened)
 static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
@@ -523,6 +544,9 @@ static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
   }
   vd_vec3 p1 = vd_mss_momentum(m, d);
   note_momentum(g, p0, p1, fmax(scale0, mss_scale(m, d)));
+  // the masses of this year from the first substep: new nodes, this year's leaves and the
+  // wood laid down (the seed's own rule keeps last year's until the end of the step)
+  if (!g->def.paper_masses) mass_update(g);
   // nodes that hardened join the rigid body (Algorithm 2)
   if (g->def.model == VD_GROWTH_MRL) {
     unsigned char* join = (unsigned char*)d->held;  // scratch, cleared by the next substep
@@ -988,18 +1012,7 @@ static void rods_breaking(vd_growth* g) {
 static vd_status end_mss(vd_growth* g, vd_error* err) {
   vd_mss_model* m = g->mm;
   vd_mss_data* d = g->md;
-  vd_vec3 p0 = vd_mss_momentum(m, d);
-  double sc = mss_scale(m, d);
-  int any_rigid = 0;
-  for (int k = 0; k < m->nnode; k++) {
-    if (d->removed[k]) continue;
-    double mn = m->node_mass[k];
-    if (!d->rigid[k] && !(m->node_flags[k] & VD_MSS_FIXED)) d->vel[k] = vd_scale(d->vel[k], d->mass[k] / mn);
-    any_rigid |= d->rigid[k];
-    d->mass[k] = mn;
-  }
-  if (any_rigid) vd_mss_rigid_update(m, d);
-  note_momentum(g, p0, vd_mss_momentum(m, d), fmax(sc, mss_scale(m, d)));
+  mass_update(g);
   if (m->opt.gravitropism == VD_MSS_GRAVI_BASTIEN) {
     vd_vec3* rest = vd_malloc(sizeof(vd_vec3) * (size_t)(m->nnode ? m->nnode : 1));
     vd_vec3* old = vd_malloc(sizeof(vd_vec3) * (size_t)(g->spec->nnode ? g->spec->nnode : 1));
