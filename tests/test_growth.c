@@ -335,3 +335,123 @@ TEST(growth, defect8_paper_drag_coefficient_is_one) {
   CHECK_NEAR(d.opt.drag_cd, 1.0, 0);
   CHECK_INT(d.paper_masses, 1);
 }
+
+// largest stress of the root internodes of a mass-spring tree (Pa), and the root breaks
+static double root_stress(const vd_growth* g, int* root_breaks) {
+  const vd_mss_data* d = NULL;
+  const vd_mss_model* m = vd_growth_mss(g, &d);
+  double rs = 0;
+  for (int q = 0; m && q < m->ninter; q++)
+    if (m->node_flags[m->spring_node[2 * q + 1]] & VD_MSS_ROOT) rs = fmax(rs, d->spring_stress[q]);
+  int n, nb = 0;
+  const vd_growth_event* ev = vd_growth_events(g, &n);
+  for (int k = 0; k < n; k++) nb += ev[k].kind == VD_MSS_BREAK && !strcmp(ev[k].label, "root");
+  *root_breaks = nb;
+  return rs;
+}
+
+// issue 26 defect 3: the AC model bent the clamped roots' rest shape upward: 408 MPa and 7 roots
+// broken (1.7 MPa, none without it)
+TEST(growth, defect3_bastien_leaves_roots_as_they_grew) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double rs[2];
+  int nb[2];
+  for (int gr = 0; gr < 2; gr++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_MSS;
+    def.substeps = 10;
+    def.opt.gravitropism = gr ? VD_MSS_GRAVI_BASTIEN : VD_MSS_GRAVI_NONE;
+    vd_growth* g = grow_def(ls, &def, 6, &e);
+    REQUIRE(g);
+    rs[gr] = root_stress(g, &nb[gr]);
+    vd_growth_destroy(g);
+  }
+  CHECK_INT(nb[1], 0);
+  CHECK(rs[1] < 2e6 && rs[1] <= 1.01 * rs[0] + 1);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 5: MRL stressed clamped roots (1.7 MPa against 9e-6 Pa in mss): roots joined
+// the rigid body and carried their own weight as cantilevers
+TEST(growth, defect5_mrl_leaves_clamped_roots_unstressed) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  vd_growth_def def = vd_growth_def_default();
+  def.model = VD_GROWTH_MRL;
+  def.substeps = 10;
+  vd_growth* g = grow_def(ls, &def, 6, &e);
+  REQUIRE(g);
+  int nb;
+  CHECK(root_stress(g, &nb) < 1);  // Pa: the clamp holds every root node
+  CHECK_INT(nb, 0);
+  vd_growth_stats s;
+  vd_growth_get_stats(g, &s);
+  CHECK(s.nrigid > 0);
+  vd_growth_destroy(g);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 2: MRL's rigid body never moved (welded to its clamped or held members), and
+// eq. 8 as printed gave the corrected results; now it turns about the node it grows from (RK4,
+// quaternions), swaying in gusts
+TEST(growth, defect2_mrl_rigid_body_moves_and_eq8_matters) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double sway[2], ke[2];
+  for (int paper = 0; paper < 2; paper++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_MRL;
+    def.opt.wind = vd_v3(12, 0, 0);
+    def.opt.gust_amplitude = 0.5, def.opt.gust_period = 0.7;
+    def.opt.breaking = 0;
+    def.paper_eq8 = paper;
+    vd_growth* g = grow_def(ls, &def, 5, &e);
+    REQUIRE(g);
+    vd_growth_stats s;
+    vd_growth_get_stats(g, &s);
+    const vd_mss_data* d = NULL;
+    const vd_mss_model* m = vd_growth_mss(g, &d);
+    REQUIRE(m && d && d->rb.n > 0);
+    ke[paper] = vd_rigid_energy(&d->rb);
+    // the rigid members have left their rest positions
+    sway[paper] = 0;
+    for (int k = 0; k < m->nnode; k++)
+      if (d->rigid[k]) sway[paper] = fmax(sway[paper], vd_norm(vd_sub(d->pos[k], m->node_rest[k])));
+    CHECK(!s.collapsed && !s.diverged && s.unstable == 0);
+    vd_growth_destroy(g);
+  }
+  CHECK(ke[0] > 0 && ke[1] > 0);
+  CHECK(sway[0] > 1e-5);
+  CHECK(sway[0] != sway[1]);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 4: the rods ignored the species, E, density, C_d and --no-breaking
+TEST(growth, defect4_rods_take_the_wood_and_breaking) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double mass[2];
+  for (int k = 0; k < 2; k++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_RODS;
+    def.substeps = 5;
+    def.opt.wind = vd_v3(25, 0, 0);
+    def.mss.mor = def.mss.mor_green = 1e3;  // everything would break
+    def.opt.breaking = 0;
+    if (k) def.mss.density_wood = 2 * def.mss.density_wood, def.mss.density_green *= 2;
+    vd_growth* g = grow_def(ls, &def, 2, &e);
+    REQUIRE(g);
+    vd_growth_stats s;
+    vd_growth_get_stats(g, &s);
+    CHECK_INT(s.nbroken, 0);
+    mass[k] = s.total_mass;
+    vd_growth_destroy(g);
+  }
+  CHECK(mass[1] > 1.5 * mass[0]);
+  vd_lsys_destroy(ls);
+}

@@ -57,7 +57,9 @@ typedef struct vd_growth_def {
   vd_turtle_def turtle;   // turtle settings
   vd_mss_def mss;         // mss / mrl: model settings (mss.rigid_age is set to INFINITY for mss)
   vd_mss_opt opt;         // mss / mrl: run settings and forces (opt.dt is the substep)
-  vd_sim_def rods;        // rods: model settings
+  vd_sim_def rods;        // rods: model settings; the green, wood and root materials' E, density
+                          // and C_d are replaced by mss.young_*, mss.density_* and opt.drag_cd (one
+                          // wood for every model); opt.breaking and mss.mor, mor_green also apply
   vd_sim_opt rod_opt;     // rods: run settings (rod_opt.dt is the substep)
   int paper_eq8;          // mrl: 1 joins nodes by eq. 8 as printed, 0 with the corrected term
   int bastien_substeps;   // explicit substeps of the AC model per age step (>= 1)

@@ -393,6 +393,18 @@ static vd_status build_physics(vd_growth* g, vd_error* err) {
   const vd_growth_def* def = &g->def;
   if (def->model == VD_GROWTH_RODS) {
     vd_sim_def rdef = def->rods;
+    // one wood for every model: the rods' green stems, wood and roots take the mass-spring
+    // settings' moduli, densities and drag coefficient (species presets included), issue 26
+    // defect 4; their strength is read at breaking (rods_breaking)
+    rdef.material[VD_SIM_GREEN].young = def->mss.young_green;
+    rdef.material[VD_SIM_GREEN].density = def->mss.density_green;
+    int woody_class[2] = {VD_SIM_WOOD, VD_SIM_ROOT};
+    for (int k = 0; k < 2; k++) {
+      rdef.material[woody_class[k]].young = def->mss.young_wood;
+      rdef.material[woody_class[k]].density = def->mss.density_wood;
+    }
+    int stem_class[3] = {VD_SIM_GREEN, VD_SIM_WOOD, VD_SIM_ROOT};
+    for (int k = 0; k < 3; k++) rdef.material[stem_class[k]].drag_cd = def->opt.drag_cd;
     int soil = def->mss.soil.method != VD_SOIL_CLAMP;
     if (soil) rdef.clamp_roots = 0;
     if (g->plant->nseg == 0) return VD_OK;  // nothing to simulate yet (an axiom that draws nothing)
@@ -552,7 +564,11 @@ static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
     unsigned char* join = (unsigned char*)d->held;  // scratch, cleared by the next substep
     int any = 0;
     for (int k = 0; k < nn; k++) {
-      join[k] = !d->rigid[k] && m->node_age[k] >= m->rigid_age;
+      // the hardened wood above the ground: roots stay with the soil that holds each of them up
+      // to its own resistance, clamped nodes and a held root crown are the ground's (the body
+      // turns about them), issue 26 defects 2 and 5
+      unsigned ground = VD_MSS_ROOT | VD_MSS_FIXED | VD_MSS_SOIL | VD_MSS_CROWN;
+      join[k] = !d->rigid[k] && !d->removed[k] && !(m->node_flags[k] & ground) && m->node_age[k] >= m->rigid_age;
       any |= join[k];
     }
     if (any) {
@@ -975,6 +991,7 @@ static void collect_events(vd_growth* g) {
 
 // rods: internodes whose bending stress exceeds the modulus of rupture break at the end of the step
 static void rods_breaking(vd_growth* g) {
+  if (!g->def.opt.breaking) return;
   const vd_model* p = g->plant;
   double* st = vd_malloc(sizeof(double) * (size_t)(p->nseg ? p->nseg : 1));
   if (!st) return;
