@@ -375,7 +375,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
   if (rc) return rc;
   o->paper = scan.paper, o->soil = scan.soil, o->species = scan.species;
   // options that do not apply to this run are errors, not silently ignored
-  int soil = o->soil && strcmp(o->soil, "clamp"), rods = d->model == VD_GROWTH_RODS;
+  int soil = o->soil && strcmp(o->soil, "clamp") != 0, rods = d->model == VD_GROWTH_RODS;
   int mrl = d->model == VD_GROWTH_MRL;
   const char* nosoil = "it describes roots in a soil: give --soil loam, sandy-loam, clay or singapore-residual "
                        "(clamp, the default, holds the roots fixed)";

@@ -70,6 +70,10 @@ typedef struct vd_growth_def {
                           // and every mass its last year's value for the whole age step, updated
                           // at its end; 0 (default): each node takes its mass now (its internode,
                           // leaves and organs this year) before the first substep, momentum kept
+  int paper_rigid;        // mrl: 1 as the seed: every node old enough joins the rigid body, roots
+                          // and clamped nodes too, so the body is held in place while its soil
+                          // or clamp holds; 0 (default): the wood above the ground joins and the
+                          // body turns about the clamped or held node it grows from
 } vd_growth_def;
 
 // Defaults: model mrl, ages 0 (the file's derivation length is the caller's to read), substeps
@@ -81,8 +85,8 @@ vd_growth_def vd_growth_def_default(void);
 // The seed's own choices, for reproducing it: paper springs (k0 d / l, alternate-node springs),
 // eq. 3, the paper's wind load (eqs. 9-10 on node cross-sections, C_d 1) with Stokes drag (eq. 11),
 // eq. 8 as printed, no strain limiting, a rigid part stepped by RK4 even when nothing holds it, no
-// stress-free growth, masses updated at the end of each age step (the rest of def is left as it
-// is).
+// stress-free growth, masses updated at the end of each age step, the seed's rigid part (the rest
+// of def is left as it is).
 void vd_growth_def_paper(vd_growth_def* def);
 
 // A tree whose height falls below this share of its drawn height has collapsed (fallen over or

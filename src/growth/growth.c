@@ -212,6 +212,7 @@ void vd_growth_def_paper(vd_growth_def* d) {
   d->paper_eq8 = 1;
   d->stress_free = 0;
   d->paper_masses = 1;
+  d->paper_rigid = 1;
 }
 
 static void free_nodes(vd_growth* g) {
@@ -567,7 +568,8 @@ static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
       // the hardened wood above the ground: roots stay with the soil that holds each of them up
       // to its own resistance, clamped nodes and a held root crown are the ground's (the body
       // turns about them), issue 26 defects 2 and 5
-      unsigned ground = VD_MSS_ROOT | VD_MSS_FIXED | VD_MSS_SOIL | VD_MSS_CROWN;
+      // (paper_rigid: the seed's, every node old enough, held while its soil or clamp holds)
+      unsigned ground = g->def.paper_rigid ? 0u : VD_MSS_ROOT | VD_MSS_FIXED | VD_MSS_SOIL | VD_MSS_CROWN;
       join[k] = !d->rigid[k] && !d->removed[k] && !(m->node_flags[k] & ground) && m->node_age[k] >= m->rigid_age;
       any |= join[k];
     }
