@@ -486,6 +486,18 @@ static vd_status write_sdf(out* w, const plan* p, const char* dir_rel, prim_ref*
   return st;
 }
 
+// an MJCF mesh asset of shape s, inline, its vertices less offset (the frame of its body)
+static void mjcf_mesh(FILE* fp, const char* name, const tmesh* s, vd_vec3 o) {
+  fprintf(fp, "    <mesh name=\"%s\" vertex=\"", name);
+  for (int v = 0; v < s->nv; v++)
+    fprintf(fp, "%s%.9g %.9g %.9g", v ? " " : "", s->v[3 * v] - o.x, s->v[3 * v + 1] - o.y,
+            s->v[3 * v + 2] - o.z);
+  fprintf(fp, "\" face=\"");
+  for (int t = 0; t < s->nt; t++)
+    fprintf(fp, "%s%d %d %d", t ? " " : "", s->t[3 * t], s->t[3 * t + 1], s->t[3 * t + 2]);
+  fprintf(fp, "\"/>\n");
+}
+
 static vd_status write_mjcf(out* w, const plan* p, prim_ref* pr, int cap, vd_error* err) {
   FILE* fp = w->fp;
   const vd_model* m = p->m;
@@ -509,13 +521,9 @@ static vd_status write_mjcf(out* w, const plan* p, prim_ref* pr, int cap, vd_err
       if (pr[j].kind != 2) continue;
       tmesh s;
       if ((st = mesh_shape(p, pr[j].i, d->leaf_thickness, &s, err))) break;
-      fprintf(fp, "    <mesh name=\"%s%s_m%d\" vertex=\"", pre, p->org[o].name, kmesh++);
-      for (int v = 0; v < s.nv; v++)
-        fprintf(fp, "%s%.9g %.9g %.9g", v ? " " : "", s.v[3 * v], s.v[3 * v + 1], s.v[3 * v + 2]);
-      fprintf(fp, "\" face=\"");
-      for (int t = 0; t < s.nt; t++)
-        fprintf(fp, "%s%d %d %d", t ? " " : "", s.t[3 * t], s.t[3 * t + 1], s.t[3 * t + 2]);
-      fprintf(fp, "\"/>\n");
+      char name[VD_LABEL_NAME_MAX + 128];
+      snprintf(name, sizeof name, "%s%s_m%d", pre, p->org[o].name, kmesh++);
+      mjcf_mesh(fp, name, &s, vd_v3(0, 0, 0));
       tmesh_free(&s);
     }
   }
@@ -954,14 +962,9 @@ static vd_status write_mjcf_flex(out* w, const plan* p, const flex* f, vd_error*
     tmesh s;
     if ((st = mesh_shape(p, i, d->leaf_thickness, &s, err))) break;
     vd_vec3 o = link_origin(f, f->mesh_link[i]);
-    fprintf(fp, "    <mesh name=\"%smesh_%d\" vertex=\"", pre, i);
-    for (int v = 0; v < s.nv; v++)
-      fprintf(fp, "%s%.9g %.9g %.9g", v ? " " : "", s.v[3 * v] - o.x, s.v[3 * v + 1] - o.y,
-              s.v[3 * v + 2] - o.z);
-    fprintf(fp, "\" face=\"");
-    for (int t = 0; t < s.nt; t++)
-      fprintf(fp, "%s%d %d %d", t ? " " : "", s.t[3 * t], s.t[3 * t + 1], s.t[3 * t + 2]);
-    fprintf(fp, "\"/>\n");
+    char name[128];
+    snprintf(name, sizeof name, "%smesh_%d", pre, i);
+    mjcf_mesh(fp, name, &s, o);
     tmesh_free(&s);
   }
   fprintf(fp, "  </asset>\n");
