@@ -475,49 +475,12 @@ static void remove_frames(const frame_writer* w) {
   }
 }
 
-vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
-  memset(info, 0, sizeof *info);
-  *out = NULL;
-  vd_status st;
-  // a file of another kind says what it is (not an L-Py syntax error in a mesh)
-  char kind_buf[160];
-  const char* kind = cli_not_a_plant(o->path, kind_buf, sizeof kind_buf);
-  if (kind)
-    return vd_error_set(err, VD_ERR_FORMAT, o->path, 0, 0, "%s, not a plant: verdant takes an .lpy file or a plant .json",
-                        kind);
-  if (cli_has_ext(o->path, ".json")) {
-    if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
-    if (o->animate || o->ncall)
-      return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "%s applies to .lpy files only",
-                          o->ncall ? "--call" : o->frames ? "--frames" : "--animate");
-    // a plant file or a curves file, by its "format"
-    char* text;
-    size_t len;
-    st = vd_file_read(o->path, &text, &len, err);
-    if (st) return st;
-    char fmt[32];
-    if (!strcmp(vd_plant_json_format(text, len, fmt, sizeof fmt), "verdant-curves")) {
-      st = load_curves(o, text, len, out, err);
-    } else if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0) {
-      st = vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
-    } else {
-      st = vd_plant_parse_json(text, len, o->path, out, err);
-    }
-    vd_free(text, len + 1);
-    for (int i = 0; !st && i < o->nlabel; i++) {
-      const char* eq = strchr(o->label[i], '=');
-      st = vd_plant_set_label(*out, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
-    }
-    if (!st && o->instances >= 0 && (st = vd_plant_set_instances(*out, (vd_instance_mode)o->instances)))
-      vd_error_set(err, st, o->path, 0, 0, "out of memory");
-    return st;
-  }
-  if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0)
-    return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
-  vd_lsystem* ls;
-  st = vd_lsys_load_engine(o->path, (vd_lsys_engine)o->engine, &ls, err);
-  if (st) return st;
+// an L-system's run: its --set overrides, derivation (or animation), interpretation, the
+// turtle, --call; the plant in *out
+static vd_status run_lsystem(const cli_plant_opts* o, vd_lsystem* ls, vd_plant_spec** out, cli_grow_info* info,
+                             vd_error* err) {
   info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
+  vd_status st = VD_OK;
   for (int i = 0; !st && i < o->nset; i++) {
     char name[128];
     const char* eq = strchr(o->set[i], '=');
@@ -575,7 +538,6 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   }
   vd_lstring_free(&derived);
   vd_lstring_free(&geo);
-  vd_lsys_destroy(ls);
   if (st) {
     vd_plant_spec_destroy(plant);
     cli_grow_info_free(info);
@@ -583,6 +545,58 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   }
   *out = plant;
   return VD_OK;
+}
+
+vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
+  memset(info, 0, sizeof *info);
+  *out = NULL;
+  vd_status st;
+  // a file of another kind says what it is (not an L-Py syntax error in a mesh)
+  char kind_buf[160];
+  const char* kind = cli_not_a_plant(o->path, kind_buf, sizeof kind_buf);
+  if (kind)
+    return vd_error_set(err, VD_ERR_FORMAT, o->path, 0, 0, "%s, not a plant: verdant takes an .lpy file or a plant .json",
+                        kind);
+  if (cli_has_ext(o->path, ".json")) {
+    if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
+    if (o->animate || o->ncall)
+      return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "%s applies to .lpy files only",
+                          o->ncall ? "--call" : o->frames ? "--frames" : "--animate");
+    // a plant file or a curves file, by its "format"
+    char* text;
+    size_t len;
+    st = vd_file_read(o->path, &text, &len, err);
+    if (st) return st;
+    char fmt[32];
+    if (!strcmp(vd_plant_json_format(text, len, fmt, sizeof fmt), "verdant-curves")) {
+      st = load_curves(o, text, len, out, err);
+    } else if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0) {
+      st = vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
+    } else {
+      st = vd_plant_parse_json(text, len, o->path, out, err);
+    }
+    vd_free(text, len + 1);
+    for (int i = 0; !st && i < o->nlabel; i++) {
+      const char* eq = strchr(o->label[i], '=');
+      st = vd_plant_set_label(*out, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
+    }
+    if (!st && o->instances >= 0 && (st = vd_plant_set_instances(*out, (vd_instance_mode)o->instances)))
+      vd_error_set(err, st, o->path, 0, 0, "out of memory");
+    return st;
+  }
+  if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0)
+    return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
+  vd_lsystem* ls;
+  st = vd_lsys_load_engine(o->path, (vd_lsys_engine)o->engine, &ls, err);
+  if (st) return st;
+  st = run_lsystem(o, ls, out, info, err);
+  // what the native engine refuses only when it runs: the automatic choice runs it in CPython
+  if (st && vd_lsys_fallback(&ls, st)) {
+    memset(err, 0, sizeof *err);
+    st = run_lsystem(o, ls, out, info, err);
+  }
+  vd_lsys_destroy(ls);
+  return st;
 }
 
 void cli_grow_info_free(cli_grow_info* info) {

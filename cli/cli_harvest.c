@@ -489,6 +489,17 @@ static int cmp_double(const void* a, const void* b) {
   return x < y ? -1 : x > y;
 }
 
+// the q-quantile (0 <= q <= 1) of n >= 1 sorted values by linear interpolation between order
+// statistics (Hyndman & Fan's type 7, numpy's and R's default): h = (n - 1) q,
+// Q = v[floor h] + (h - floor h) (v[floor h + 1] - v[floor h]); the median of an even count is
+// the mean of the middle two
+static double quantile(const double* v, int n, double q) {
+  double h = (n - 1) * q;
+  int i = (int)floor(h);
+  if (i >= n - 1) return v[n - 1];
+  return v[i] + (h - i) * (v[i + 1] - v[i]);
+}
+
 // statistics of n values (sorted in place): count, mean, sd, min, quartiles, max
 static cJSON* stats_json(double* v, int n) {
   cJSON* o = cJSON_CreateObject();
@@ -502,9 +513,9 @@ static cJSON* stats_json(double* v, int n) {
   cJSON_AddNumberToObject(o, "mean", mean);
   cJSON_AddNumberToObject(o, "sd", n > 1 ? sqrt(s2 / (n - 1)) : 0);
   cJSON_AddNumberToObject(o, "min", v[0]);
-  cJSON_AddNumberToObject(o, "q25", v[(n - 1) / 4]);
-  cJSON_AddNumberToObject(o, "median", v[(n - 1) / 2]);
-  cJSON_AddNumberToObject(o, "q75", v[3 * (n - 1) / 4]);
+  cJSON_AddNumberToObject(o, "q25", quantile(v, n, 0.25));
+  cJSON_AddNumberToObject(o, "median", quantile(v, n, 0.5));
+  cJSON_AddNumberToObject(o, "q75", quantile(v, n, 0.75));
   cJSON_AddNumberToObject(o, "max", v[n - 1]);
   return o;
 }
