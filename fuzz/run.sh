@@ -31,7 +31,7 @@ newest_h=$(ls -t include/verdant/*.h src/*/*.h fuzz/*.h "$OUT/gen/lsys_shim.h" |
 objs=()
 jobs=$(nproc 2>/dev/null || echo 2)
 # (the robot module only for its scene parser: MuJoCo is not linked)
-for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/sim/*.c src/robot/robot_scene.c; do
+for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/phys/*.c src/sim/*.c src/mss/*.c src/robot/robot_scene.c; do
   obj="$OUT/obj/$(basename "${src%.c}").o"
   objs+=("$obj")
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$newest_h" -nt "$obj" ]; then
