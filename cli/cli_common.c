@@ -342,8 +342,13 @@ int cli_progress_due(cli_progress* p) {
   return 1;
 }
 
+void cli_progress_clear(void) {
+  fputs("\r\033[K", stderr);
+  fflush(stderr);
+}
+
 void cli_progress_end(cli_progress* p) {
-  if (p->shown) fputc('\n', stderr);
+  if (p->shown) cli_progress_clear();
   p->shown = 0;
 }
 
@@ -355,7 +360,7 @@ static int progress_cb(void* user, int step, int steps, int64_t modules) {
   for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
   bar[w] = 0;
   fprintf(stderr, "\rderiving [%s] step %d/%d, %lld modules", bar, step, steps, (long long)modules);
-  if (step == steps) fprintf(stderr, "\n");
+  if (step == steps) cli_progress_clear();
   fflush(stderr);
   return 0;
 }
@@ -518,6 +523,9 @@ static vd_status run_lsystem(const cli_plant_opts* o, vd_lsystem* ls, vd_plant_s
   for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
   if (!st) st = name_labels(o, ls, plant, err);
   if (st && o->frames) remove_frames(&fw);
+  if (!st && !derived.n && !vd_lsys_axiom_line(ls))
+    fprintf(stderr, "verdant: %s:1:1: warning: the file has no Axiom: line, so its L-string starts empty and the "
+            "plant is empty\n", o->path);
   if (!st) {
     // module counts by symbol for --stats
     info->modules = derived.n;

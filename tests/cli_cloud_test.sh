@@ -37,7 +37,7 @@ if ls "$T"/bad.ply* >/dev/null 2>&1; then bad "no output after error"; else ok "
 expect "cloud unwritable output" 1 "$V" cloud "$A" -N 100 -o /nonexistent-dir/x.ply
 
 # a cloud, its stats, every format
-expect "cloud stats" 0 "$V" cloud "$A" -N 5000 --seed 3 -o "$T/a.ply" --stats
+expect "cloud stats" 0 "$V" cloud "$A" -N 5000 --seed 3 -o "$T/a.ply" --stats --profile
 if python3 - "$T/out" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

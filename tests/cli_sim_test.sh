@@ -67,7 +67,7 @@ expect "sim bad wind file" 2 "$V" sim "$T/p.lpy" --stats --wind-file "$T/badwind
 expect_err "wind file line named" "badwind.csv:3:"
 
 # stats: the documented fields
-expect "sim stats" 0 "$V" sim "$T/p.lpy" --duration 0.05 --stats
+expect "sim stats" 0 "$V" sim "$T/p.lpy" --duration 0.05 --stats --profile
 json_check "stats fields" "all(k in d for k in ['max_displacement','tip_displacement','kinetic_energy','events','steps_per_second','steps','time'])"
 json_check "stats steps" "d['steps'] == 50 and abs(d['time'] - 0.05) < 1e-9"
 

@@ -196,6 +196,9 @@ vd_status vd_lsys_load_engine(const char* path, vd_lsys_engine engine, vd_lsyste
 // text parsed for the Python engine and 1 is returned: the caller runs again from the start
 // (its --set overrides, derivation...). Else 0 and *ls is unchanged (the error stands).
 int vd_lsys_fallback(vd_lsystem** ls, vd_status st);
+// The line of the file's Axiom: keyword; 0 when it has none (its string then starts empty, as
+// in L-Py).
+int vd_lsys_axiom_line(const vd_lsystem* ls);
 // The engine that runs ls (VD_LSYS_NATIVE or VD_LSYS_PYTHON).
 vd_lsys_engine vd_lsys_get_engine(const vd_lsystem* ls);
 // "auto", "native" or "python".

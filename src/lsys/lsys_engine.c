@@ -104,6 +104,10 @@ vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name, v
   return lsys_parse_with(text, len, name, VD_LSYS_PYTHON, out, err);
 }
 
+int vd_lsys_axiom_line(const vd_lsystem* ls) {
+  return ls->axiom_line;
+}
+
 int vd_lsys_fallback(vd_lsystem** ls, vd_status st) {
   vd_lsystem* old = *ls;
   if (!old || !old->auto_text || (st != VD_ERR_UNSUPPORTED && st != VD_ERR_TYPE)) return 0;
