@@ -309,6 +309,20 @@ static void outcome_line(const vd_harvest* h, const char* out) {
           r.grasped ? "grasped" : "not grasped", detail, out);
 }
 
+// the files a scene names are there; else exit 2 naming the key, the path and the folder a
+// relative path is read from (a broken "../tomato.lpy" said only that a file was missing)
+static int scene_files_exist(const vd_scene* s) {
+  const char* key[2] = {"plant.file", "robot.mjcf"};
+  const char* path[2] = {s->plant_path, s->robot_path};
+  for (int k = 0; k < 2; k++)
+    if (path[k][0] && access(path[k], F_OK) != 0) {
+      fprintf(stderr, "verdant harvest: %s: %s: '%s' does not exist (%s; a relative path is read from the scene's folder)\n",
+              s->path, key[k], path[k], strerror(errno));
+      return 0;
+    }
+  return 1;
+}
+
 static int run_one(const harvest_opts* o, vd_scene* s) {
   vd_error err = {0};
   vd_plant_spec* spec = NULL;
@@ -767,6 +781,10 @@ int cli_harvest(int argc, char** argv) {
   vd_error err = {0};
   vd_status st = vd_scene_read(o.scene, &s, &err);
   if (st) return cli_report("harvest", &err, st);
+  if (!scene_files_exist(&s)) {
+    vd_scene_free(&s);
+    return EXIT_USAGE;
+  }
   if (!o.out && !o.stats) {
     vd_scene_free(&s);
     return cli_usage_error("harvest", "nothing to do: give -o RUN and/or --stats");

@@ -4,12 +4,10 @@
 // be ignored in silence); relative paths resolved against the scene's folder. Also the per-
 // episode scene of a batch and the plant's placement.
 #include <cjson/cJSON.h>
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "robot_internal.h"
 
@@ -157,11 +155,6 @@ static vd_status path_of(rd* r, const cJSON* o, const char* where, const char* k
   int n = (p[0] == '/' || !r->dir[0]) ? snprintf(out, cap, "%s", p)
                                       : snprintf(out, cap, "%s/%s", r->dir, p);
   if (n < 0 || (size_t)n >= cap) return bad(r, where, key, "a shorter path");
-  // a file that is not there is named with the key that names it and the folder it is relative to
-  if (access(out, F_OK) != 0)
-    return vd_error_set(r->err, VD_ERR_IO, r->file, 0, 0, "%s%s%s: '%s' %s%s%sdoes not exist: %s", where,
-                        *where ? "." : "", key, p, p[0] == '/' ? "" : "(relative to the scene's folder: ",
-                        p[0] == '/' ? "" : out, p[0] == '/' ? "" : ") ", strerror(errno));
   return VD_OK;
 }
 
