@@ -348,9 +348,7 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
     cloud_bar bar = {{po->progress, 0, 0}, "writing ", 0};
     wd.progress = cloud_progress;
     wd.progress_user = &bar;
-    int w = cli_watch(out);
     st = vd_cloud_write(&cloud, out, &wd, err);
-    cli_unwatch(w);
     cli_progress_end(&bar.bar);
     if (st) res->write_failed = 1;
   }
@@ -528,8 +526,11 @@ int cli_cloud(int argc, char** argv) {
   if (out && vd_cloud_format_of(out) == VD_CLOUD_AUTO)
     return cli_usage_error("cloud", "output '%s': unknown format (use .ply, .pcd, .xyz, .csv or .las)", out);
   if (cli_cloud_check(&co, "cloud") || cli_cloud_check_output(&co, "cloud", out)) return EXIT_USAGE;
-  const char* ins[2] = {po.path, co.scanners_file};
-  if (out && cli_check_outputs("cloud", &out, 1, ins, 2)) return EXIT_USAGE;
+  // the files: the plant and the scanners read, the cloud written
+  cli_out_plant_opts(&po);
+  cli_out_input("--scanners", co.scanners_file);
+  cli_out_file("-o", out);
+  if (cli_out_check("cloud")) return EXIT_USAGE;
   vd_error err = {0};
   cli_cloud_result res;
   vd_status st = cli_cloud_make(&po, &co, out, &res, &err);

@@ -92,6 +92,21 @@ int cli_export(int argc, char** argv) {
     return cli_usage_error("export", "output '%s': use .urdf, .sdf or .xml (MuJoCo MJCF)", out);
   if (check && def.format != VD_EXPORT_MJCF)
     return cli_usage_error("export", "--check and --check-with load MJCF (.xml) in MuJoCo");
+  // the files: the plant and the robot read, the file and its meshes written (the meshes of an
+  // earlier export there that this one does not write go)
+  cli_out_plant_opts(&po);
+  cli_out_input("--check-with", with);
+  cli_out_file("-o", out);
+  if (def.format != VD_EXPORT_MJCF) {
+    const char* slash = strrchr(out, '/');
+    const char* dot = strrchr(out, '.');
+    size_t n = dot && (!slash || dot > slash) ? (size_t)(dot - out) : strlen(out);
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%.*s_meshes", (int)n, out);
+    const char* members[1] = {"*.obj"};
+    cli_out_folder("-o", dir, members, 1, 1);
+  }
+  if (cli_out_check("export")) return EXIT_USAGE;
   // the plant, its model, the files
   vd_error err = {0};
   vd_plant_spec* spec = NULL;
@@ -106,17 +121,18 @@ int cli_export(int argc, char** argv) {
     code = cli_report("export", &err, st);
     goto done;
   }
-  int w = cli_watch(out);
   st = vd_geom_export(m, NULL, &def, out, &err);
-  cli_unwatch(w);
   if (st) {
     code = cli_report("export", &err, st);
     if (st == VD_ERR_IO) code = EXIT_FAIL;
     goto done;
   }
   if (check) {
-    // the plant alone, or in a scene with the robot
-    const char* parts[2] = {with ? with : out, out};
+    // the plant alone, or in a scene with the robot (the file is under its temporary name until
+    // the command ends)
+    char now[4300];
+    cli_out_current(out, now, sizeof now);
+    const char* parts[2] = {with ? with : now, now};
     char prefix[64];
     snprintf(prefix, sizeof prefix, "%s/", def.name);
     vd_mjcf_info mi;

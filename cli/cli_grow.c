@@ -227,11 +227,11 @@ int cli_grow(int argc, char** argv) {
   if (profile && !stats) return cli_usage_error("grow", "--profile adds timings to --stats; give --stats");
   if (ascii && !(out && cli_has_ext(out, ".ply")))
     return cli_usage_error("grow", "--ascii applies to a .ply output (plant JSON and OBJ are text already)");
-  char files[2][4200];
-  const char* outs[3] = {files[0], files[1], NULL};
-  int nf = out ? cli_plant_files(out, files) : 0;
-  if (traits) outs[nf++] = traits;
-  if (cli_check_outputs("grow", outs, nf, (const char* const[]){po.path}, 1)) return EXIT_USAGE;
+  // the files: declared and checked before anything runs
+  cli_out_plant_opts(&po);
+  if (out) cli_out_plant("-o", out);
+  if (traits) cli_out_file("--traits", traits);
+  if (cli_out_check("grow")) return EXIT_USAGE;
   vd_error err = {0};
   vd_plant_spec* plant;
   cli_grow_info info;
@@ -246,18 +246,9 @@ int cli_grow(int argc, char** argv) {
     vd_error_set(&err, st, "", 0, 0, "out of memory");
     return cli_report("grow", &err, st);
   }
-  // the file, its material library and the traits: together or not at all
-  cli_outset set;
-  if (nf && (st = cli_outset_begin(&set, outs, nf, NULL, &err))) {
-    vd_plant_spec_destroy(plant);
-    cli_grow_info_free(&info);
-    vd_free(tr, (size_t)ntr * sizeof *tr);
-    cli_report("grow", &err, st);
-    return EXIT_FAIL;
-  }
+  // the file, its material library and the traits: in place together when the command ends
   if (out) st = cli_write_plant(plant, out, ascii, &err);
   if (!st && traits) st = write_traits(traits, plant, tr, ntr, &err);
-  if (nf) cli_outset_end(&set, st == VD_OK);
   cli_blame_input(&err, po.path);  // a plant that does not compile (output errors name the output)
   if (!st && stats && !print_stats(plant, &info, tr, ntr, profile)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   vd_free(tr, (size_t)ntr * sizeof *tr);

@@ -188,13 +188,11 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
 // write text to path atomically
 static vd_status write_text(const char* path, const char* text, vd_error* err) {
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     st = vd_outfile_commit(&f, err);
   }
-  cli_unwatch(w);
   return st;
 }
 
@@ -215,10 +213,8 @@ static vd_status write_events(const vd_harvest* h, const char* dir, vd_error* er
   char path[4200];
   snprintf(path, sizeof path, "%s/events.csv", dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (st) {
-    cli_unwatch(w);
     return st;
   }
   fputs("time_s,event,value,segment,instance,class,force_N,moment_Nm,site\n", f.fp);
@@ -235,7 +231,6 @@ static vd_status write_events(const vd_harvest* h, const char* dir, vd_error* er
             e->kind == VD_EV_DETACH ? vd_harvest_site_name(e->site) : "");
   }
   st = vd_outfile_commit(&f, err);
-  cli_unwatch(w);
   return st;
 }
 
@@ -244,7 +239,7 @@ typedef struct episode_out {
   const harvest_opts* o;
   cli_frames frames;
   vd_outfile traj;
-  int traj_open, traj_watch, progress;
+  int traj_open, progress;
   double next_frame, fps;
   int write_failed;
 } episode_out;
@@ -332,7 +327,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
   episode_out eo;
   memset(&eo, 0, sizeof eo);
   eo.o = o;
-  eo.frames.watch = eo.frames.cwatch = eo.traj_watch = -1;
   eo.fps = s->fps;
   eo.progress = o->progress;
   vd_status st = scene_plant(s, &spec, &plant, &err);
@@ -349,12 +343,10 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     // no reachable target: a clean outcome, said on stderr
     char buf[1024];
     fprintf(stderr, "verdant harvest: %s\n", vd_error_format(&err, buf, sizeof buf));
-    st = VD_OK;
   }
   // the run folder: a simulation run (for 'verdant render RUN/') plus the harvest's files
   if (o->out) {
-    if (mkdir(o->out, 0777) && errno != EEXIST)
-      st = vd_error_set(&err, VD_ERR_IO, o->out, 0, 0, "cannot create the output folder: %s", strerror(errno));
+    st = vd_outdir_make(o->out, &err);
     if (!st) st = cli_rod_json_write(vd_harvest_sim_model(h), plant, &s->sim_def, o->out, &err);
     char path[4200];
     if (!st) {
@@ -364,7 +356,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     if (!st && s->frames) st = cli_frames_begin(&eo.frames, vd_harvest_sim_model(h), o->out, s->frames == 2, &err);
     if (!st) {
       snprintf(path, sizeof path, "%s/trajectory.csv", o->out);
-      eo.traj_watch = cli_watch(path);
       st = vd_outfile_open(&eo.traj, path, &err);
       if (!st) {
         eo.traj_open = 1;
@@ -422,7 +413,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
   }
 done:
   if (eo.traj_open) vd_outfile_abort(&eo.traj);
-  cli_unwatch(eo.traj_watch);
   cli_frames_abort(&eo.frames);
   vd_harvest_destroy(h);
   vd_model_destroy(plant);
@@ -527,6 +517,9 @@ static vd_status make_episode(const batch* b, int k, vd_error* err) {
     char path[4300];
     record_path(b, k, path, sizeof path);
     st = write_json(path, r, err);
+    // a complete episode is kept even when the batch stops later (it resumes from there)
+    const char* done[1] = {path};
+    if (!st && cli_out_publish(done, 1, 1)) st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot put the record in place");
   }
   vd_harvest_destroy(h);
   vd_model_destroy(plant);
@@ -577,7 +570,6 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
   char path[4300];
   snprintf(path, sizeof path, "%s/episodes.csv", b->dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, &err);
   double* force = vd_malloc(sizeof(double) * (size_t)n * 2);
   double* pforce = force ? force + n : NULL;
@@ -624,7 +616,6 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
     if (st) vd_outfile_abort(&f);
     else st = vd_outfile_commit(&f, &err);
   }
-  cli_unwatch(w);
   cJSON* o = st ? NULL : cJSON_CreateObject();
   if (o) {
     cJSON_AddStringToObject(o, "format", "verdant-harvest-batch");
@@ -694,8 +685,8 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
   snprintf(b.key, sizeof b.key, "%016llx", (unsigned long long)key);
   char sub[4300];
   snprintf(sub, sizeof sub, "%s/episodes", b.dir);
-  if ((mkdir(b.dir, 0777) && errno != EEXIST) || (mkdir(sub, 0777) && errno != EEXIST)) {
-    fprintf(stderr, "verdant harvest: %s: cannot create the folder: %s\n", sub, strerror(errno));
+  if ((st = vd_outdir_make(b.dir, &err)) || (st = vd_outdir_make(sub, &err))) {
+    cli_report("harvest", &err, st);
     return EXIT_FAIL;
   }
   int n = o->episodes;
@@ -790,6 +781,22 @@ int cli_harvest(int argc, char** argv) {
     return cli_usage_error("harvest", "nothing to do: give -o RUN and/or --stats");
   }
   override(&o, &s);
+  // the files: the scene and what it names read; the run folder written (a single run replaces
+  // an earlier one's files; a batch keeps its complete episodes and resumes)
+  static const char* const run_files[] = {"summary.json", "events.csv", "trajectory.csv"};
+  static const char* const batch_files[] = {"summary.json", "episodes.csv", "episodes/*.json"};
+  const char* members[32];
+  int nm = 0;
+  for (int k = 0; !o.episodes && k < cli_run_nmember && nm < 29; k++) members[nm++] = cli_run_members[k];
+  for (int k = 0; k < 3; k++) members[nm++] = o.episodes ? batch_files[k] : run_files[k];
+  cli_out_input("SCENE", o.scene);
+  cli_out_input("the scene's plant", s.plant_path);
+  cli_out_input("the scene's robot", s.robot_path);
+  if (o.out) cli_out_folder("-o", o.out, members, nm, !o.episodes);
+  if (cli_out_check("harvest")) {
+    vd_scene_free(&s);
+    return EXIT_USAGE;
+  }
   rc = o.episodes ? run_batch(&o, &s) : run_one(&o, &s);
   vd_scene_free(&s);
   return rc;

@@ -308,13 +308,11 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
 
 static vd_status write_text(const char* path, const char* text, vd_error* err) {
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     st = vd_outfile_commit(&f, err);
   }
-  cli_unwatch(w);
   return st;
 }
 
@@ -454,11 +452,14 @@ int cli_sim_grow(int argc, char** argv) {
   if (!o.out && !o.stats && !o.final) return cli_usage_error(cmd, "nothing to do: give -o RUN/, --final FILE and/or --stats");
   if (o.profile && !o.stats) return cli_usage_error(cmd, "--profile adds timings to --stats; give --stats");
   if (o.ply && !o.out) return cli_usage_error(cmd, "--ply writes into the run folder: give -o RUN/");
-  {
-    const char* ins[1] = {o.po.path};
-    const char* outs[2] = {o.out, o.final};
-    if (cli_check_outputs(cmd, outs, 2, ins, 1)) return EXIT_USAGE;
-  }
+  // the files: the model and the wind series read; the growth run folder (an earlier run's ages
+  // that this one does not write go when it completes) and --final written
+  static const char* const members[] = {"growth.json", "events.csv", "plant.json", "age_*.json", "age_*.ply"};
+  cli_out_plant_opts(&o.po);
+  cli_out_input("--wind-file", o.wind_file);
+  if (o.out) cli_out_folder("-o", o.out, members, 5, 1);
+  if (o.final) cli_out_plant("--final", o.final);
+  if (cli_out_check(cmd)) return EXIT_USAGE;
   vd_error err = {0};
   vd_lsystem* ls = NULL;
   vd_growth* g = NULL;
@@ -498,9 +499,8 @@ int cli_sim_grow(int argc, char** argv) {
   }
   cJSON_AddItemToObject(index, "snapshots", snaps);
   // the run folder: failing to write is a failed run (exit 1), not bad input
-  if (o.out && mkdir(o.out, 0777) && errno != EEXIST) {
-    vd_error_set(&err, VD_ERR_IO, o.out, 0, 0, "cannot create the output folder: %s", strerror(errno));
-    cli_report(cmd, &err, VD_ERR_IO);
+  if (o.out && (st = vd_outdir_make(o.out, &err))) {
+    cli_report(cmd, &err, st);
     code = EXIT_FAIL;
     goto done;
   }

@@ -34,7 +34,7 @@ printf 'Axiom: A\nproduction:\nA --> B(1 +)\n' >"$T/bad.lpy"
 expect "cloud syntax error" 2 "$V" cloud "$T/bad.lpy" -o "$T/bad.ply"
 expect_err "syntax error location" "bad.lpy:3:[0-9]+: "
 if ls "$T"/bad.ply* >/dev/null 2>&1; then bad "no output after error"; else ok "no output after error"; fi
-expect "cloud unwritable output" 1 "$V" cloud "$A" -N 100 -o /nonexistent-dir/x.ply
+expect "cloud unwritable output" 2 "$V" cloud "$A" -N 100 -o /nonexistent-dir/x.ply
 
 # a cloud, its stats, every format
 expect "cloud stats" 0 "$V" cloud "$A" -N 5000 --seed 3 -o "$T/a.ply" --stats --profile

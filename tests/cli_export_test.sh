@@ -3,7 +3,7 @@
 # End-to-end tests of `verdant export`: URDF, SDF and MJCF files of the tomato; the MJCF loads in
 # MuJoCo alone and beside the arm (--check, --check-with: always run, no OpenGL needed); the URDF
 # passes check_urdf (liburdfdom-tools) and the SDF `ign sdf -k` (ignition-tools, libsdformat)
-# when they are installed; bad usage is exit 2, an unwritable output exit 1, nothing left.
+# when they are installed; bad usage and an unwritable output are exit 2, nothing left.
 # Usage: cli_export_test.sh VERDANT_BINARY SOURCE_DIR
 source "$(dirname "$0")/cli_lib.sh" cli_export "$@"
 
@@ -63,8 +63,8 @@ else
   echo "skip: ign sdf is not installed (Debian: ignition-tools, libsdformat-dev)"
 fi
 
-# an unwritable output: exit 1, nothing left (no mesh folder either)
-expect "unwritable export" 1 "$V" export "$SRC/data/tomato.lpy" -o "/nonexistent-dir/p.urdf"
+# an unwritable output: exit 2 (found before the run), nothing left (no mesh folder either)
+expect "unwritable export" 2 "$V" export "$SRC/data/tomato.lpy" -o "/nonexistent-dir/p.urdf"
 if [ -e /nonexistent-dir ]; then bad "nothing left after a failed export"; else ok "nothing left after a failed export"; fi
 
 echo "$pass passed, $fail failed"

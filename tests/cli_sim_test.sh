@@ -143,7 +143,7 @@ json_check "probe no penetration" "d['max_penetration'] < 1e-4"
 mkdir -p "$T/ro"
 chmod 500 "$T/ro"
 if [ "$(id -u)" -ne 0 ]; then
-  expect "unwritable output" 1 "$V" sim "$T/p.lpy" --duration 0.01 -o "$T/ro/run"
+  expect "unwritable output" 2 "$V" sim "$T/p.lpy" --duration 0.01 -o "$T/ro/run"
 else
   ok "unwritable output (skipped as root)"
 fi

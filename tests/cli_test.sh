@@ -99,8 +99,8 @@ if command -v assimp >/dev/null 2>&1; then
 else
   echo "skip assimp import checks (assimp-utils not installed)"
 fi
-# an unwritable output: exit 1 (failed run), no temporary file left
-expect "unwritable output" 1 "$V" grow "$T/plant.lpy" -o "/nonexistent-dir/x.obj"
+# an unwritable output: exit 2 (found before the run; docs/reliability.md), no temporary file left
+expect "unwritable output" 2 "$V" grow "$T/plant.lpy" -o "/nonexistent-dir/x.obj"
 # --lstring: the derived string as JSON (names and parameters)
 expect "grow --lstring" 0 "$V" grow "$T/plant.lpy" -o "$T/ls.json" --lstring "$T/lstring.json" -n 1
 if /usr/bin/python3 -c 'import json,sys; m = json.load(open(sys.argv[1]))["modules"]; assert [x[0] for x in m] == ["SetWidth", "I", "[", "+", "Leaf", "]", "/", "A"] and m[7] == ["A", 2]' "$T/lstring.json"; then

@@ -607,10 +607,9 @@ vd_status vd_geom_export(const vd_model* m, const vd_data* d, const vd_export_de
   mesh_dirs(path, dir, sizeof dir, rel, sizeof rel);
   int made_dir = 0, nfile = 0;
   if (ed.format != VD_EXPORT_MJCF && m->nmesh > 0) {
-    if (mkdir(dir, 0777) == 0)
-      made_dir = 1;
-    else if (errno != EEXIST)
-      st = vd_error_set(err, VD_ERR_IO, dir, 0, 0, "cannot create the mesh folder: %s", strerror(errno));
+    struct stat sb;
+    made_dir = stat(dir, &sb) != 0;
+    st = vd_outdir_make(dir, err);
     for (int o = 0; !st && o < p.norg; o++) {
       int n = organ_prims(&p, o, pr, cap), kmesh = 0;
       for (int j = 0; !st && j < n && j < cap; j++) {
@@ -652,11 +651,11 @@ vd_status vd_geom_export(const vd_model* m, const vd_data* d, const vd_export_de
         if (pr[j].kind != 2) continue;
         char file[4800];
         snprintf(file, sizeof file, "%s/%s_m%d.obj", dir, p.org[o].name, kmesh++);
-        unlink(file);
+        vd_outfile_remove(file);
       }
     }
   }
-  if (st && made_dir) rmdir(dir);
+  if (st && made_dir) vd_outdir_remove(dir);
   vd_free(pr, sizeof(prim_ref) * (size_t)cap);
   plan_free(&p);
   return st;
