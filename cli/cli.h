@@ -124,6 +124,8 @@ double cli_now(void);
 // A progress bar on stderr: "\rWHAT [####    ] TEXT" (frac in [0, 1]); the caller ends it with
 // a newline. Callers show it only when stderr is a terminal (cli_plant_opts.progress).
 void cli_progress_bar(const char* what, double frac, const char* text);
+// the end of a bar: its line cleared, nothing left on screen
+void cli_progress_clear(void);
 // When to redraw a bar: at the first call, then at most ten times a second; off when on is 0.
 typedef struct cli_progress {
   int on, shown;
@@ -228,7 +230,8 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
 // Points per label table entry (count has c->nlabel slots); 0 when out of memory.
 int cli_label_counts(const vd_cloud* c, int64_t* count);
 // The --stats JSON of a result (caller deletes it), NULL when out of memory.
-struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total);
+// profile: also the threads, the seconds per stage and the rates (timings: not the same bytes twice)
+struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total, int profile);
 
 // Simulation runs on disk (cli_run.c): the rod build settings of rod.json, the colliders of
 // colliders.jsonl, and a run read back frame by frame.

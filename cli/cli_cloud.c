@@ -50,8 +50,10 @@ static const char* cloud_usage =
     "options:\n"
     "  -o, --output OUT      the cloud file (written under a temporary name, then renamed)\n"
     "      --stats           print a JSON summary on stdout: points, labels (points per label),\n"
-    "                        instances, bbox_min, bbox_max (m), area (m^2), rejected counts,\n"
-    "                        seconds per stage, points_per_second\n";
+    "                        instances, bbox_min, bbox_max (m), area (m^2), rejected counts;\n"
+    "                        the same bytes for the same inputs\n"
+    "      --profile         --stats adds threads, seconds per stage and points_per_second:\n"
+    "                        timings, which differ per run\n";
 
 void cli_cloud_opts_init(cli_cloud_opts* o) {
   memset(o, 0, sizeof *o);
@@ -414,7 +416,7 @@ int cli_label_counts(const vd_cloud* c, int64_t* count) {
   return 1;
 }
 
-cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
+cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total, int profile) {
   const vd_cloud* c = &r->cloud;
   const vd_cloud_stats* s = &r->stats;
   cJSON* root = cJSON_CreateObject();
@@ -464,6 +466,7 @@ cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
   cJSON_AddNumberToObject(rej, "occluded", (double)s->rejected_occluded);
   cJSON_AddNumberToObject(rej, "noise", (double)s->rejected_noise);
   cJSON_AddNumberToObject(root, "missed_rays", (double)s->missed);
+  if (!profile) return root;
   cJSON_AddNumberToObject(root, "threads", s->threads);
   cJSON* t = cJSON_AddObjectToObject(root, "seconds");
   cJSON_AddNumberToObject(t, "load", r->seconds_load);
@@ -487,7 +490,7 @@ int cli_cloud(int argc, char** argv) {
   cli_cloud_opts co;
   cli_cloud_opts_init(&co);
   const char* out = NULL;
-  int stats = 0;
+  int stats = 0, profile = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -507,6 +510,8 @@ int cli_cloud(int argc, char** argv) {
       out = argv[++i];
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error("cloud", "unknown option '%s'", a);
     } else if (!po.path) {
@@ -517,6 +522,7 @@ int cli_cloud(int argc, char** argv) {
   }
   if (!po.path) return cli_usage_error("cloud", "missing PLANT (an .lpy or plant .json file)");
   if (!out && !stats) return cli_usage_error("cloud", "nothing to do: give -o OUT and/or --stats");
+  if (profile && !stats) return cli_usage_error("cloud", "--profile adds timings to --stats; give --stats");
   if (out && vd_cloud_format_of(out) == VD_CLOUD_AUTO)
     return cli_usage_error("cloud", "output '%s': unknown format (use .ply, .pcd, .xyz, .csv or .las)", out);
   if (cli_cloud_check(&co, "cloud") || cli_cloud_check_output(&co, "cloud", out)) return EXIT_USAGE;
@@ -533,7 +539,7 @@ int cli_cloud(int argc, char** argv) {
     return res.write_failed && st == VD_ERR_IO ? EXIT_FAIL : code;
   }
   if (stats) {
-    cJSON* root = cli_cloud_stats_json(&res, cli_now() - start);
+    cJSON* root = cli_cloud_stats_json(&res, cli_now() - start, profile);
     char* text = root ? cJSON_Print(root) : NULL;
     if (text) {
       fputs(text, stdout);

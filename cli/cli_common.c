@@ -356,8 +356,13 @@ int cli_progress_due(cli_progress* p) {
   return 1;
 }
 
+void cli_progress_clear(void) {
+  fputs("\r\033[K", stderr);
+  fflush(stderr);
+}
+
 void cli_progress_end(cli_progress* p) {
-  if (p->shown) fputc('\n', stderr);
+  if (p->shown) cli_progress_clear();
   p->shown = 0;
 }
 
@@ -369,7 +374,7 @@ static int progress_cb(void* user, int step, int steps, int64_t modules) {
   for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
   bar[w] = 0;
   fprintf(stderr, "\rderiving [%s] step %d/%d, %lld modules", bar, step, steps, (long long)modules);
-  if (step == steps) fprintf(stderr, "\n");
+  if (step == steps) cli_progress_clear();
   fflush(stderr);
   return 0;
 }
@@ -469,6 +474,80 @@ static int write_frame(void* user, int frame, const vd_lstring* s, const vd_plan
   return w->st != VD_OK;
 }
 
+// an L-system's run: its --set overrides, derivation (or animation), interpretation, the
+// turtle, --call; the plant in *out
+static vd_status run_lsystem(const cli_plant_opts* o, vd_lsystem* ls, vd_plant_spec** out, cli_grow_info* info,
+                             vd_error* err) {
+  info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
+  vd_status st = VD_OK;
+  for (int i = 0; !st && i < o->nset; i++) {
+    char name[128];
+    const char* eq = strchr(o->set[i], '=');
+    size_t n = (size_t)(eq - o->set[i]);
+    if (n >= sizeof name) n = sizeof name - 1;
+    memcpy(name, o->set[i], n);
+    name[n] = 0;
+    st = vd_lsys_set_global(ls, name, eq + 1, err);
+  }
+  vd_plant_spec* plant = st ? NULL : vd_plant_spec_create();
+  if (!st && !plant) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
+  vd_lsys_def def = vd_lsys_def_default();
+  def.steps = o->steps;
+  def.seed = o->seed;
+  def.max_modules = o->max_modules;
+  def.max_ops = o->max_ops;
+  if (o->progress) def.progress = progress_cb;
+  double t0 = cli_now();
+  frame_writer fw = {o, ls, err, VD_OK, 0};
+  if (o->frames) def.frame = write_frame, def.frame_user = &fw;
+  // an animation draws every frame and ends with the plant of the last (the turtle's time is in
+  // the derivation's)
+  if (!st) st = o->animate ? vd_lsys_animate(ls, &def, &derived, plant, err) : vd_lsys_derive(ls, &def, &derived, err);
+  if (fw.st) st = fw.st;
+  double t1 = cli_now();
+  if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
+  if (!st && !o->animate) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
+  if (!st && !o->animate) {
+    vd_turtle_def td = vd_turtle_def_default();
+    st = vd_turtle_run(ls, &geo, &td, plant, err);
+  }
+  double t2 = cli_now();
+  // the file's functions, after the run (a check() of its asserts)
+  for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
+  if (!st) st = name_labels(o, ls, plant, err);
+  if (!st && !derived.n && !vd_lsys_axiom_line(ls))
+    fprintf(stderr, "verdant: %s:1:1: warning: the file has no Axiom: line, so its L-string starts empty and the "
+            "plant is empty\n", o->path);
+  if (!st) {
+    // module counts by symbol for --stats
+    info->modules = derived.n;
+    info->nsym = vd_lsys_symbol_count(ls);
+    info->sym_count = vd_calloc((size_t)info->nsym, sizeof(int64_t));
+    info->sym_name = vd_calloc((size_t)info->nsym, sizeof(char*));
+    if (!info->sym_count || !info->sym_name) {
+      st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+    } else {
+      for (int64_t i = 0; i < derived.n; i++) info->sym_count[derived.sym[i]]++;
+      for (int k = 0; k < info->nsym && !st; k++) {
+        info->sym_name[k] = vd_strdup(vd_lsys_symbol_name(ls, k));
+        if (!info->sym_name[k]) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+      }
+    }
+    info->seconds_derive = t1 - t0;
+    info->seconds_turtle = t2 - t1;
+  }
+  vd_lstring_free(&derived);
+  vd_lstring_free(&geo);
+  if (st) {
+    vd_plant_spec_destroy(plant);
+    cli_grow_info_free(info);
+    return st;
+  }
+  *out = plant;
+  return VD_OK;
+}
+
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
   memset(info, 0, sizeof *info);
   *out = NULL;
@@ -511,71 +590,14 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   vd_lsystem* ls;
   st = vd_lsys_load_engine(o->path, (vd_lsys_engine)o->engine, &ls, err);
   if (st) return st;
-  info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
-  for (int i = 0; !st && i < o->nset; i++) {
-    char name[128];
-    const char* eq = strchr(o->set[i], '=');
-    size_t n = (size_t)(eq - o->set[i]);
-    if (n >= sizeof name) n = sizeof name - 1;
-    memcpy(name, o->set[i], n);
-    name[n] = 0;
-    st = vd_lsys_set_global(ls, name, eq + 1, err);
+  st = run_lsystem(o, ls, out, info, err);
+  // what the native engine refuses only when it runs: the automatic choice runs it in CPython
+  if (st && vd_lsys_fallback(&ls, st)) {
+    memset(err, 0, sizeof *err);
+    st = run_lsystem(o, ls, out, info, err);
   }
-  vd_plant_spec* plant = st ? NULL : vd_plant_spec_create();
-  if (!st && !plant) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
-  vd_lsys_def def = vd_lsys_def_default();
-  def.steps = o->steps;
-  def.seed = o->seed;
-  def.max_modules = o->max_modules;
-  def.max_ops = o->max_ops;
-  if (o->progress) def.progress = progress_cb;
-  double t0 = cli_now();
-  frame_writer fw = {o, ls, err, VD_OK, 0};
-  if (o->frames) def.frame = write_frame, def.frame_user = &fw;
-  // an animation draws every frame and ends with the plant of the last (the turtle's time is in
-  // the derivation's)
-  if (!st) st = o->animate ? vd_lsys_animate(ls, &def, &derived, plant, err) : vd_lsys_derive(ls, &def, &derived, err);
-  if (fw.st) st = fw.st;
-  double t1 = cli_now();
-  if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
-  if (!st && !o->animate) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
-  if (!st && !o->animate) {
-    vd_turtle_def td = vd_turtle_def_default();
-    st = vd_turtle_run(ls, &geo, &td, plant, err);
-  }
-  double t2 = cli_now();
-  // the file's functions, after the run (a check() of its asserts)
-  for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
-  if (!st) st = name_labels(o, ls, plant, err);
-  if (!st) {
-    // module counts by symbol for --stats
-    info->modules = derived.n;
-    info->nsym = vd_lsys_symbol_count(ls);
-    info->sym_count = vd_calloc((size_t)info->nsym, sizeof(int64_t));
-    info->sym_name = vd_calloc((size_t)info->nsym, sizeof(char*));
-    if (!info->sym_count || !info->sym_name) {
-      st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-    } else {
-      for (int64_t i = 0; i < derived.n; i++) info->sym_count[derived.sym[i]]++;
-      for (int k = 0; k < info->nsym && !st; k++) {
-        info->sym_name[k] = vd_strdup(vd_lsys_symbol_name(ls, k));
-        if (!info->sym_name[k]) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-      }
-    }
-    info->seconds_derive = t1 - t0;
-    info->seconds_turtle = t2 - t1;
-  }
-  vd_lstring_free(&derived);
-  vd_lstring_free(&geo);
   vd_lsys_destroy(ls);
-  if (st) {
-    vd_plant_spec_destroy(plant);
-    cli_grow_info_free(info);
-    return st;
-  }
-  *out = plant;
-  return VD_OK;
+  return st;
 }
 
 void cli_grow_info_free(cli_grow_info* info) {

@@ -54,7 +54,8 @@ static const char* dataset_usage =
     "                        by the item; needs an OpenGL context (EGL, software without a GPU)\n"
     "      --image-size WxH  size of those pictures in pixels (default 640x480)\n"
     "      --force           remake complete items too\n"
-    "      --stats           print a JSON summary on stdout (made, skipped, seconds, items/s)\n";
+    "      --stats           print a JSON summary on stdout (made, skipped, points, manifest)\n"
+    "      --profile         --stats adds seconds and items_per_second (timings)\n";
 
 typedef struct vary {
   char name[64];
@@ -453,7 +454,7 @@ static void progress(const dataset* ds, int done, int total, double t0) {
     bar[k] = k < fill ? '#' : ' ';
   bar[w] = 0;
   fprintf(stderr, "\rdataset [%s] %d/%d items, %.1f items/s, ETA %.0f s   ", bar, done, total, rate, eta);
-  if (done == total) fputc('\n', stderr);
+  if (done == total) cli_progress_clear();
   fflush(stderr);
 }
 
@@ -780,7 +781,7 @@ static int check_vary(const dataset* ds, const char* path) {
 // options that do not change what an item holds: left out of the parameter id
 static int neutral_option(const char* a, int* takes_value) {
   static const char* with_value[] = {"-o", "--output", "--jobs", "--shard", "--threads", "-K", "--count"};
-  static const char* flags[] = {"--force", "--no-progress", "--stats"};
+  static const char* flags[] = {"--force", "--no-progress", "--stats", "--profile"};
   for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++)
     if (!strcmp(a, with_value[k])) return *takes_value = 1, 1;
   for (size_t k = 0; k < sizeof flags / sizeof *flags; k++)
@@ -802,7 +803,7 @@ int cli_dataset(int argc, char** argv) {
   ds.argc = argc, ds.argv = argv;
   int image_size_given = 0;
   ds.progress = po.progress;
-  int stats = 0;
+  int stats = 0, profile = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -862,6 +863,8 @@ int cli_dataset(int argc, char** argv) {
       ds.force = 1;
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error("dataset", "unknown option '%s'", a);
     } else if (!po.path) {
@@ -873,6 +876,7 @@ int cli_dataset(int argc, char** argv) {
   if (!po.path) return cli_usage_error("dataset", "missing PLANT (an .lpy or plant .json file)");
   if (ds.count < 0) return cli_usage_error("dataset", "missing --count K");
   if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
+  if (profile && !stats) return cli_usage_error("dataset", "--profile adds timings to --stats; give --stats");
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset") || cli_cloud_check_output(&co, "dataset", ds.ext)) return EXIT_USAGE;
   if (co.has_cloud_seed)
@@ -997,7 +1001,7 @@ int cli_dataset(int argc, char** argv) {
   pool_free(&pool);
   if (failed_item >= 0) {
     cJSON_Delete(ds.arguments);
-    if (ds.progress) fputc('\n', stderr);
+    if (ds.progress) cli_progress_clear();
     char buf[1024];
     fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
             first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
@@ -1012,9 +1016,10 @@ int cli_dataset(int argc, char** argv) {
   if (m < 0) return cli_report("dataset", &err, err.status);
   double el = cli_now() - t0;
   if (stats) {
-    printf("{\n\t\"made\":\t%d,\n\t\"skipped\":\t%d,\n\t\"points\":\t%lld,\n\t\"manifest\":\t%s,\n"
-           "\t\"seconds\":\t%.6f,\n\t\"items_per_second\":\t%.3f\n}\n",
-           done, skipped, (long long)points, m == 0 ? "true" : "false", el, el > 0 ? done / el : 0.0);
+    printf("{\n\t\"made\":\t%d,\n\t\"skipped\":\t%d,\n\t\"points\":\t%lld,\n\t\"manifest\":\t%s", done, skipped,
+           (long long)points, m == 0 ? "true" : "false");
+    if (profile) printf(",\n\t\"seconds\":\t%.6f,\n\t\"items_per_second\":\t%.3f", el, el > 0 ? done / el : 0.0);
+    printf("\n}\n");
   }
   return EXIT_OK;
 }

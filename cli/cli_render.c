@@ -60,9 +60,11 @@ static const char* render_help =
 static const char* render_help_run =
     "simulation runs (RUN/ holds rod.json, plant_initial.json, frames, colliders.jsonl):\n"
     "  -o OUT.png            one frame: the one nearest --time T (s), default the last\n"
-    "  -o DIR/               every frame: DIR/frame_00000.png ... (and their depth, masks and\n"
+    "  -o DIR/               every frame (a name ending in /, a folder or without extension):\n"
+    "                        DIR/frame_00000.png ... (and their depth, masks and\n"
     "                        sidecars), DIR/frames.json (index: frame times and files)\n"
-    "      --time T          simulated time of the frame to draw (s), nearest frame\n"
+    "      --time T          simulated time of the frame to draw (s), nearest frame; within\n"
+    "                        the run's time range\n"
     "      --mp4 OUT.mp4     every frame as an H.264 video (needs Debian's ffmpeg; skipped\n"
     "                        with a message when it is not installed)\n"
     "      --fps N           frame rate of the video (default: the run's, from its frame times)\n"

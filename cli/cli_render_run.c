@@ -262,6 +262,16 @@ static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int n
   return st;
 }
 
+// -o names a folder for every frame: DIR/, an existing folder or a name without an extension
+// (g.jpg is a mistyped picture, not a folder to fill with frames)
+static int folder_name(const char* out) {
+  size_t n = strlen(out);
+  struct stat sb;
+  if ((n && out[n - 1] == '/') || (!stat(out, &sb) && S_ISDIR(sb.st_mode))) return 1;
+  const char* base = strrchr(out, '/');
+  return strchr(base ? base + 1 : out, '.') == NULL;
+}
+
 int cli_render_run(const cli_render_opts* o) {
   const char* cmd = "render";
   // what to write
@@ -269,6 +279,11 @@ int cli_render_run(const cli_render_opts* o) {
   const char* folder = o->out && !single ? o->out : NULL;
   if (!o->out && !o->mp4)
     return cli_usage_error(cmd, "missing -o OUT.png, -o DIR/ or --mp4 OUT.mp4 for the run");
+  if (folder && !folder_name(folder))
+    return cli_usage_error(cmd,
+                           "-o %s: a run is drawn as PNG: -o OUT.png for one frame, -o DIR/ (a folder) for "
+                           "every frame",
+                           folder);
   if (o->has_time && !single) return cli_usage_error(cmd, "--time picks the frame of -o OUT.png");
   if (o->po.steps >= 0 || o->po.seed || o->po.nset || o->po.nlabel)
     return cli_usage_error(
@@ -315,6 +330,15 @@ int cli_render_run(const cli_render_opts* o) {
   int writing = 0; // the failure, if any, is in writing the outputs
   if ((st = cli_run_open(o->po.path, &run, &err))) return cli_report(cmd, &err, st);
   const vd_model* pm = run.plant;
+  if (o->has_time) {
+    // --time picks a frame of the run: a time outside it is a mistake, not the nearest end
+    double t0 = vd_sim_frames_time(run.frames, 0), t1 = vd_sim_frames_time(run.frames, run.nframe - 1);
+    double tol = run.nframe > 1 ? (t1 - t0) / (run.nframe - 1) : 0;  // half a frame either side
+    if (!(o->time >= t0 - 0.5 * tol - 1e-9 && o->time <= t1 + 0.5 * tol + 1e-9)) {
+      cli_run_close(&run);
+      return cli_usage_error(cmd, "--time %g: the run %s has frames from %g to %g s", o->time, o->po.path, t0, t1);
+    }
+  }
   int want = o->has_time ? vd_sim_frames_nearest(run.frames, o->time) : run.nframe - 1;
   int all = folder || mp4;
   // first pass: the box swept by the plant and the colliders; the colour scale of the whole run
@@ -413,12 +437,12 @@ int cli_render_run(const cli_render_opts* o) {
       goto fail;
     }
   }
-  if (progress) fputc('\n', stderr);
+  if (progress) cli_progress_clear();
   if (folder && (st = write_index(o, &run, folder, &f, &err))) goto fail;
   if (mp4 && (st = video_finish(&vid, mp4, 1, &err))) goto fail;
   goto done;
 fail:
-  if (progress) fputc('\n', stderr);
+  if (progress) cli_progress_clear();
   // bad run files are bad input (2); a failure to write or to encode is a failed run (1)
   code = cli_report(cmd, &err, st);
   if (writing) code = EXIT_FAIL;

@@ -98,14 +98,16 @@ static const char* sim_help_output =
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
-    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n"
+    "                          axis), kinetic_energy (J), events, ...; the same bytes for the\n"
+    "                          same inputs\n"
     "      --batch N           run N plants side by side: item i grown with the seed drawn from\n"
     "                          (--seed, i) as dataset does (the same plant N times for a plant\n"
     "                          file); --stats prints one record per item, -o DIR writes\n"
     "                          DIR/item_NNNNNN/ (plant.json, events.csv); frames are not written\n"
     "      --jobs J            items run at once (threads), default 1\n"
     "      --profile           time each stage of the steps and the frame output; --stats then\n"
-    "                          has stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
+    "                          has wall_seconds, steps_per_second, real_time_factor and\n"
+    "                          stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
     "                          project, velocity, fracture, frames)\n";
 
 // a closed triangle mesh from a Wavefront OBJ file: "v x y z" and "f i j k ..." lines (1-based
@@ -421,9 +423,11 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "nevents", d->nevent);
   cJSON_AddNumberToObject(root, "steps", (double)steps);
   cJSON_AddNumberToObject(root, "time", d->time);
-  cJSON_AddNumberToObject(root, "wall_seconds", wall);
-  cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
-  cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * m->opt.dt / wall : 0);
+  if (d->profile) {  // timings: only when asked, so that the same inputs print the same bytes
+    cJSON_AddNumberToObject(root, "wall_seconds", wall);
+    cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
+    cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * m->opt.dt / wall : 0);
+  }
   if (settle_steps >= 0) {
     cJSON_AddBoolToObject(root, "settled", settled);
     cJSON_AddNumberToObject(root, "settle_steps", settle_steps);
@@ -874,14 +878,16 @@ static int sim_batch(const sim_opts* o, double nsteps) {
       cJSON_AddNumberToObject(it, "kinetic_energy", r[i].ke);
       cJSON_AddNumberToObject(it, "nevents", r[i].nevent);
       cJSON_AddNumberToObject(it, "warnings", (double)r[i].nwarning);
-      cJSON_AddNumberToObject(it, "wall_seconds", r[i].wall);
+      if (o->profile) cJSON_AddNumberToObject(it, "wall_seconds", r[i].wall);
       cJSON_AddItemToArray(items, it);
       steps += r[i].steps;
     }
     cJSON_AddNumberToObject(root, "jobs", jobs);
-    cJSON_AddNumberToObject(root, "wall_seconds", wall);
-    cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
-    cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * o->opt.dt / wall : 0);
+    if (o->profile) {
+      cJSON_AddNumberToObject(root, "wall_seconds", wall);
+      cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
+      cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * o->opt.dt / wall : 0);
+    }
     char* text = cJSON_Print(root);
     cJSON_Delete(root);
     if (text) fputs(text, stdout), fputc('\n', stdout), cJSON_free(text);

@@ -84,7 +84,9 @@ static const char* grow_help_output =
     "      --ply               also RUN/age_NNN.ply meshes with a per-vertex stress property\n"
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             JSON summary on stdout: height, max_displacement, max_stress,\n"
-    "                          broken_branches, uprooted, collapsed, momentum_error, ...\n";
+    "                          broken_branches, uprooted, collapsed, momentum_error, ...; the\n"
+    "                          same bytes for the same inputs\n"
+    "      --profile           --stats adds wall_seconds (a timing, which differs per run)\n";
 
 // options given (for the checks that each applies to the run, whatever their order)
 enum {
@@ -102,7 +104,7 @@ typedef struct grow_opts {
   const char* out;
   const char* final;
   const char* wind_file;
-  int stats, ply, ages;
+  int stats, ply, ages, profile;
   vd_growth_def def;
   // presets, applied before every other option (pass 0 finds them)
   int paper;
@@ -158,6 +160,8 @@ static int parse_pass(int argc, char** argv, grow_opts* o) {
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      o->profile = 1;
     } else if (!strcmp(a, "--ply")) {
       o->ply = 1;
     } else if (!strcmp(a, "--ages")) {
@@ -488,7 +492,7 @@ static cJSON* stats_json(const vd_growth* g, const vd_growth_def* def, double wa
   cJSON_AddNumberToObject(o, "substeps", (double)s.substeps);
   cJSON_AddNumberToObject(o, "cg_iterations", (double)s.cg_iterations);
   cJSON_AddNumberToObject(o, "unstable_substeps", (double)s.unstable);
-  cJSON_AddNumberToObject(o, "wall_seconds", wall);
+  if (wall >= 0) cJSON_AddNumberToObject(o, "wall_seconds", wall);  // --profile
   int n;
   const vd_growth_event* ev = vd_growth_events(g, &n);
   cJSON* arr = cJSON_AddArrayToObject(o, "events");
@@ -572,6 +576,7 @@ int cli_sim_grow(int argc, char** argv) {
   if (!cli_has_ext(o.po.path, ".lpy"))
     return cli_usage_error(cmd, "'%s': --grow needs an .lpy file (the L-system grows the plant step by step)", o.po.path);
   if (!o.out && !o.stats && !o.final) return cli_usage_error(cmd, "nothing to do: give -o RUN/, --final FILE and/or --stats");
+  if (o.profile && !o.stats) return cli_usage_error(cmd, "--profile adds timings to --stats; give --stats");
   if (o.ply && !o.out) return cli_usage_error(cmd, "--ply writes into the run folder: give -o RUN/");
   // the files: the model and the wind series read; the growth run folder (an earlier run's ages
   // that this one does not write go when it completes) and --final written
@@ -632,7 +637,7 @@ int cli_sim_grow(int argc, char** argv) {
     if (o.out && (st = snapshot(g, &o, snaps, &err))) goto failed;
     if (o.po.progress) progress_bar(k + 1, ages, g);
   }
-  if (o.po.progress && ages > 0) fputc('\n', stderr);
+  if (o.po.progress && ages > 0) cli_progress_clear();
   double wall = cli_now() - t0;
   if (st) {
     // a step that failed: bad settings found on the way (a light the tree grew around) or the
@@ -681,7 +686,7 @@ int cli_sim_grow(int argc, char** argv) {
     if (st) goto failed;
   }
   if (o.stats) {
-    cJSON* s = stats_json(g, &o.def, wall);
+    cJSON* s = stats_json(g, &o.def, o.profile ? wall : -1);
     char* text = s ? cJSON_Print(s) : NULL;
     cJSON_Delete(s);
     if (!text) {

@@ -18,10 +18,10 @@ CLOUD_OPTS="-N=N --points=N --max-points=N --sensor=N --scanner=N --scanners=R -
   --occlusion=N --no-interior=N --pattern=N --fov=N --res=N --labels=N --slices=N --cloud-seed=N --threads=N
   --ascii=N --ply-scalar-prefix=N"
 declare -A TABLE
-TABLE[grow]="-o=W --output=W --ascii=N --stats=N --traits=W --animate=N --frames=P --call=N $PLANT_OPTS"
-TABLE[cloud]="-o=W --output=W --stats=N $CLOUD_OPTS $PLANT_OPTS"
+TABLE[grow]="-o=W --output=W --ascii=N --stats=N --profile=N --traits=W --animate=N --frames=P --call=N $PLANT_OPTS"
+TABLE[cloud]="-o=W --output=W --stats=N --profile=N $CLOUD_OPTS $PLANT_OPTS"
 TABLE[dataset]="-K=N --count=N -o=D --output=D --seed=N --format=N --jobs=N --shard=N --vary=N --images=N
-  --image-size=N --force=N --stats=N --no-shadows=N --palette=N --supersample=N --view-elevation=N
+  --image-size=N --force=N --stats=N --profile=N --no-shadows=N --palette=N --supersample=N --view-elevation=N
   --view-distance=N --view-jitter=N --vary-light=N --vary-background=N $CLOUD_OPTS $PLANT_OPTS"
 TABLE[render]="-o=W --output=W --camera=N --eye=N --lookat=N --up=N --fov=N --size=N --color-by=N --palette=N
   --range=N --depth=W --masks=W --supersample=N --point-size=N --robot=R --no-floor=N --light=N --sky-rgb=N
@@ -37,9 +37,9 @@ TABLE[sim --grow]="--grow=N --ages=N --substeps=N --dt=N --model=N --paper=N --w
   --integrator=N --rigid-age=N --woody-age=N --k0=N --damping=N --species=N --young=N --density=N --mor=N
   --no-breaking=N --eq8=N --no-stress-free=N --strain-limit=N --gravity=N --wind=N --gust=N --wind-file=R
   --drag=N --cd=N --light=N --gravitropism=N --soil=N --soil-method=N --clay=N --ptf=N --uproot-tilt=N
-  -o=D --output=D --ply=N --final=W --stats=N $PLANT_OPTS"
+  -o=D --output=D --ply=N --final=W --stats=N --profile=N $PLANT_OPTS"
 TABLE[validate]="--json=N --full=N --case=N --plant=R"
-TABLE[harvest]="-o=D --output=D --stats=N --episodes=N --jobs=N --seed=N --frames=N --duration=N --two-way=N
+TABLE[harvest]="-o=D --output=D --stats=N --profile=N --episodes=N --jobs=N --seed=N --frames=N --duration=N --two-way=N
   --one-way=N --no-progress=N"
 TABLE[export]="-o=W --output=W --name=N --pos=N --leaf-thickness=N --links-per-organ=N --damping-ratio=N --static=N --check=N --check-with=R $PLANT_OPTS"
 

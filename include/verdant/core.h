@@ -240,6 +240,12 @@ typedef struct vd_quat {
 
 #define VD_PI 3.14159265358979323846
 
+// The q-quantile (0 <= q <= 1) of n >= 1 values sorted ascending, by linear interpolation between
+// order statistics (Hyndman & Fan 1996, type 7; numpy's and R's default): h = (n - 1) q,
+// Q = x[floor h] + (h - floor h)(x[floor h + 1] - x[floor h]). The median of an even count is
+// the mean of the middle two.
+double vd_quantile_sorted(const double* x, int n, double q);
+
 static inline vd_vec3 vd_v3(double x, double y, double z) {
   vd_vec3 r = {x, y, z};
   return r;
