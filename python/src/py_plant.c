@@ -146,6 +146,20 @@ static vd_status grow_lsys(const grow_args* a, vd_lsystem* ls, const char* name,
   return st;
 }
 
+// grow_lsys, again in CPython when the automatic engine choice took native and native refused
+// what it met only when running (vd_lsys_fallback)
+static vd_status grow_lsys_auto(const grow_args* a, vd_lsystem** ls, const char* name, grow_out* out,
+                                vd_error* err) {
+  vd_status st = grow_lsys(a, *ls, name, out, err);
+  if (st && vd_lsys_fallback(ls, st)) {
+    vd_plant_spec_destroy(out->spec);
+    out->spec = NULL;
+    memset(err, 0, sizeof *err);
+    st = grow_lsys(a, *ls, name, out, err);
+  }
+  return st;
+}
+
 // the whole load, without the GIL
 static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   const char* name = a->path[0] ? a->path : "<string>";
@@ -159,7 +173,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
     vd_lsystem* ls;
     vd_status st = vd_lsys_parse_engine(a->text, len, name, a->engine, &ls, err);
     if (st) return st;
-    st = grow_lsys(a, ls, name, out, err);
+    st = grow_lsys_auto(a, &ls, name, out, err);
     vd_lsys_destroy(ls);
     return st;
   }
@@ -177,7 +191,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   vd_lsystem* ls;
   vd_status st = vd_lsys_load_engine(a->path, a->engine, &ls, err);
   if (st) return st;
-  st = grow_lsys(a, ls, a->path, out, err);
+  st = grow_lsys_auto(a, &ls, a->path, out, err);
   vd_lsys_destroy(ls);
   return st;
 }
