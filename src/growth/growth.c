@@ -366,13 +366,9 @@ static vd_status turtle_plant(vd_growth* g, vd_plant_spec** out, vd_error* err) 
   if (!st) st = vd_lsys_interpret(g->ls, &g->def.lsys, &g->str, &geo, err);
   g->str.src = src;
   if (!st) st = vd_turtle_run(g->ls, &geo, &g->def.turtle, spec, err);
-  for (int i = 0; !st && i < vd_lsys_label_count(g->ls); i++) {
-    int id;
-    const char* name;
-    vd_lsys_label_get(g->ls, i, &id, &name);
-    st = vd_plant_set_label(spec, id, name);
-  }
-  if (!st) st = vd_plant_complete_labels(spec);
+  // labels and instances as every front end names a plant (vd_plant_load: organs)
+  vd_plant_load_def ld = vd_plant_load_def_default();
+  if (!st && (st = vd_plant_load_name(g->ls, &ld, spec))) vd_error_set(err, st, "", 0, 0, "out of memory");
   // the axiom's roots and trunk start at one node (the base)
   if (!st) vd_plant_join_bases(spec);
   vd_lstring_free(&geo);
