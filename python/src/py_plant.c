@@ -488,14 +488,16 @@ static PyObject* plant_reduce(vdpy_plant* p, PyObject* unused) {
 
 static PyMethodDef plant_methods[] = {
     {"save", (PyCFunction)(void (*)(void))plant_save, METH_VARARGS | METH_KEYWORDS,
+     "save($self, /, path, *, ascii=False)\n--\n\n"
      "save(path, *, ascii=False): write the plant as plant JSON (.json), a labelled OBJ mesh with\n"
      "its MTL (.obj) or a PLY mesh with face label and instance (.ply, binary unless ascii).\n"
      "The same bytes as `verdant grow PLANT -o path`."},
     {"mesh", (PyCFunction)(void (*)(void))plant_mesh, METH_VARARGS | METH_KEYWORDS,
+     "mesh($self, /, *, slices=None, stacks=None, caps=True)\n--\n\n"
      "mesh(*, slices=None, stacks=None, caps=True) -> Mesh: the labelled triangle mesh of the\n"
      "plant (slices: sides of every frustum and sphere, default each primitive's own)."},
     {"_cloud", (PyCFunction)(void (*)(void))plant_cloud, METH_VARARGS | METH_KEYWORDS,
-     "Low-level cloud sampler; see Plant.cloud."},
+     "_cloud($self, /, **options)\n--\n\nLow-level cloud sampler; see Plant.cloud."},
     {"__reduce__", (PyCFunction)plant_reduce, METH_NOARGS, NULL},
     {NULL, NULL, 0, NULL},
 };
@@ -576,6 +578,7 @@ static PyObject* mesh_save(vdpy_mesh* m, PyObject* args, PyObject* kw) {
 
 static PyMethodDef mesh_methods[] = {
     {"save", (PyCFunction)(void (*)(void))mesh_save, METH_VARARGS | METH_KEYWORDS,
+     "save($self, /, path, *, ascii=False)\n--\n\n"
      "save(path, *, ascii=False): write OBJ (+MTL, faces grouped by label/instance) or PLY (face\n"
      "label and instance; binary unless ascii)."},
     {NULL, NULL, 0, NULL},

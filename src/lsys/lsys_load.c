@@ -165,6 +165,7 @@ static vd_status grow_lsys(vd_lsystem* ls, const char* name, const vd_plant_load
   if (!st && (st = count_symbols(ls, &derived, info))) vd_error_set(err, st, name, 0, 0, "out of memory");
   info->seconds_derive = t1 - t0;
   info->seconds_turtle = t2 - t1;
+  info->axiom_line = vd_lsys_axiom_line(ls);
   vd_lstring_free(&derived);
   vd_lstring_free(&geo);
   if (st) {
@@ -205,6 +206,16 @@ static vd_status load_lpy(const load_input* in, const vd_plant_load_def* d, vd_p
   vd_status st = open_lsys(in, d, &ls, err);
   if (st) return st;
   st = grow_lsys(ls, in->name, d, out, info, err);
+  // what the native engine refuses only when it runs: the automatic choice runs it in CPython,
+  // with the same overrides
+  if (st && vd_lsys_fallback(&ls, st)) {
+    if (err) memset(err, 0, sizeof *err);
+    vd_plant_load_info_free(info);
+    info->format = VD_PLANT_FORMAT_LPY;
+    st = VD_OK;
+    for (int i = 0; !st && i < d->nset; i++) st = vd_lsys_set_global(ls, d->set_name[i], d->set_value[i], err);
+    if (!st) st = grow_lsys(ls, in->name, d, out, info, err);
+  }
   vd_lsys_destroy(ls);
   return st;
 }
