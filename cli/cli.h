@@ -179,6 +179,11 @@ void cli_out_plant(const char* what, const char* path);
 
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
+// Write text to path through the output layer (a temporary name, renamed when complete).
+vd_status cli_write_text(const char* path, const char* text, vd_error* err);
+// Write a JSON tree to path the same way, pretty or on one line, ending in a newline.
+struct cJSON;
+vd_status cli_write_json(const char* path, const struct cJSON* root, int pretty, vd_error* err);
 
 // Options of the commands that make point clouds (cloud, dataset).
 #define CLI_MAX_SCANNERS 64

@@ -146,22 +146,6 @@ static int sha256_file(const char* path, char hex[65], int64_t* bytes) {
   return ok;
 }
 
-// write JSON atomically
-static vd_status write_json(const char* path, const cJSON* root, int pretty, vd_error* err) {
-  char* text = pretty ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
-  if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
-  vd_outfile f;
-  vd_status st = vd_outfile_open(&f, path, err);
-  if (!st) {
-    fputs(text, f.fp);
-    fputc('\n', f.fp);
-    st = vd_outfile_commit(&f, err);
-    vd_outfile_abort(&f);
-  }
-  cJSON_free(text);
-  return st;
-}
-
 // the record of item i if it is complete (parsed, matching parameters, cloud file of its size);
 // *mismatch is set when a record exists but was made with other parameters
 static cJSON* complete_record(const dataset* ds, int i, int* mismatch) {
@@ -435,7 +419,7 @@ static vd_status make_item_files(const dataset* ds, render_pool* pool, const cli
   vd_cloud_free(&res.cloud);
   // the pictures, then the record that makes the item complete
   if (ds->images) st = make_images(ds, pool, &po, i, seed, rec, err);
-  if (!st) st = write_json(rpath, rec, 0, err);
+  if (!st) st = cli_write_json(rpath, rec, 0, err);
   *out_failed = st != VD_OK;
   cJSON_Delete(rec);
   return st;

@@ -187,27 +187,10 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
   return o;
 }
 
-// write text to path atomically
-static vd_status write_text(const char* path, const char* text, vd_error* err) {
-  vd_outfile f;
-  vd_status st = vd_outfile_open(&f, path, err);
-  if (!st) {
-    fputs(text, f.fp);
-    st = vd_outfile_commit(&f, err);
-  }
-  return st;
-}
-
 // write a JSON object to path (pretty) atomically; the object is deleted
 static vd_status write_json(const char* path, cJSON* o, vd_error* err) {
-  char* text = o ? cJSON_Print(o) : NULL;
+  vd_status st = o ? cli_write_json(path, o, 1, err) : vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
   cJSON_Delete(o);
-  if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
-  size_t n = strlen(text);
-  char* t2 = realloc(text, n + 2);
-  if (t2) text = t2, text[n] = '\n', text[n + 1] = 0;
-  vd_status st = write_text(path, text, err);
-  free(text);
   return st;
 }
 

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
-// Writing a plant by the output file's extension: plant JSON, OBJ (+MTL) or PLY mesh.
+// Writing a plant by the output file's extension: plant JSON, OBJ (+MTL) or PLY mesh; text and
+// JSON files through the output layer.
 #include <string.h>
+
+#include <cjson/cJSON.h>
 
 #include "cli.h"
 
@@ -50,4 +53,28 @@ void cli_out_plant(const char* what, const char* path) {
 
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
   return write_plant(plant, path, ascii, err);
+}
+
+vd_status cli_write_text(const char* path, const char* text, vd_error* err) {
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (!st) {
+    fputs(text, f.fp);
+    st = vd_outfile_commit(&f, err);
+  }
+  return st;
+}
+
+vd_status cli_write_json(const char* path, const cJSON* root, int pretty, vd_error* err) {
+  char* text = pretty ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
+  if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (!st) {
+    fputs(text, f.fp);
+    fputc('\n', f.fp);
+    st = vd_outfile_commit(&f, err);
+  }
+  cJSON_free(text);
+  return st;
 }

@@ -223,19 +223,10 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
       snprintf(name, sizeof name, "frame_%05d.png.json", k), cJSON_AddStringToObject(e, "camera", name);
     cJSON_AddItemToArray(frames, e);
   }
-  char* text = cJSON_Print(root);
-  cJSON_Delete(root);
-  if (!text) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   char path[4200];
   snprintf(path, sizeof path, "%s/frames.json", dir);
-  vd_outfile of;
-  vd_status st = vd_outfile_open(&of, path, err);
-  if (!st) {
-    fputs(text, of.fp);
-    fputc('\n', of.fp);
-    st = vd_outfile_commit(&of, err);
-  }
-  cJSON_free(text);
+  vd_status st = cli_write_json(path, root, 1, err);
+  cJSON_Delete(root);
   return st;
 }
 

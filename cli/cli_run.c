@@ -264,19 +264,10 @@ vd_status cli_rod_json_write(const vd_sim_model* m, const vd_model* plant, const
   // what rebuilds this rod model: the initial plant and the build settings
   cJSON_AddStringToObject(root, "initial_plant", "plant_initial.json");
   cJSON_AddItemToObject(root, "build", cli_sim_def_json(def));
-  char* text = cJSON_PrintUnformatted(root);
-  cJSON_Delete(root);
-  if (!text) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   char path[4096];
   snprintf(path, sizeof path, "%s/rod.json", dir);
-  vd_outfile f;
-  vd_status st = vd_outfile_open(&f, path, err);
-  if (!st) {
-    fputs(text, f.fp);
-    fputc('\n', f.fp);
-    st = vd_outfile_commit(&f, err);
-  }
-  cJSON_free(text);
+  vd_status st = cli_write_json(path, root, 0, err);
+  cJSON_Delete(root);
   return st;
 }
 

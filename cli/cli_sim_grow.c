@@ -431,16 +431,6 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
 // ---------------------------------------------------------------------------------------------
 // outputs
 
-static vd_status write_text(const char* path, const char* text, vd_error* err) {
-  vd_outfile f;
-  vd_status st = vd_outfile_open(&f, path, err);
-  if (!st) {
-    fputs(text, f.fp);
-    st = vd_outfile_commit(&f, err);
-  }
-  return st;
-}
-
 static const char* kind_name(int k) { return k == VD_MSS_UPROOT ? "uproot" : k == VD_MSS_ANCHOR ? "anchorage" : "break"; }
 
 static vd_status write_events(const vd_growth* g, const char* dir, vd_error* err) {
@@ -455,7 +445,7 @@ static vd_status write_events(const vd_growth* g, const char* dir, vd_error* err
                             ev[k].time, ev[k].node, ev[k].segment, ev[k].label, ev[k].stress, ev[k].limit, ev[k].removed);
   char path[4200];
   snprintf(path, sizeof path, "%s/events.csv", dir);
-  vd_status st = write_text(path, text, err);
+  vd_status st = cli_write_text(path, text, err);
   vd_free(text, cap);
   return st;
 }
@@ -661,19 +651,9 @@ int cli_sim_grow(int argc, char** argv) {
     cJSON_AddNumberToObject(index, "dt", o.def.model == VD_GROWTH_RODS ? o.def.rod_opt.dt : o.def.opt.dt);
     cJSON_AddStringToObject(index, "events", "events.csv");
     cJSON_AddStringToObject(index, "final", "plant.json");
-    char* text = cJSON_Print(index);
-    if (!text) {
-      st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-      goto failed;
-    }
     char path[4200];
     snprintf(path, sizeof path, "%s/growth.json", o.out);
-    size_t n = strlen(text);
-    char* t2 = vd_malloc(n + 2);
-    if (t2) memcpy(t2, text, n), t2[n] = '\n', t2[n + 1] = 0;
-    st = t2 ? write_text(path, t2, &err) : vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-    vd_free(t2, n + 2);
-    cJSON_free(text);
+    st = cli_write_json(path, index, 1, &err);
     if (st) goto failed;
   }
   if (o.stats) {

@@ -31,11 +31,7 @@ vd_model* vdt_quad_plant(const vd_vec3 v[4], int label, int instance) {
   int t[6] = {0, 1, 2, 0, 2, 3};
   vd_plant_add_mesh(s, &m, v, 4, t, 2);
   vd_plant_set_label(s, label, "leaf");
-  vd_model* model = NULL;
-  vd_error err = {0};
-  vd_plant_compile(s, &model, &err);
-  vd_plant_spec_destroy(s);
-  return model;
+  return vdt_compile(s);
 }
 
 vd_model* vdt_tomato(uint64_t seed) {

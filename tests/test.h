@@ -23,6 +23,10 @@ const char* vdt_tmpdir(void);
 void vdt_oom_begin(int64_t budget);
 // Restore the libc allocator after vdt_oom_begin.
 void vdt_oom_end(void);
+// Compile the spec s and free it; the model, or NULL when it does not compile.
+struct vd_plant_spec;
+struct vd_model;
+struct vd_model* vdt_compile(struct vd_plant_spec* s);
 
 #define TEST(group, name)                                                                          \
   static void test_##group##_##name(void);                                                         \

@@ -13,11 +13,7 @@ static vd_model* rod_plant(double len, double r) {
   g.node0 = a, g.node1 = b, g.r0 = g.r1 = r, g.label = 1, g.instance = 1, g.up = vd_v3(0, 0, 1);
   vd_plant_add_segment(s, &g);
   vd_plant_set_label(s, 1, "stem");
-  vd_model* m = NULL;
-  vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
-  return m;
+  return vdt_compile(s);
 }
 
 // static tip deflection under a tip load p (N) with the given clamp length (m); -1 on failure

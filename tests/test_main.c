@@ -4,6 +4,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "test.h"
 
+#include "verdant/plant.h"
+
 #include <stdarg.h>
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -69,6 +71,14 @@ void vdt_oom_begin(int64_t budget) {
 }
 
 void vdt_oom_end(void) { vd_set_allocator(NULL, NULL); }
+
+vd_model* vdt_compile(vd_plant_spec* s) {
+  vd_model* m = NULL;
+  vd_error e = {0};
+  vd_plant_compile(s, &m, &e);
+  vd_plant_spec_destroy(s);
+  return m;
+}
 
 static int cmp_case(const void* a, const void* b) {
   const vdt_case *x = a, *y = b;

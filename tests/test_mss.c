@@ -21,11 +21,7 @@ static vd_model* chain(int n, double len, double r, vd_vec3 dir, double age) {
     ps = vd_plant_add_segment(s, &g);
     prev = nd;
   }
-  vd_model* m = NULL;
-  vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
-  return m;
+  return vdt_compile(s);
 }
 
 TEST(mss, build_chain_nodes_springs_hinges) {

@@ -150,11 +150,7 @@ static vd_model* leaf_and_blocker(double gap, double sx, double sz) {
   vd_plant_add_mesh(s, &m, small, 4, t, 2);
   vd_plant_set_label(s, 2, "leaf");
   vd_plant_set_label(s, 3, "leaflet");
-  vd_model* model = NULL;
-  vd_error err = {0};
-  vd_plant_compile(s, &model, &err);
-  vd_plant_spec_destroy(s);
-  return model;
+  return vdt_compile(s);
 }
 
 TEST(picture, no_shadow_acne) {

@@ -27,25 +27,11 @@ static vd_model* grow(const char* rel, vd_plant_spec** spec_out) {
 
 // a straight cantilever along +x: clamped piece of length l behind the origin, then L
 static vd_model* cantilever(double len, double r, int with_fruit) {
-  vd_plant_spec* s = vd_plant_spec_create();
-  int a = vd_plant_add_node(s, vd_v3(-0.01, 0, 0)), b = vd_plant_add_node(s, vd_v3(0, 0, 0));
-  int c = vd_plant_add_node(s, vd_v3(len, 0, 0));
-  vd_segment_spec g = vd_segment_spec_default();
-  g.node0 = a, g.node1 = b, g.r0 = g.r1 = r, g.label = 1, g.instance = 1, g.up = vd_v3(0, 0, 1);
-  int s0 = vd_plant_add_segment(s, &g);
-  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
-  int s1 = vd_plant_add_segment(s, &g);
-  vd_plant_set_label(s, 1, "stem");
-  if (with_fruit) {
-    vd_sphere_spec f = vd_sphere_spec_default();
-    f.center = vd_v3(len + 0.01, 0, 0), f.radius = 0.01, f.parent = s1, f.label = 2, f.instance = 3;
-    vd_plant_add_sphere(s, &f);
-    vd_plant_set_label(s, 2, "fruit");
-  }
-  vd_model* m = NULL;
+  vd_beam_def d = vd_beam_def_default();
+  d.length = len, d.radius = r, d.fruit_radius = with_fruit ? 0.01 : 0, d.fruit_offset = 0.01, d.fruit_on_node = 0;
+  vd_model* m;
   vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
+  vd_plant_beam_model(&d, &m, &e);
   return m;
 }
 
@@ -510,7 +496,7 @@ TEST(sim, self_contact_projection) {
   CHECK(sim_contact_gap(m, d, &c) > -1e-9);
   vd_vec3 mom1 = vd_v3(0, 0, 0);
   for (int k = 0; k < 4; k++) mom1 = vd_madd(mom1, d->node_pos[nodes[k]], d->node_mass[nodes[k]]);
-  CHECK(v_norm(vd_sub(mom1, mom0)) < 1e-12);
+  CHECK(vd_norm(vd_sub(mom1, mom0)) < 1e-12);
   vd_sim_data_destroy(d);
   vd_sim_model_destroy(m);
   vd_model_destroy(pm);
@@ -598,11 +584,7 @@ static vd_model* comb(int k, double len, double apart, double r) {
     vd_plant_add_segment(s, &g);
   }
   vd_plant_set_label(s, 1, "stem");
-  vd_model* m = NULL;
-  vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
-  return m;
+  return vdt_compile(s);
 }
 
 TEST(sim, self_collision_pairs_linear) {
@@ -815,7 +797,7 @@ TEST(sim, drag_lanes_same_bytes) {
   int leaves = 0;
   for (int i = 0; i < m->nnode_all; i++) d->node_vel[i] = vd_v3(half_rand(&r), half_rand(&r), 3 * half_rand(&r));
   for (int t = 0; t < m->nseg; t++) {
-    d->seg_quat[t] = q_normalize(q_mul(d->seg_quat[t], (vd_quat){1, 0.3 * half_rand(&r), 0.3 * half_rand(&r), 0.3 * half_rand(&r)}));
+    d->seg_quat[t] = q_normalize(vd_quat_mul(d->seg_quat[t], (vd_quat){1, 0.3 * half_rand(&r), 0.3 * half_rand(&r), 0.3 * half_rand(&r)}));
     const double* ln = m->seg_leaf_normal + 3 * t;
     leaves += ln[0] != 0 || ln[1] != 0 || ln[2] != 0;
   }

@@ -204,19 +204,11 @@ static double mujoco_tomato(const char* argv0) {
 
 // a cantilever (clamped piece + L along x)
 static vd_model* cantilever(double len, double r) {
-  vd_plant_spec* s = vd_plant_spec_create();
-  int a = vd_plant_add_node(s, vd_v3(-0.01, 0, 0)), b = vd_plant_add_node(s, vd_v3(0, 0, 0));
-  int c = vd_plant_add_node(s, vd_v3(len, 0, 0));
-  vd_segment_spec g = vd_segment_spec_default();
-  g.node0 = a, g.node1 = b, g.r0 = g.r1 = r, g.label = 1, g.instance = 1, g.up = vd_v3(0, 0, 1);
-  int s0 = vd_plant_add_segment(s, &g);
-  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
-  vd_plant_add_segment(s, &g);
-  vd_plant_set_label(s, 1, "stem");
-  vd_model* m = NULL;
+  vd_beam_def d = vd_beam_def_default();
+  d.length = len, d.radius = r;
+  vd_model* m;
   vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
+  vd_plant_beam_model(&d, &m, &e);
   return m;
 }
 

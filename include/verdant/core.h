@@ -16,6 +16,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <math.h>
 #include <stdio.h>
 
 #ifdef __cplusplus
@@ -285,8 +286,10 @@ static inline vd_vec3 vd_vmin(vd_vec3 a, vd_vec3 b) {
 static inline vd_vec3 vd_vmax(vd_vec3 a, vd_vec3 b) {
   return vd_v3(a.x > b.x ? a.x : b.x, a.y > b.y ? a.y : b.y, a.z > b.z ? a.z : b.z);
 }
+// 1 when all three components are finite (no NaN, no infinity), else 0.
+int vd_v3_finite(vd_vec3 a);
 // Euclidean length.
-double vd_norm(vd_vec3 a);
+static inline double vd_norm(vd_vec3 a) { return sqrt(vd_dot(a, a)); }
 // a / |a|, or a unchanged when |a| is 0.
 vd_vec3 vd_normalize(vd_vec3 a);
 // Rotate v about the unit axis by angle (radians), right-handed (Rodrigues).
@@ -300,13 +303,24 @@ static inline vd_quat vd_quat_identity(void) {
 // Quaternion for a rotation of angle (radians) about the unit axis.
 vd_quat vd_quat_axis_angle(vd_vec3 axis, double angle);
 // Product a * b (apply b first, then a).
-vd_quat vd_quat_mul(vd_quat a, vd_quat b);
+static inline vd_quat vd_quat_mul(vd_quat a, vd_quat b) {
+  vd_quat q = {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+               a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+  return q;
+}
 // Conjugate (inverse for unit quaternions).
-vd_quat vd_quat_conj(vd_quat q);
+static inline vd_quat vd_quat_conj(vd_quat q) {
+  vd_quat c = {q.w, -q.x, -q.y, -q.z};
+  return c;
+}
 // q normalised to unit length.
 vd_quat vd_quat_normalize(vd_quat q);
-// Rotate v by the unit quaternion q.
-vd_vec3 vd_quat_rotate(vd_quat q, vd_vec3 v);
+// Rotate v by the unit quaternion q: v + 2w (u x v) + 2 u x (u x v), u its vector part.
+static inline vd_vec3 vd_quat_rotate(vd_quat q, vd_vec3 v) {
+  vd_vec3 u = vd_v3(q.x, q.y, q.z);
+  vd_vec3 t = vd_scale(vd_cross(u, v), 2.0);
+  return vd_add(vd_add(v, vd_scale(t, q.w)), vd_cross(u, t));
+}
 // Quaternion of the rotation whose columns are the orthonormal axes x, y, z.
 vd_quat vd_quat_from_axes(vd_vec3 x, vd_vec3 y, vd_vec3 z);
 

@@ -277,6 +277,28 @@ typedef struct vd_data {
 
 // Compile a spec into a model (labels completed, sizes checked).
 vd_status vd_plant_compile(const vd_plant_spec* s, vd_model** out, vd_error* err);
+
+// A straight beam, the cantilever of the validation cases, tests and benchmarks: a clamped
+// piece from origin - clamp * dir to origin (segment 0, instance 1), then length along dir (segment
+// 1, instance 2 or 1 with one_instance), both of radius r and label 1; with fruit_radius > 0 a
+// sphere on segment 1 (label 2 "fruit", instance 3) centred fruit_offset beyond the tip, hung on
+// the tip node when fruit_on_node. Segments' up: +z, or +x for a dir within 26 degrees of z.
+typedef struct vd_beam_def {
+  vd_vec3 origin;       // the clamped end of the free length (m, 0)
+  vd_vec3 dir;          // unit direction (+x)
+  double length;        // free length (m, 0.1)
+  double radius;        // radius (m, 0.001)
+  double clamp;         // length of the clamped piece behind the origin (m, 0.01)
+  double fruit_radius;  // m; 0: no fruit (0)
+  double fruit_offset;  // the fruit's centre beyond the tip along dir (m, 0)
+  int fruit_on_node;    // 1: the sphere's node is the tip (1)
+  int one_instance;     // 1: both segments are instance 1 (0)
+  const char* label;    // label 1's name ("stem")
+} vd_beam_def;
+vd_beam_def vd_beam_def_default(void);
+// The beam of d as a spec (*out new) or compiled (vd_plant_beam_model; the spec is not kept).
+vd_status vd_plant_beam(const vd_beam_def* d, vd_plant_spec** out, vd_error* err);
+vd_status vd_plant_beam_model(const vd_beam_def* d, vd_model** out, vd_error* err);
 // Free a model (NULL is fine).
 void vd_model_destroy(vd_model* m);
 // Label entry for id in a model, or NULL.

@@ -109,7 +109,6 @@ static vd_vec3 mesh_vert(const vd_mesh* mesh, int v) {
 // ---------------------------------------------------------------------------------------------
 // checks
 
-static int finite3(vd_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 static vd_status check_def(const vd_cloud_def* def, vd_error* err) {
 #define BAD(...) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, __VA_ARGS__)
@@ -157,7 +156,7 @@ static vd_status check_def(const vd_cloud_def* def, vd_error* err) {
   int64_t rays = 0;
   for (int v = 0; v < def->nscanner; v++) {
     const vd_scanner* s = &def->scanner[v];
-    if (!finite3(s->pos) || !finite3(s->target)) BAD("scanner %d: position and target must be finite", v);
+    if (!vd_v3_finite(s->pos) || !vd_v3_finite(s->target)) BAD("scanner %d: position and target must be finite", v);
     if (vd_norm(vd_sub(s->target, s->pos)) == 0) BAD("scanner %d: target equals the position", v);
     if (def->sensor != VD_SENSOR_SCAN) continue;
     if (s->pattern != VD_SCAN_ANGULAR && s->pattern != VD_SCAN_PINHOLE) BAD("scanner %d: unknown pattern", v);

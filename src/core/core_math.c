@@ -4,7 +4,7 @@
 
 #include <math.h>
 
-double vd_norm(vd_vec3 a) { return sqrt(vd_dot(a, a)); }
+int vd_v3_finite(vd_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
 vd_vec3 vd_normalize(vd_vec3 a) {
   double n = vd_norm(a);
@@ -26,29 +26,11 @@ vd_quat vd_quat_axis_angle(vd_vec3 axis, double angle) {
   return q;
 }
 
-vd_quat vd_quat_mul(vd_quat a, vd_quat b) {
-  vd_quat q = {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-               a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
-  return q;
-}
-
-vd_quat vd_quat_conj(vd_quat q) {
-  vd_quat c = {q.w, -q.x, -q.y, -q.z};
-  return c;
-}
-
 vd_quat vd_quat_normalize(vd_quat q) {
   double n = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
   if (n <= 0) return vd_quat_identity();
   vd_quat r = {q.w / n, q.x / n, q.y / n, q.z / n};
   return r;
-}
-
-vd_vec3 vd_quat_rotate(vd_quat q, vd_vec3 v) {
-  // v + 2w (u x v) + 2 u x (u x v), u = vector part
-  vd_vec3 u = vd_v3(q.x, q.y, q.z);
-  vd_vec3 t = vd_scale(vd_cross(u, v), 2.0);
-  return vd_add(vd_add(v, vd_scale(t, q.w)), vd_cross(u, t));
 }
 
 vd_quat vd_quat_from_axes(vd_vec3 x, vd_vec3 y, vd_vec3 z) {

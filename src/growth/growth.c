@@ -41,7 +41,6 @@ static vd_quat qbetween(vd_vec3 a, vd_vec3 b) {
   return vd_quat_normalize(q);
 }
 
-static int finite3(vd_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 // stable key of a plant element: module id, rank, end
 static uint64_t pack_key(int64_t uid, int rank, int end) {
@@ -671,7 +670,7 @@ static void map_rods(vd_growth* g) {
     d->seg_quat[t] = vd_quat_normalize(vd_quat_mul(rot[t], m->seg_quat0[t]));
   }
   for (int i = 0; i < m->nnode_all; i++)
-    if (!finite3(d->node_pos[i])) d->node_pos[i] = m->node_pos0[i];
+    if (!vd_v3_finite(d->node_pos[i])) d->node_pos[i] = m->node_pos0[i];
   vd_free(rot, sizeof(vd_quat) * (size_t)(ns ? ns : 1));
   vd_free(placed, (size_t)(m->nnode_all ? m->nnode_all : 1));
 }

@@ -67,7 +67,6 @@ vd_mss_opt vd_mss_opt_default(void) {
   return o;
 }
 
-static int finite3(vd_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 vd_status vd_mss_opt_check(const vd_mss_opt* o, vd_error* err) {
   const char* f = NULL;
@@ -75,8 +74,8 @@ vd_status vd_mss_opt_check(const vd_mss_opt* o, vd_error* err) {
   else if (o->integrator < VD_MSS_EQ3 || o->integrator > VD_MSS_IMPLICIT) f = "integrator";
   else if (o->cg_iterations < 1) f = "conjugate-gradient iterations (>= 1)";
   else if (!(o->cg_tolerance > 0 && o->cg_tolerance < 1)) f = "conjugate-gradient tolerance (in (0, 1))";
-  else if (!finite3(o->gravity)) f = "gravity (m/s^2, finite)";
-  else if (!finite3(o->wind) || fabs(o->wind.x) > VD_SIM_MAX_WIND || fabs(o->wind.y) > VD_SIM_MAX_WIND ||
+  else if (!vd_v3_finite(o->gravity)) f = "gravity (m/s^2, finite)";
+  else if (!vd_v3_finite(o->wind) || fabs(o->wind.x) > VD_SIM_MAX_WIND || fabs(o->wind.y) > VD_SIM_MAX_WIND ||
            fabs(o->wind.z) > VD_SIM_MAX_WIND)
     f = "wind (m/s, finite, within the largest wind)";
   else if (!isfinite(o->gust_amplitude) || !(o->gust_period > 0)) f = "gusts (amplitude finite, period > 0 s)";
@@ -87,7 +86,7 @@ vd_status vd_mss_opt_check(const vd_mss_opt* o, vd_error* err) {
     f = "drag coefficients (>= 0)";
   else if (o->drag < VD_MSS_DRAG_NONE || o->drag > VD_MSS_DRAG_QUADRATIC) f = "drag model";
   else if (!(o->viscosity >= 0 && isfinite(o->viscosity))) f = "viscosity (Pa s >= 0)";
-  else if (o->light && (!finite3(o->light_pos) || !isfinite(o->light_k))) f = "light (position m, strength N m^2)";
+  else if (o->light && (!vd_v3_finite(o->light_pos) || !isfinite(o->light_k))) f = "light (position m, strength N m^2)";
   else if (o->gravitropism < VD_MSS_GRAVI_NONE || o->gravitropism > VD_MSS_GRAVI_BASTIEN) f = "gravitropism";
   else if (!isfinite(o->gravi_k)) f = "gravitropism strength (N)";
   else if (!(o->bastien_beta >= 0 && isfinite(o->bastien_beta)) || !(o->bastien_gamma >= 0 && isfinite(o->bastien_gamma)))
@@ -237,7 +236,7 @@ vd_status vd_mss_build(const vd_model* p, const vd_mss_def* def, const double* r
       if (!structural(p, j)) continue;
       int a = map[p->seg_node[2 * j]], b = map[p->seg_node[2 * j + 1]];
       vd_vec3 xa = rest_at(p, rest, p->seg_node[2 * j]), xb = rest_at(p, rest, p->seg_node[2 * j + 1]);
-      if (!finite3(xa) || !finite3(xb)) {
+      if (!vd_v3_finite(xa) || !vd_v3_finite(xb)) {
         st = vd_error_set(err, VD_ERR_VALUE, "", 0, 0, "segment %d: non-finite rest position", j);
         goto done;
       }
@@ -669,7 +668,7 @@ static void blk_add_ident(double* b, double s) { b[0] += s, b[4] += s, b[8] += s
 static void spring_block(const vd_mss_model* m, const vd_mss_data* d, int s, double* b, vd_vec3* u_out) {
   int i = m->spring_node[2 * s], j = m->spring_node[2 * s + 1];
   vd_vec3 e = vd_sub(d->pos[j], d->pos[i]);
-  double l = v_norm(e);
+  double l = vd_norm(e);
   vd_vec3 u = l > 0 ? vd_scale(e, 1.0 / l) : vd_v3(0, 0, 1);
   double k = m->spring_k[s], t = l > 0 ? fmax(0.0, 1.0 - m->spring_l0[s] / l) : 0;
   memset(b, 0, 9 * sizeof(double));
@@ -705,7 +704,7 @@ static int hinge_linearise(const vd_mss_model* m, const vd_mss_data* d, int h, h
   if ((hl->a >= 0 && d->removed[hl->a]) || d->removed[hl->b] || d->removed[hl->c]) return 0;
   if ((hl->a < 0 || d->rigid[hl->a]) && d->rigid[hl->b] && d->rigid[hl->c]) return 0;
   vd_vec3 q = vd_sub(d->pos[hl->c], d->pos[hl->b]);
-  double lq = v_norm(q);
+  double lq = vd_norm(q);
   if (!(lq > 0)) return 0;
   double sq[9];
   skew(sq, vd_scale(q, 1.0 / lq));
@@ -713,7 +712,7 @@ static int hinge_linearise(const vd_mss_model* m, const vd_mss_data* d, int h, h
   for (int k = 0; k < 9; k++) hl->jc[k] = -sq[k] / lq, hl->jb[k] = sq[k] / lq;
   if (hl->a >= 0) {
     vd_vec3 pa = vd_sub(d->pos[hl->a], d->pos[hl->b]);
-    double lp = v_norm(pa);
+    double lp = vd_norm(pa);
     if (lp > 0) {
       double sp[9];
       skew(sp, vd_scale(pa, 1.0 / lp));
@@ -1135,8 +1134,8 @@ static void solve_kang(const vd_mss_model* m, vd_mss_data* d, mss_work* w, int e
       continue;
     }
     if (eq4) {
-      double f = v_norm(w->ftot[i]);
-      w->cg_z[i] = f > 0 ? vd_scale(w->ftot[i], v_norm(d->dv[i]) / f) : vd_v3(0, 0, 0);
+      double f = vd_norm(w->ftot[i]);
+      w->cg_z[i] = f > 0 ? vd_scale(w->ftot[i], vd_norm(d->dv[i]) / f) : vd_v3(0, 0, 0);
     } else {
       w->cg_z[i] = vd_scale(w->ftot[i], h / (d->mass[i] + h2 * w->ksum[i]));
     }
@@ -1249,7 +1248,7 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
       double fm = m->node_soil[i];
       soil_members = 1;
       cap_f += fm;
-      cap_m += fm * v_norm(vd_sub(d->pos[i], b->x));
+      cap_m += fm * vd_norm(vd_sub(d->pos[i], b->x));
     }
   }
   if (clamped || (!m->opt.soil && soil_members)) {
@@ -1262,7 +1261,7 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
   int held = 0;
   if (soil_members) {
     // the per-node rule for a whole body: held while the wrench is within the soil's capacity
-    double nf = v_norm(f), nt = v_norm(tau);
+    double nf = vd_norm(f), nt = vd_norm(tau);
     if (nf <= cap_f && nt <= cap_m) {
       held = 1;
       b->p = b->L = vd_v3(0, 0, 0);
@@ -1308,7 +1307,7 @@ static void anchor_check(const vd_mss_model* m, vd_mss_data* d, const mss_work* 
     f = vd_add(f, fc);
     mo = vd_add(mo, vd_add(mc, vd_cross(vd_sub(d->pos[c], d->pos[b]), fc)));
   }
-  double nm = v_norm(mo), nf = v_norm(f);
+  double nm = vd_norm(mo), nf = vd_norm(f);
   double load = fmax(m->anchor_moment > 0 ? nm / m->anchor_moment : nm > 0 ? INFINITY : 0,
                      m->anchor_force > 0 ? nf / m->anchor_force : nf > 0 ? INFINITY : 0);
   if (load > d->anchor_load) d->anchor_load = load;
@@ -1367,7 +1366,7 @@ vd_status vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
       continue;
     }
     if (w->con[i] || !(m->node_flags[i] & VD_MSS_SOIL)) continue;
-    double fm = m->opt.soil ? m->node_soil[i] : INFINITY, f = v_norm(w->ftot[i]);
+    double fm = m->opt.soil ? m->node_soil[i] : INFINITY, f = vd_norm(w->ftot[i]);
     if (f <= fm) {
       d->held[i] = 1;
       w->con[i] = 1;
@@ -1390,7 +1389,7 @@ vd_status vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     d->vel[i] = vd_add(d->vel[i], dv);
     if (d->held[i]) d->vel[i] = vd_v3(0, 0, 0);
     d->pos[i] = vd_madd(d->pos[i], d->vel[i], h);
-    if (!finite3(d->pos[i]) || !finite3(d->vel[i])) bad = 1;
+    if (!vd_v3_finite(d->pos[i]) || !vd_v3_finite(d->vel[i])) bad = 1;
   }
   // the ground of a rooted plant: stem nodes that reach it stop there (an inelastic contact
   // without sliding), so a tree that tips over lies on it
@@ -1409,7 +1408,7 @@ vd_status vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
       if (sp < 0 || d->spring_broken[sp] || !mss_free(m, d, c) || d->held[c]) continue;
       int b = m->spring_node[2 * sp];
       vd_vec3 e = vd_sub(d->pos[c], d->pos[b]);
-      double l = v_norm(e), l0 = m->spring_l0[sp], lim = m->opt.strain_limit;
+      double l = vd_norm(e), l0 = m->spring_l0[sp], lim = m->opt.strain_limit;
       double lt = l > l0 * (1 + lim) ? l0 * (1 + lim) : l < l0 * (1 - lim) ? l0 * (1 - lim) : l;
       if (lt == l || !(l > 0)) continue;
       vd_vec3 x = vd_add(d->pos[b], vd_scale(e, lt / l));

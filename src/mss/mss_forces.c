@@ -19,7 +19,7 @@
 
 // the upward direction: against gravity, +z without gravity
 static vd_vec3 up_dir(const vd_mss_opt* o) {
-  double g = v_norm(o->gravity);
+  double g = vd_norm(o->gravity);
   return g > 0 ? vd_scale(o->gravity, -1.0 / g) : vd_v3(0, 0, 1);
 }
 
@@ -40,7 +40,7 @@ void mss_external(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
     for (int i = 0; i < nn; i++) {
       if (d->removed[i] || (m->node_flags[i] & (VD_MSS_SOIL | VD_MSS_ROOT))) continue;
       vd_vec3 u = relative ? vd_sub(wind, d->vel[i]) : wind;
-      double a = VD_PI * m->node_radius[i] * m->node_radius[i], un = v_norm(u);
+      double a = VD_PI * m->node_radius[i] * m->node_radius[i], un = vd_norm(u);
       d->fext[i] = vd_madd(d->fext[i], u, q * o->drag_cd * a * un);
       if (relative) w->cdrag[i] += 2 * q * o->drag_cd * a * un;
     }
@@ -55,7 +55,7 @@ void mss_external(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
       vd_vec3 e = vd_normalize(vd_sub(d->pos[j], d->pos[i]));
       vd_vec3 un = vd_madd(u, e, -vd_dot(u, e));
       double area = (m->spring_radius[2 * s] + m->spring_radius[2 * s + 1]) * m->spring_l0[s];
-      double nu = v_norm(un);
+      double nu = vd_norm(un);
       vd_vec3 f = vd_scale(un, q * o->drag_cd * area * nu);
       double c = relative ? 2 * q * o->drag_cd * area * nu : 0;
       int hi = !(m->node_flags[i] & VD_MSS_SOIL);
@@ -69,7 +69,7 @@ void mss_external(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
     for (int i = 0; i < nn; i++) {
       if (d->removed[i] || m->node_leaf_area[i] <= 0) continue;
       vd_vec3 u = relative ? vd_sub(wind, d->vel[i]) : wind;
-      double un = v_norm(u), a = m->node_leaf_area[i];
+      double un = vd_norm(u), a = m->node_leaf_area[i];
       d->fext[i] = vd_madd(d->fext[i], u, q * o->leaf_cd * a * un);
       if (relative) w->cdrag[i] += 2 * q * o->leaf_cd * a * un;
     }
@@ -116,20 +116,20 @@ void mss_hinge_force_at(const vd_mss_model* m, int h, vd_vec3 xa, vd_vec3 xb, vd
   int a = m->hinge_node[3 * h];
   *fa = *fb = *fc = vd_v3(0, 0, 0);
   vd_vec3 qv = vd_sub(xc, xb);
-  double lq = v_norm(qv);
+  double lq = vd_norm(qv);
   if (!(lq > 0)) return;
   vd_vec3 q = vd_scale(qv, 1.0 / lq), p = m->hinge_p0[h];
   double lp = 0;
   if (a >= 0) {
     vd_vec3 pv = vd_sub(xa, xb);
-    lp = v_norm(pv);
+    lp = vd_norm(pv);
     if (!(lp > 0)) return;
     p = vd_scale(pv, 1.0 / lp);
   }
   // target: the rest direction of b->c carried by the smallest rotation of the other arm
-  vd_vec3 t = q_rotate(quat_between(m->hinge_p0[h], p), m->hinge_q0[h]);
+  vd_vec3 t = vd_quat_rotate(quat_between(m->hinge_p0[h], p), m->hinge_q0[h]);
   vd_vec3 n = vd_cross(q, t);
-  double sn = v_norm(n), theta = atan2(sn, vd_dot(q, t));
+  double sn = vd_norm(n), theta = atan2(sn, vd_dot(q, t));
   if (!(sn > 1e-15)) return;
   vd_vec3 mo = vd_scale(n, m->hinge_k[h] * theta / sn);
   *fc = vd_scale(vd_cross(mo, q), 1.0 / lq);
@@ -145,7 +145,7 @@ void mss_internal(const vd_mss_model* m, const vd_mss_data* d, mss_work* w) {
     int i = m->spring_node[2 * s], j = m->spring_node[2 * s + 1];
     if (d->removed[i] || d->removed[j] || (d->rigid[i] && d->rigid[j])) continue;
     vd_vec3 e = vd_sub(d->pos[j], d->pos[i]);
-    double l = v_norm(e);
+    double l = vd_norm(e);
     if (!(l > 0)) continue;
     vd_vec3 u = vd_scale(e, 1.0 / l);
     vd_vec3 f = vd_scale(u, m->spring_k[s] * (l - m->spring_l0[s]));

@@ -52,7 +52,7 @@ static rk_state rk_deriv(const vd_rigid* b, const rk_state* s, vd_vec3 f, vd_vec
   rk_state d;
   d.x = vd_scale(s->p, 1.0 / b->mass);
   vd_quat wq = {0, w.x, w.y, w.z};
-  vd_quat dq = q_mul(wq, s->q);
+  vd_quat dq = vd_quat_mul(wq, s->q);
   d.q = (vd_quat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z};
   d.p = f;
   d.L = tau;
@@ -155,7 +155,7 @@ void mss_rigid_sync(const vd_mss_model* m, vd_mss_data* d) {
   vd_vec3 w = vd_rigid_omega(b), v0 = vd_scale(b->p, 1.0 / b->mass);
   for (int i = 0; i < m->nnode; i++)
     if (d->rigid[i] && !d->removed[i]) {
-      vd_vec3 r = q_rotate(b->q, d->body[i]);
+      vd_vec3 r = vd_quat_rotate(b->q, d->body[i]);
       d->pos[i] = vd_add(b->x, r);
       d->vel[i] = vd_add(v0, vd_cross(w, r));
     }
@@ -282,7 +282,7 @@ void vd_mss_rigid_update(const vd_mss_model* m, vd_mss_data* d) {
 // a node's position and velocity with the body at orientation q turning at w (outside nodes
 // stay where they are for the substep)
 static vd_vec3 pos_at(const vd_mss_data* d, const mss_anchor* an, vd_quat q, int i) {
-  return d->rigid[i] ? vd_add(an->pivot, q_rotate(q, vd_sub(d->body[i], an->pivot_body))) : d->pos[i];
+  return d->rigid[i] ? vd_add(an->pivot, vd_quat_rotate(q, vd_sub(d->body[i], an->pivot_body))) : d->pos[i];
 }
 
 static vd_vec3 vel_at(const vd_mss_data* d, const mss_anchor* an, vd_quat q, vd_vec3 w, int i) {
@@ -298,7 +298,7 @@ static vd_vec3 coupling_torque(const vd_mss_model* m, const vd_mss_data* d, cons
   for (int k = 0; k < an->nspring; k++) {
     int s = an->spring[k], i = m->spring_node[2 * s], j = m->spring_node[2 * s + 1];
     vd_vec3 xi = pos_at(d, an, q, i), xj = pos_at(d, an, q, j), e = vd_sub(xj, xi);
-    double l = v_norm(e);
+    double l = vd_norm(e);
     if (!(l > 0)) continue;
     vd_vec3 u = vd_scale(e, 1.0 / l), dv = vd_sub(vel_at(d, an, q, w, j), vel_at(d, an, q, w, i));
     vd_vec3 f = vd_scale(u, m->spring_k[s] * (l - m->spring_l0[s]));
@@ -345,10 +345,10 @@ static pin_state pin_deriv(const vd_mss_model* m, const vd_mss_data* d, const ms
   vd_vec3 w = m3_mul_v(iai, s->la);
   pin_state r;
   vd_quat wq = {0, w.x, w.y, w.z};
-  vd_quat dq = q_mul(wq, q);
+  vd_quat dq = vd_quat_mul(wq, q);
   r.q = (vd_quat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z};
   // the anchor's bending is damped like eq. 5, c sqrt(k I) on the turn across the trunk's axis
-  vd_vec3 axis = q_rotate(q, an->axis_body);
+  vd_vec3 axis = vd_quat_rotate(q, an->axis_body);
   vd_vec3 wp = vd_madd(w, axis, -vd_dot(w, axis));
   r.la = vd_madd(vd_add(torque, coupling_torque(m, d, an, q, w)), wp, -an->damping);
   return r;
@@ -398,7 +398,7 @@ void mss_rigid_pinned_step(const vd_mss_model* m, vd_mss_data* d, mss_anchor* an
   pinned_inertia(b, an->pivot_body, s.q, ia, iai);
   vd_vec3 w = m3_mul_v(iai, s.la);
   b->q = s.q;
-  b->x = vd_sub(an->pivot, q_rotate(s.q, an->pivot_body));
+  b->x = vd_sub(an->pivot, vd_quat_rotate(s.q, an->pivot_body));
   vd_vec3 r = vd_sub(b->x, an->pivot);
   b->p = vd_scale(vd_cross(w, r), b->mass);
   b->L = vd_sub(s.la, vd_cross(r, b->p));

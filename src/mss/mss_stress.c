@@ -52,7 +52,7 @@ static double section_stress(vd_vec3 f, vd_vec3 mo, vd_vec3 e, double r) {
   r = fmax(r, 1e-6);
   double n = fabs(vd_dot(f, e));
   vd_vec3 mp = vd_madd(mo, e, -vd_dot(mo, e));
-  return n / (VD_PI * r * r) + 4 * v_norm(mp) / (VD_PI * r * r * r);
+  return n / (VD_PI * r * r) + 4 * vd_norm(mp) / (VD_PI * r * r * r);
 }
 
 void vd_mss_stress(const vd_mss_model* m, vd_mss_data* d) {
@@ -65,7 +65,7 @@ void vd_mss_stress(const vd_mss_model* m, vd_mss_data* d) {
     int b = m->spring_node[2 * s], c = m->spring_node[2 * s + 1];
     if (d->spring_broken[s] || d->removed[c] || m->node_owner[c] != s) continue;
     vd_vec3 ev = vd_sub(d->pos[c], d->pos[b]);
-    double l = v_norm(ev);
+    double l = vd_norm(ev);
     vd_vec3 e = l > 0 ? vd_scale(ev, 1.0 / l) : vd_v3(0, 0, 1);
     // a cut through the rigid part: the loads beyond it; elsewhere the elastic forces across it
     int rigid = d->rigid[b] && d->rigid[c];
@@ -101,7 +101,7 @@ void vd_mss_bastien(const vd_mss_model* m, const vd_mss_data* d, double t, int n
   int nn = m->nnode;
   for (int i = 0; i < nn; i++) rest[i] = m->node_rest[i];
   if (nsub < 1 || !(t > 0)) return;
-  double g = v_norm(m->opt.gravity), beta = m->opt.bastien_beta, gamma = m->opt.bastien_gamma;
+  double g = vd_norm(m->opt.gravity), beta = m->opt.bastien_beta, gamma = m->opt.bastien_gamma;
   vd_vec3 up = g > 0 ? vd_scale(m->opt.gravity, -1.0 / g) : vd_v3(0, 0, 1);
   double dt = t / nsub;
   for (int step = 0; step < nsub; step++) {
@@ -114,22 +114,22 @@ void vd_mss_bastien(const vd_mss_model* m, const vd_mss_data* d, double t, int n
       int a = m->node_parent[b];
       if (a < 0 || m->node_axis[c] != m->node_axis[b] || m->node_age[c] >= m->opt.growth_zone_age) continue;
       vd_vec3 qv = vd_sub(rest[c], rest[b]), pv = vd_sub(rest[a], rest[b]);
-      double lq = v_norm(qv), lp = v_norm(pv);
+      double lq = vd_norm(qv), lp = vd_norm(pv);
       if (!(lq > 0) || !(lp > 0)) continue;
       vd_vec3 q = vd_scale(qv, 1.0 / lq), cont = vd_scale(pv, -1.0 / lp);
       // the rest bend: rotation from the continuation of the lower internode to the upper one
       vd_vec3 ax = vd_cross(cont, q);
-      double sn = v_norm(ax), th = atan2(sn, vd_dot(cont, q));
+      double sn = vd_norm(ax), th = atan2(sn, vd_dot(cont, q));
       vd_vec3 omega = sn > 1e-15 ? vd_scale(ax, th / sn) : vd_v3(0, 0, 0);
       double lbar = 0.5 * (lq + lp);
       vd_vec3 domega = vd_scale(vd_madd(vd_scale(vd_cross(q, up), beta * lbar), omega, -gamma), dt);
-      double ang = v_norm(domega);
+      double ang = vd_norm(domega);
       if (!(ang > 0)) continue;
       vd_quat r = vd_quat_axis_angle(vd_scale(domega, 1.0 / ang), ang);
       vd_vec3 pivot = rest[b];
       for (int j = m->node_pre[c]; j <= m->node_last[c]; j++) {
         int i = m->node_order[j];
-        rest[i] = vd_add(pivot, q_rotate(r, vd_sub(rest[i], pivot)));
+        rest[i] = vd_add(pivot, vd_quat_rotate(r, vd_sub(rest[i], pivot)));
       }
     }
   }

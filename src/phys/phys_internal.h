@@ -64,17 +64,9 @@ int m6_cholesky(double* a);
 void m6_chol_solve(const double* l, double* b);
 
 // ---------------------------------------------------------------------------------------------
-// quaternions: inline copies of the core operations for the hot loops
+// quaternions: a normalisation by the reciprocal for the hot loops (core's vd_quat_mul, _conj,
+// _rotate and vd_norm are inline)
 
-static inline vd_quat q_mul(vd_quat a, vd_quat b) {
-  vd_quat q = {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-               a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
-  return q;
-}
-static inline vd_quat q_conj(vd_quat q) {
-  vd_quat c = {q.w, -q.x, -q.y, -q.z};
-  return c;
-}
 static inline vd_quat q_normalize(vd_quat q) {
   double n = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
   if (!(n > 0)) return vd_quat_identity();
@@ -82,14 +74,6 @@ static inline vd_quat q_normalize(vd_quat q) {
   vd_quat r = {q.w * in, q.x * in, q.y * in, q.z * in};
   return r;
 }
-// v rotated by the unit quaternion q
-static inline vd_vec3 q_rotate(vd_quat q, vd_vec3 v) {
-  // t = 2 (u x v), v' = v + w t + u x t
-  vd_vec3 u = {q.x, q.y, q.z};
-  vd_vec3 t = vd_scale(vd_cross(u, v), 2.0);
-  return vd_add(vd_add(v, vd_scale(t, q.w)), vd_cross(u, t));
-}
-static inline double v_norm(vd_vec3 a) { return sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
 
 // Series of the maps for small angles, shared by the scalar maps below and the direct solver's
 // lane code (same operations, same bytes). For a rotation vector of squared angle a2 <= 0.01:
@@ -127,7 +111,7 @@ static inline vd_vec3 quat_log(vd_quat q) {
   return vd_v3(q.x * k, q.y * k, q.z * k);
 }
 // q rotated by the world rotation vector v: exp(v) q, normalised
-static inline vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) { return q_normalize(q_mul(quat_exp(v), q)); }
+static inline vd_quat quat_rotate_by(vd_quat q, vd_vec3 v) { return q_normalize(vd_quat_mul(quat_exp(v), q)); }
 static inline double quat_dot(vd_quat a, vd_quat b) { return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline vd_vec3 quat_im(vd_quat q) { return vd_v3(q.x, q.y, q.z); }
 // d3 (z axis) of a frame

@@ -62,7 +62,7 @@ void m6_chol_solve(const double* l, double* b) {
 }
 
 vd_quat quat_exp_big(vd_vec3 v) {
-  double a = v_norm(v), k = sin(0.5 * a) / a;
+  double a = vd_norm(v), k = sin(0.5 * a) / a;
   vd_quat q = {cos(0.5 * a), v.x * k, v.y * k, v.z * k};
   return q;
 }

@@ -137,6 +137,54 @@ vd_segment_spec vd_segment_spec_default(void) {
   return g;
 }
 
+vd_beam_def vd_beam_def_default(void) {
+  vd_beam_def d;
+  memset(&d, 0, sizeof d);
+  d.dir = vd_v3(1, 0, 0);
+  d.length = 0.1;
+  d.radius = 0.001;
+  d.clamp = 0.01;
+  d.fruit_on_node = 1;
+  d.label = "stem";
+  return d;
+}
+
+vd_status vd_plant_beam(const vd_beam_def* d, vd_plant_spec** out, vd_error* err) {
+  *out = NULL;
+  vd_plant_spec* s = vd_plant_spec_create();
+  if (!s) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "beam: out of memory");
+  vd_vec3 up = fabs(d->dir.z) < 0.9 ? vd_v3(0, 0, 1) : vd_v3(1, 0, 0);
+  int a = vd_plant_add_node(s, vd_madd(d->origin, d->dir, -d->clamp)), b = vd_plant_add_node(s, d->origin);
+  int c = vd_plant_add_node(s, vd_madd(d->origin, d->dir, d->length));
+  vd_segment_spec g = vd_segment_spec_default();
+  g.node0 = a, g.node1 = b, g.r0 = g.r1 = d->radius, g.label = 1, g.instance = 1, g.up = up;
+  int s0 = vd_plant_add_segment(s, &g);
+  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = d->one_instance ? 1 : 2;
+  int s1 = vd_plant_add_segment(s, &g);
+  vd_status st = a < 0 || b < 0 || c < 0 || s0 < 0 || s1 < 0 ? VD_ERR_NOMEM : vd_plant_set_label(s, 1, d->label);
+  if (!st && d->fruit_radius > 0) {
+    vd_sphere_spec f = vd_sphere_spec_default();
+    f.center = vd_madd(d->origin, d->dir, d->length + d->fruit_offset), f.radius = d->fruit_radius;
+    f.node = d->fruit_on_node ? c : -1, f.parent = s1, f.label = 2, f.instance = 3;
+    st = vd_plant_add_sphere(s, &f) < 0 ? VD_ERR_NOMEM : vd_plant_set_label(s, 2, "fruit");
+  }
+  if (st) {
+    vd_plant_spec_destroy(s);
+    return vd_error_set(err, st, "", 0, 0, "beam: out of memory");
+  }
+  *out = s;
+  return VD_OK;
+}
+
+vd_status vd_plant_beam_model(const vd_beam_def* d, vd_model** out, vd_error* err) {
+  vd_plant_spec* s;
+  *out = NULL;
+  vd_status st = vd_plant_beam(d, &s, err);
+  if (!st) st = vd_plant_compile(s, out, err);
+  vd_plant_spec_destroy(s);
+  return st;
+}
+
 vd_sphere_spec vd_sphere_spec_default(void) {
   vd_sphere_spec g;
   memset(&g, 0, sizeof g);

@@ -123,20 +123,11 @@ static void pusher_mjcf(const char* path, double kp, double fmax) {
 
 // a horizontal cantilever along +x from the origin, length L, radius r, no gravity
 static vd_model* rod_plant(double len, double r) {
-  vd_plant_spec* s = vd_plant_spec_create();
-  vd_plant_add_node(s, vd_v3(-0.01, 0, 0.3));
-  vd_plant_add_node(s, vd_v3(0, 0, 0.3));
-  vd_plant_add_node(s, vd_v3(len, 0, 0.3));
-  vd_segment_spec g = vd_segment_spec_default();
-  g.node0 = 0, g.node1 = 1, g.r0 = g.r1 = r, g.label = 1, g.instance = 1, g.up = vd_v3(0, 0, 1);
-  int s0 = vd_plant_add_segment(s, &g);
-  g.node0 = 1, g.node1 = 2, g.parent = s0;
-  vd_plant_add_segment(s, &g);
-  vd_plant_set_label(s, 1, "branch");
-  vd_model* m = NULL;
+  vd_beam_def d = vd_beam_def_default();
+  d.origin = vd_v3(0, 0, 0.3), d.length = len, d.radius = r, d.one_instance = 1, d.label = "branch";
+  vd_model* m;
   vd_error e = {0};
-  vd_plant_compile(s, &m, &e);
-  vd_plant_spec_destroy(s);
+  vd_plant_beam_model(&d, &m, &e);
   return m;
 }
 

@@ -443,7 +443,7 @@ static vd_status build_chains(bld* b) {
     for (;;) {
       segs[k] = cur;
       pts[k + 1] = pnode(p, p->seg_node[2 * cur + 1]);
-      cum[k + 1] = cum[k] + v_norm(vd_sub(pts[k + 1], pts[k]));
+      cum[k + 1] = cum[k] + vd_norm(vd_sub(pts[k + 1], pts[k]));
       k++;
       int e = p->seg_node[2 * cur + 1];
       if (b->key[e] || k >= ns) break;
@@ -458,7 +458,7 @@ static vd_status build_chains(bld* b) {
       if (par >= 0 && b->rod_of[p->seg_node[2 * par + 1]] >= 0) {
         int pe = b->rod_of[p->seg_node[2 * par + 1]];
         vd_vec3 x = pnode(p, n0);
-        if (v_norm(vd_sub(x, b->node[pe].pos)) < 1e-9) {
+        if (vd_norm(vd_sub(x, b->node[pe].pos)) < 1e-9) {
           start = pe;
         } else {
           start = add_node(b, x, 0);
@@ -550,7 +550,7 @@ static vd_status build_spheres(bld* b) {
     double r = p->sphere_radius[k];
     vd_vec3 c = vd_v3(p->sphere_pos0[3 * k], p->sphere_pos0[3 * k + 1], p->sphere_pos0[3 * k + 2]);
     double mass = b->def->material[cls].density * 4.0 / 3.0 * VD_PI * r * r * r;
-    if (v_norm(vd_sub(c, b->node[a].pos)) < 1e-7) {
+    if (vd_norm(vd_sub(c, b->node[a].pos)) < 1e-7) {
       // centred on the node: the node carries the sphere
       b->node[a].mass += mass;
       if (r > b->node[a].sphere) b->node[a].sphere = r;
@@ -577,7 +577,7 @@ static double seg_dist(vd_vec3 a, vd_vec3 b, vd_vec3 p, double* u) {
   double l2 = vd_dot(ab, ab), t = l2 > 0 ? vd_dot(vd_sub(p, a), ab) / l2 : 0;
   t = t < 0 ? 0 : t > 1 ? 1 : t;
   *u = t;
-  return v_norm(vd_sub(p, vd_add(a, vd_scale(ab, t))));
+  return vd_norm(vd_sub(p, vd_add(a, vd_scale(ab, t))));
 }
 
 // a chain of nseg rod segments from rod node a straight to point e; returns the end node
@@ -617,7 +617,7 @@ static vd_status leaf_graph(bld* b, int k, int* done) {
   int tip = -1;
   double len = 0;
   for (int i = 0; i < nv; i++) {
-    double l = v_norm(vd_sub(VP(v0 + i), xa));
+    double l = vd_norm(vd_sub(VP(v0 + i), xa));
     if (l > len) len = l, tip = v0 + i;
   }
   if (len < 1e-6) return VD_OK;
@@ -646,7 +646,7 @@ static vd_status leaf_graph(bld* b, int k, int* done) {
       vd_vec3 w = vd_sub(VP(v0 + i), xa);
       double tau = vd_dot(w, u);
       vd_vec3 lat = vd_madd(w, u, -tau);
-      double dist = v_norm(lat);
+      double dist = vd_norm(lat);
       double sg = vd_dot(vd_cross(u, lat), nrm);
       if ((sg > 0 ? 1 : -1) == side && dist > bd) bd = dist, best = v0 + i, btau = tau / len;
     }
@@ -656,7 +656,7 @@ static vd_status leaf_graph(bld* b, int k, int* done) {
     if (j < 0) j = 0;
     int sn = j == 0 ? a : mid0 + j - 1;
     double rv = 0.7 * r0 * (1 - 0.3 * btau);
-    double lv = v_norm(vd_sub(VP(best), b->node[sn].pos));
+    double lv = vd_norm(vd_sub(VP(best), b->node[sn].pos));
     if (lv < 1e-6) continue;
     if (straight(b, sn, VP(best), nsteps(b, lv), rv, 0.7 * rv, label, inst, NULL) < 0) return oom(b);
   }
@@ -677,7 +677,7 @@ static vd_status leaf_graph(bld* b, int k, int* done) {
   for (int i = 0; i < nt; i++) {
     const int* tv = p->tri_vert + 3 * (t0 + i);
     vd_vec3 cr = vd_cross(vd_sub(VP(tv[1]), VP(tv[0])), vd_sub(VP(tv[2]), VP(tv[0])));
-    double area = 0.5 * v_norm(cr);
+    double area = 0.5 * vd_norm(cr);
     for (int c = 0; c < 3; c++) {
       int t = b->vert_seg[tv[c]];
       double uu;
@@ -727,7 +727,7 @@ static vd_status build_meshes(bld* b) {
       vd_vec3 q0 = vd_v3(p->vert_pos0[3 * tv[0]], p->vert_pos0[3 * tv[0] + 1], p->vert_pos0[3 * tv[0] + 2]);
       vd_vec3 q1 = vd_v3(p->vert_pos0[3 * tv[1]], p->vert_pos0[3 * tv[1] + 1], p->vert_pos0[3 * tv[1] + 2]);
       vd_vec3 q2 = vd_v3(p->vert_pos0[3 * tv[2]], p->vert_pos0[3 * tv[2] + 1], p->vert_pos0[3 * tv[2] + 2]);
-      area += 0.5 * v_norm(vd_cross(vd_sub(q1, q0), vd_sub(q2, q0)));
+      area += 0.5 * vd_norm(vd_cross(vd_sub(q1, q0), vd_sub(q2, q0)));
     }
     b->node[a >= 0 ? a : b->seg[t].n1].mass += b->def->leaf_areal_density * area;
   }
@@ -773,7 +773,7 @@ static vd_status stake_ties(bld* b, int tip) {
   vd_vec3 prev = np ? b->node[n].pos : vd_v3(0, 0, 0);
   for (int i = np - 1; i >= 0; i--) {
     int k = path[i];
-    arc += v_norm(vd_sub(b->node[k].pos, prev));
+    arc += vd_norm(vd_sub(b->node[k].pos, prev));
     prev = b->node[k].pos;
     if (arc + 1e-12 >= next) {
       if (!vd_grow((void**)&b->tie_node, &b->cap_tie, b->ntie + 1, sizeof(int))) {
@@ -874,7 +874,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     m->seg_parent[t] = s->parent, m->seg_flags[t] = s->flags, m->seg_class[t] = s->cls;
     m->seg_label[t] = s->label, m->seg_instance[t] = s->instance, m->seg_plant[t] = s->plant;
     m->seg_radius[t] = s->radius, m->seg_cd[t] = mt->drag_cd;
-    double l = v_norm(vd_sub(b->node[s->n1].pos, b->node[s->n0].pos));
+    double l = vd_norm(vd_sub(b->node[s->n1].pos, b->node[s->n0].pos));
     m->seg_len0[t] = l > 1e-12 ? l : 1e-12;
     double r = s->radius, area = VD_PI * r * r;
     double mass = (s->flags & VD_SIM_FRUITSEG) || s->ghost ? 0.0 : mt->density * area * m->seg_len0[t];
@@ -929,11 +929,11 @@ static vd_status pack(bld* b, vd_sim_model** out) {
       int par = m->seg_parent[t];
       vd_quat q;
       if (par >= 0) {
-        q = q_mul(quat_between(quat_d3(m->seg_quat0[par]), d3), m->seg_quat0[par]);
+        q = vd_quat_mul(quat_between(quat_d3(m->seg_quat0[par]), d3), m->seg_quat0[par]);
       } else if (m->seg_plant[t] >= 0) {
         const double* pq = p->seg_quat0 + 4 * m->seg_plant[t];
         vd_quat qp = {pq[0], pq[1], pq[2], pq[3]};
-        q = q_mul(quat_between(quat_d3(qp), d3), qp);
+        q = vd_quat_mul(quat_between(quat_d3(qp), d3), qp);
       } else {
         q = quat_between(vd_v3(0, 0, 1), d3);
       }
@@ -980,7 +980,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
       if (!(m->seg_flags[par] & VD_SIM_FIXED) && !JUNCTION_DOWN(par))
         fb += 0.5 * lp / (ep * ip), ft += 0.5 * lp / (gp * 2 * ip);
       lbar = 0.5 * (l + lp);
-      vd_quat qr = q_mul(q_conj(m->seg_quat0[par]), m->seg_quat0[t]);
+      vd_quat qr = vd_quat_mul(vd_quat_conj(m->seg_quat0[par]), m->seg_quat0[t]);
       if (qr.w < 0) qr.w = -qr.w, qr.x = -qr.x, qr.y = -qr.y, qr.z = -qr.z;
       m->seg_rest[t] = q_normalize(qr);
     } else {
@@ -990,7 +990,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     m->seg_cb[3 * t] = m->seg_cb[3 * t + 1] = fb / (lbar * lbar);
     m->seg_cb[3 * t + 2] = ft / (lbar * lbar);
     // lamina normal into the segment frame
-    vd_vec3 ln = q_rotate(q_conj(m->seg_quat0[t]), b->seg[t].leafn);
+    vd_vec3 ln = vd_quat_rotate(vd_quat_conj(m->seg_quat0[t]), b->seg[t].leafn);
     m->seg_leaf_normal[3 * t] = ln.x, m->seg_leaf_normal[3 * t + 1] = ln.y, m->seg_leaf_normal[3 * t + 2] = ln.z;
   }
 #undef JUNCTION_DOWN
@@ -1011,7 +1011,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     if (b->rod_of[i] >= 0) continue;
     m->bind_node_seg[i] = t;
     vd_vec3 off = vd_sub(pnode(p, i), m->node_pos0[m->seg_node[2 * t]]);
-    m->bind_node_local[i] = q_rotate(q_conj(m->seg_quat0[t]), off);
+    m->bind_node_local[i] = vd_quat_rotate(vd_quat_conj(m->seg_quat0[t]), off);
   }
   for (int j = 0; j < p->nseg; j++) {
     int t = b->pseg_rod[j];
@@ -1019,7 +1019,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     if (t < 0) continue;
     const double* pq = p->seg_quat0 + 4 * j;
     vd_quat qp = {pq[0], pq[1], pq[2], pq[3]};
-    m->bind_seg_local[j] = q_mul(q_conj(m->seg_quat0[t]), qp);
+    m->bind_seg_local[j] = vd_quat_mul(vd_quat_conj(m->seg_quat0[t]), qp);
   }
   for (int k = 0; k < p->nsphere; k++) m->bind_sphere_node[k] = b->sph_node[k], m->bind_sphere_seg[k] = b->sph_seg[k];
   for (int v = 0; v < p->nvert; v++) {
@@ -1027,7 +1027,7 @@ static vd_status pack(bld* b, vd_sim_model** out) {
     m->bind_vert_seg[v] = t;
     if (t < 0) continue;
     vd_vec3 x = vd_v3(p->vert_pos0[3 * v], p->vert_pos0[3 * v + 1], p->vert_pos0[3 * v + 2]);
-    m->bind_vert_local[v] = q_rotate(q_conj(m->seg_quat0[t]), vd_sub(x, m->node_pos0[m->seg_node[2 * t]]));
+    m->bind_vert_local[v] = vd_quat_rotate(vd_quat_conj(m->seg_quat0[t]), vd_sub(x, m->node_pos0[m->seg_node[2 * t]]));
   }
   *out = m;
   return VD_OK;
@@ -1070,7 +1070,7 @@ static void hold_outside(vd_sim_model* m, const vd_sim_def* def) {
       vd_vec3 x = m->node_pos0[m->seg_node[2 * t + e]];
       double u = l2 > 0 ? vd_dot(vd_sub(x, a), ab) / l2 : 0;
       u = u < 0 ? 0 : u > 1 ? 1 : u;
-      inside |= v_norm(vd_sub(x, vd_madd(a, ab, u))) <= r;
+      inside |= vd_norm(vd_sub(x, vd_madd(a, ab, u))) <= r;
     }
     if (inside) continue;
     m->seg_flags[t] |= VD_SIM_FIXED | VD_SIM_HELD;

@@ -49,7 +49,7 @@ void sim_bend_strain(vd_sim_bend kind, vd_quat qr, vd_quat q0, double lbar, doub
     return;
   }
   // the turn away from rest, qd = conj(q0) q (its w = q0 . q >= 0: at most 180 degrees)
-  vd_quat qd = q_mul(q_conj(q0), q);
+  vd_quat qd = vd_quat_mul(vd_quat_conj(q0), q);
   vd_vec3 ph = quat_log(qd);
   double f = 1.0 / lbar;
   c[0] = f * ph.x, c[1] = f * ph.y, c[2] = f * ph.z;
@@ -92,7 +92,7 @@ void sim_joint_eval(const vd_sim_model* m, const vd_sim_data* d, int t, sim_join
   }
   j->bend = 1;
   vd_quat qp = d->seg_quat[p];
-  vd_quat qr = q_mul(q_conj(qp), d->seg_quat[t]);
+  vd_quat qr = vd_quat_mul(vd_quat_conj(qp), d->seg_quat[t]);
   // G = dC_b/dpsi R_p^T
   double dc[9], rp[9];
   sim_bend_strain(m->bend_measure, qr, m->seg_rest[t], m->seg_lbar[t], j->c + 3, dc);
@@ -115,6 +115,6 @@ void sim_joint_values(const vd_sim_model* m, const vd_sim_data* d, int t, double
     c[3] = c[4] = c[5] = 0;
     return;
   }
-  vd_quat qr = q_mul(q_conj(d->seg_quat[p]), d->seg_quat[t]);
+  vd_quat qr = vd_quat_mul(vd_quat_conj(d->seg_quat[p]), d->seg_quat[t]);
   sim_bend_strain(m->bend_measure, qr, m->seg_rest[t], m->seg_lbar[t], c + 3, NULL);
 }

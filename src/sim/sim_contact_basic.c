@@ -10,27 +10,27 @@ double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* norma
   vd_vec3 v = vd_sub(p, k->pos);
   switch (k->shape) {
     case VD_SIM_PLANE: {
-      vd_vec3 n = q_rotate(k->quat, vd_v3(0, 0, 1));
+      vd_vec3 n = vd_quat_rotate(k->quat, vd_v3(0, 0, 1));
       *normal = n;
       return vd_dot(n, v);
     }
     case VD_SIM_SPHERE: {
-      double r = v_norm(v);
+      double r = vd_norm(v);
       *normal = r > 1e-15 ? vd_scale(v, 1.0 / r) : vd_v3(0, 0, 1);
       return r - k->size[0];
     }
     case VD_SIM_CAPSULE: {
-      vd_vec3 a = q_rotate(k->quat, vd_v3(0, 0, 1));
+      vd_vec3 a = vd_quat_rotate(k->quat, vd_v3(0, 0, 1));
       double s = vd_dot(v, a), hl = k->size[1];
       s = s < -hl ? -hl : s > hl ? hl : s;
       vd_vec3 w = vd_madd(v, a, -s);
-      double r = v_norm(w);
-      *normal = r > 1e-15 ? vd_scale(w, 1.0 / r) : q_rotate(k->quat, vd_v3(1, 0, 0));
+      double r = vd_norm(w);
+      *normal = r > 1e-15 ? vd_scale(w, 1.0 / r) : vd_quat_rotate(k->quat, vd_v3(1, 0, 0));
       return r - k->size[0];
     }
     case VD_SIM_BOX: {
       // box signed distance in the box frame, gradient back to world
-      vd_vec3 l = q_rotate(q_conj(k->quat), v);
+      vd_vec3 l = vd_quat_rotate(vd_quat_conj(k->quat), v);
       double q[3] = {fabs(l.x) - k->size[0], fabs(l.y) - k->size[1], fabs(l.z) - k->size[2]};
       double sg[3] = {l.x < 0 ? -1.0 : 1.0, l.y < 0 ? -1.0 : 1.0, l.z < 0 ? -1.0 : 1.0};
       double out2 = 0, inside = q[0];
@@ -51,16 +51,16 @@ double sim_collider_distance(const vd_sim_collider* k, vd_vec3 p, vd_vec3* norma
         e[imax] = sg[imax];
         g = vd_v3(e[0], e[1], e[2]);
       }
-      *normal = q_rotate(k->quat, g);
+      *normal = vd_quat_rotate(k->quat, g);
       return dist;
     }
     case VD_SIM_MESH: {
       // the collide module's grid in the mesh frame: interpolated distance and its gradient
       if (!k->sdf) break;
       vd_vec3 g;
-      double dist = vd_sdf_eval(k->sdf, q_rotate(q_conj(k->quat), v), &g);
-      double gn = v_norm(g);
-      *normal = gn > 1e-15 ? q_rotate(k->quat, vd_scale(g, 1.0 / gn)) : vd_v3(0, 0, 1);
+      double dist = vd_sdf_eval(k->sdf, vd_quat_rotate(vd_quat_conj(k->quat), v), &g);
+      double gn = vd_norm(g);
+      *normal = gn > 1e-15 ? vd_quat_rotate(k->quat, vd_scale(g, 1.0 / gn)) : vd_v3(0, 0, 1);
       return dist;
     }
   }
@@ -105,7 +105,7 @@ static double seg_param(const vd_sim_collider* k, vd_vec3 a, vd_vec3 b) {
   switch (k->shape) {
     case VD_SIM_SPHERE: return closest_t(a, b, k->pos);
     case VD_SIM_CAPSULE: {
-      vd_vec3 ax = q_rotate(k->quat, vd_v3(0, 0, k->size[1]));
+      vd_vec3 ax = vd_quat_rotate(k->quat, vd_v3(0, 0, k->size[1]));
       return closest_t_seg(a, b, vd_sub(k->pos, ax), vd_add(k->pos, ax));
     }
     case VD_SIM_MESH: {
@@ -202,7 +202,7 @@ int sim_contacts_find(const vd_sim_model* m, vd_sim_data* d, double margin, sim_
     if (col->shape == VD_SIM_PLANE) {
       // every moving node with the rod's reach towards the plane; a node higher than its
       // largest radius plus the margin cannot touch, and needs no reach
-      vd_vec3 pn = q_rotate(col->quat, vd_v3(0, 0, 1));
+      vd_vec3 pn = vd_quat_rotate(col->quat, vd_v3(0, 0, 1));
       const sim_work* w = (const sim_work*)d->work;
       int any = 0;
       for (int i = 0; i < m->nnode_all; i++) {
@@ -295,7 +295,7 @@ double sim_contact_gap(const vd_sim_model* m, const vd_sim_data* d, sim_contact*
   vd_vec3 nrm;
   if (c->collider >= 0) return sim_collider_distance(&d->collider[c->collider], q.p, &nrm) - c->radius;
   cpoint q2 = element_point(m, d, c->node2, c->seg2, c->t2);
-  return v_norm(vd_sub(q.p, q2.p)) - c->radius - c->radius2;
+  return vd_norm(vd_sub(q.p, q2.p)) - c->radius - c->radius2;
 }
 
 // move the contact point by dp, sharing the motion by inverse mass; returns the mass-weighted
@@ -336,7 +336,7 @@ void sim_contacts_project(const vd_sim_model* m, vd_sim_data* d, sim_contact* c,
     // self-contact: push the two elements apart along the line between them, by inverse mass
     cpoint q2 = element_point(m, d, c[i].node2, c[i].seg2, c[i].t2);
     vd_vec3 dp = vd_sub(q.p, q2.p);
-    double dist = v_norm(dp), s = dist - c[i].radius - c[i].radius2, w = q.w + q2.w;
+    double dist = vd_norm(dp), s = dist - c[i].radius - c[i].radius2, w = q.w + q2.w;
     if (s >= 0 || w <= 0 || dist < 1e-15) continue;
     nrm = vd_scale(dp, 1.0 / dist);
     move_point(d, &q, vd_scale(nrm, -s * q.w / w));
@@ -359,7 +359,7 @@ void sim_contacts_friction(const vd_sim_model* m, vd_sim_data* d, sim_contact* c
     vd_vec3 p0 = vd_add(vd_scale(w->node_prev[q.na], q.ca), vd_scale(w->node_prev[q.nb], q.cb));
     vd_vec3 dp = vd_sub(vd_sub(q.p, p0), vd_scale(col->vel, h));
     vd_vec3 dt = vd_madd(dp, nrm, -vd_dot(dp, nrm));
-    double lt = v_norm(dt), lim = mu * c[i].lambda;
+    double lt = vd_norm(dt), lim = mu * c[i].lambda;
     if (lt <= 0) continue;
     // static friction cancels the slip; kinetic friction removes mu times the normal push
     double k = lt <= lim ? 1.0 : lim / lt;

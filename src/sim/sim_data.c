@@ -240,7 +240,7 @@ double vd_sim_kinetic_energy(const vd_sim_model* m, const vd_sim_data* d) {
     if (sim_node_moves(m, d, i)) e += 0.5 * d->node_mass[i] * vd_dot(d->node_vel[i], d->node_vel[i]);
   for (int t = 0; t < m->nseg; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
-    vd_vec3 w = q_rotate(q_conj(d->seg_quat[t]), d->seg_omega[t]);
+    vd_vec3 w = vd_quat_rotate(vd_quat_conj(d->seg_quat[t]), d->seg_omega[t]);
     double ib = m->seg_inertia[2 * t], it = m->seg_inertia[2 * t + 1];
     e += 0.5 * (ib * (w.x * w.x + w.y * w.y) + it * w.z * w.z);
   }
@@ -251,7 +251,7 @@ double vd_sim_max_displacement(const vd_sim_model* m, const vd_sim_data* d, int*
   double best = 0;
   int bi = -1;
   for (int i = 0; i < m->nnode; i++) {
-    double l = v_norm(vd_sub(d->node_pos[i], m->node_pos0[i]));
+    double l = vd_norm(vd_sub(d->node_pos[i], m->node_pos0[i]));
     if (l > best) best = l, bi = i;
   }
   if (node) *node = bi;
@@ -266,7 +266,7 @@ static vd_vec3 bound_point(const vd_sim_model* m, const vd_sim_data* d, int t, v
   int a = m->seg_node[2 * t];
   // after a break the segment hangs from its spare; the offset stays relative to the frame
   vd_vec3 base = d->node_pos[d->seg_start[t] >= 0 ? d->seg_start[t] : a];
-  return vd_add(base, q_rotate(d->seg_quat[t], local));
+  return vd_add(base, vd_quat_rotate(d->seg_quat[t], local));
 }
 
 static vd_vec3 plant_node_pos(const vd_sim_model* m, const vd_sim_data* d, int i, vd_vec3 rest) {
@@ -277,7 +277,7 @@ static vd_vec3 plant_node_pos(const vd_sim_model* m, const vd_sim_data* d, int i
 
 static vd_quat plant_seg_quat(const vd_sim_model* m, const vd_sim_data* d, int j, vd_quat rest) {
   int t = m->bind_seg_seg[j];
-  return t >= 0 ? q_normalize(q_mul(d->seg_quat[t], m->bind_seg_local[j])) : rest;
+  return t >= 0 ? q_normalize(vd_quat_mul(d->seg_quat[t], m->bind_seg_local[j])) : rest;
 }
 
 void vd_sim_to_plant(const vd_sim_model* m, const vd_sim_data* d, const vd_model* plant, vd_data* out) {
@@ -315,8 +315,8 @@ vd_status vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_s
     int t = m->bind_seg_seg[j];
     if (t < 0) continue;
     // the section's up vector turns with the rod segment
-    vd_quat rot = q_mul(d->seg_quat[t], q_conj(m->seg_quat0[t]));
-    spec->seg[j].up = q_rotate(rot, spec->seg[j].up);
+    vd_quat rot = vd_quat_mul(d->seg_quat[t], vd_quat_conj(m->seg_quat0[t]));
+    spec->seg[j].up = vd_quat_rotate(rot, spec->seg[j].up);
   }
   for (int k = 0; k < spec->nsphere; k++)
     if (m->bind_sphere_node[k] >= 0) spec->sphere[k].center = d->node_pos[m->bind_sphere_node[k]];

@@ -331,7 +331,7 @@ SIM_CLONES int sim_seg_drag_lanes(const vd_sim_model* m, const vd_sim_data* d, s
     L {
       double qw = qs[4 * l], qx = qs[4 * l + 1], qy = qs[4 * l + 2], qz = qs[4 * l + 3];
       d3[0][l] = 2 * (qx * qz + qw * qy), d3[1][l] = 2 * (qy * qz - qw * qx), d3[2][l] = 1 - 2 * (qx * qx + qy * qy);
-      // the lamina normal rotated into the world: q_rotate's operations
+      // the lamina normal rotated into the world: vd_quat_rotate's operations
       double vx = ln[3 * (b + l)], vy = ln[3 * (b + l) + 1], vz = ln[3 * (b + l) + 2];
       leaf[l] = vx != 0 || vy != 0 || vz != 0 ? 1.0 : 0.0;
       double tx = (qy * vz - qz * vy) * 2.0, ty = (qz * vx - qx * vz) * 2.0, tz = (qx * vy - qy * vx) * 2.0;

@@ -47,7 +47,7 @@ static void node_loads(void* p, int k, int i0, int i1) {
     vd_vec3 u = vd_sub(c->wind, d->node_vel[n]);
     int o2 = m->node_owner[n];
     double cd = o2 >= 0 ? m->seg_cd[o2] : 0.47, r = m->node_sphere[n];
-    double kq = c->q * cd * VD_PI * r * r * v_norm(u);
+    double kq = c->q * cd * VD_PI * r * r * vd_norm(u);
     w->node_fext[n] = vd_madd(w->node_fext[n], u, kq);
     w->node_drag[n] += 2 * kq;
   }
@@ -65,14 +65,14 @@ void sim_seg_drag_one(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, 
   vd_vec3 d3 = quat_d3(qt);
   vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
   double area = 2 * m->seg_radius[t] * m->seg_len0[t];
-  double kq = q * m->seg_cd[t] * area * v_norm(up);
+  double kq = q * m->seg_cd[t] * area * vd_norm(up);
   vd_vec3 f = vd_scale(up, kq);
   // damping of F = k |u| u: dF/du has eigenvalues k |u| and 2 k |u|; the larger is taken
   double cc = 2 * kq;
   const double* ln = m->seg_leaf_normal + 3 * t;
   if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
-    vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
-    double a = v_norm(nw);
+    vd_vec3 nw = vd_quat_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
+    double a = vd_norm(nw);
     double un = vd_dot(u, nw) / a;
     f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
     cc += 2 * q * m->leaf_cd * a * fabs(un);

@@ -50,7 +50,7 @@ static int node_piece(const vd_sim_model* m, const pieces* p, int i) {
 static vd_vec3 node_rest(const vd_sim_model* m, int i, vd_vec3 fallback) {
   if (m->bind_node_ref[i] >= 0) return m->node_pos0[m->bind_node_ref[i]];
   int t = m->bind_node_seg[i];
-  if (t >= 0) return vd_add(m->node_pos0[m->seg_node[2 * t]], q_rotate(m->seg_quat0[t], m->bind_node_local[i]));
+  if (t >= 0) return vd_add(m->node_pos0[m->seg_node[2 * t]], vd_quat_rotate(m->seg_quat0[t], m->bind_node_local[i]));
   return fallback;
 }
 

@@ -58,19 +58,19 @@ int sim_sagfree(vd_sim_model* m, vd_vec3 g) {
   for (int t = 0; t < ns; t++) {
     if (m->seg_flags[t] & VD_SIM_FIXED) continue;
     vd_vec3 e = vd_sub(m->node_pos0[m->seg_node[2 * t + 1]], m->node_pos0[m->seg_node[2 * t]]);
-    double le = v_norm(e);
+    double le = vd_norm(e);
     vd_quat q0 = m->seg_quat0[t];  // d3 along e
     vd_quat q = q0;
     double l0 = m->seg_len0[t];
     double kin[3] = {1.0 / (m->seg_cs[3 * t] * l0), 1.0 / (m->seg_cs[3 * t + 1] * l0), 1.0 / (m->seg_cs[3 * t + 2] * l0)};
     for (int it = 0; it < 4; it++) {
       // mu_s = l0 R^T F; target C_s = -mu_s / (l0 K) = -R^T F / K
-      vd_vec3 fl = q_rotate(q_conj(q), f[t]);
+      vd_vec3 fl = vd_quat_rotate(vd_quat_conj(q), f[t]);
       vd_vec3 c = vd_v3(-fl.x / kin[0], -fl.y / kin[1], -fl.z / kin[2]);
       vd_vec3 u = vd_v3(c.x, c.y, 1 + c.z);
-      double lu = v_norm(u);
+      double lu = vd_norm(u);
       l0 = le / lu;
-      q = q_normalize(q_mul(q0, quat_between(vd_scale(u, 1.0 / lu), vd_v3(0, 0, 1))));
+      q = q_normalize(vd_quat_mul(q0, quat_between(vd_scale(u, 1.0 / lu), vd_v3(0, 0, 1))));
     }
     m->seg_len0[t] = l0;
     for (int k = 0; k < 3; k++) m->seg_cs[3 * t + k] = 1.0 / (kin[k] * l0);
@@ -81,7 +81,7 @@ int sim_sagfree(vd_sim_model* m, vd_vec3 g) {
     int p = m->seg_parent[t];
     if ((m->seg_flags[t] & VD_SIM_FIXED) || p < 0) continue;
     vd_quat qp = m->seg_quat0[p];
-    vd_quat qr = q_mul(q_conj(qp), m->seg_quat0[t]);
+    vd_quat qr = vd_quat_mul(vd_quat_conj(qp), m->seg_quat0[t]);
     if (qr.w < 0) qr.w = -qr.w, qr.x = -qr.x, qr.y = -qr.y, qr.z = -qr.z;
     double lbar = m->seg_lbar[t], rp[9];
     m3_from_quat(rp, qp);
@@ -106,7 +106,7 @@ int sim_sagfree(vd_sim_model* m, vd_vec3 g) {
       if (!log) {
         // C_b = (2 / l-bar)(Im q_rel - Im q_rel0)  =>  Im q_rel0 = Im q_rel - (l-bar / 2) C_b
         vd_vec3 v0 = vd_madd(quat_im(qr), cb, -0.5 * lbar);
-        double sn = v_norm(v0);
+        double sn = vd_norm(v0);
         if (sn > 0.999) v0 = vd_scale(v0, 0.999 / sn), sn = 0.999, out = 1;
         r0 = (vd_quat){sqrt(1 - sn * sn), v0.x, v0.y, v0.z};
         break;
@@ -114,11 +114,11 @@ int sim_sagfree(vd_sim_model* m, vd_vec3 g) {
       // C_b = log(conj(q_rel0) q_rel) / l-bar  =>  q_rel0 = q_rel exp(l-bar C_b)^-1; a turn of
       // 180 degrees or more is out of reach
       vd_vec3 ph = vd_scale(cb, lbar);
-      double an = v_norm(ph);
+      double an = vd_norm(ph);
       out = an > 0.999 * VD_PI;
       if (out) ph = vd_scale(ph, 0.999 * VD_PI / an);
-      r0 = q_normalize(q_mul(qr, q_conj(quat_exp(ph))));
-      double dd = v_norm(vd_sub(ph, prev));
+      r0 = q_normalize(vd_quat_mul(qr, vd_quat_conj(quat_exp(ph))));
+      double dd = vd_norm(vd_sub(ph, prev));
       prev = ph;
       if (dd <= 1e-15 * (1 + an)) break;
     }

@@ -65,7 +65,7 @@ void vd_sim_soil_update(const vd_sim_model* m, vd_sim_data* d, vd_sim_soil* s) {
   for (int k = 0; k < s->n; k++) {
     vd_sim_tie* t = &d->tie[s->tie[k]];
     vd_vec3 x = d->node_pos[t->node], e = vd_sub(x, t->target);
-    double f = v_norm(e) / t->compliance;
+    double f = vd_norm(e) / t->compliance;
     if (!(f > s->fmax[k])) continue;
     // slip: the anchor follows the node until the tie pulls with the node's resistance
     t->target = vd_sub(x, vd_scale(e, s->fmax[k] / f));

@@ -201,7 +201,7 @@ static int cannot_break(const vd_sim_model* m, const vd_sim_data* d, int t, doub
   if (!(fs <= thr[0]) || !(mb <= thr[1])) return 0;
   if (isfinite(thr[2])) {
     vd_vec3 e = vd_sub(d->node_pos[m->seg_node[2 * t + 1]], d->node_pos[d->seg_start[t]]);
-    if (!((v_norm(e) / l0 + 1) * slack <= thr[2])) return 0;
+    if (!((vd_norm(e) / l0 + 1) * slack <= thr[2])) return 0;
   }
   return !isfinite(thr[3]) || 4 / lbar * slack <= thr[3];
 }
@@ -219,8 +219,8 @@ static void check_fracture(const vd_sim_model* m, vd_sim_data* d, double h) {
     // constraint force and moment: the generalised forces J^T lambda / h^2
     vd_vec3 ms = vd_v3(lam[0] / h2, lam[1] / h2, lam[2] / h2);
     vd_vec3 mb = vd_v3(lam[3] / h2, lam[4] / h2, lam[5] / h2);
-    double force = v_norm(m3_tmul_v(j.a, ms));
-    double moment = j.bend ? v_norm(m3_tmul_v(j.g, mb)) : 0.0;
+    double force = vd_norm(m3_tmul_v(j.a, ms));
+    double moment = j.bend ? vd_norm(m3_tmul_v(j.g, mb)) : 0.0;
     double cs = sqrt(j.c[0] * j.c[0] + j.c[1] * j.c[1] + j.c[2] * j.c[2]);
     double cb = sqrt(j.c[3] * j.c[3] + j.c[4] * j.c[4] + j.c[5] * j.c[5]);
     int cause = force > thr[0] ? 0 : moment > thr[1] ? 1 : cs > thr[2] ? 2 : cb > thr[3] ? 3 : -1;
@@ -261,7 +261,7 @@ static double torque_work(const vd_sim_model* m, const vd_sim_data* d, const sim
   double e = 0;
   for (int t = 0; t < m->nseg; t++)
     if (!(m->seg_flags[t] & VD_SIM_FIXED))
-      e += vd_dot(w->seg_text[t], quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t]))));
+      e += vd_dot(w->seg_text[t], quat_log(vd_quat_mul(d->seg_quat[t], vd_quat_conj(w->seg_prev[t]))));
   return e;
 }
 
@@ -489,11 +489,11 @@ vd_status vd_sim_settle(const vd_sim_model* m, vd_sim_data* d, const vd_sim_sett
       // largest move of a node, or of a segment end by its rotation
       double mv = fail ? INFINITY : 0;
       for (int i = 0; !fail && i < m->nnode_all; i++) {
-        double l = v_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
+        double l = vd_norm(vd_sub(d->node_pos[i], w->node_prev[i]));
         if (l > mv) mv = l;
       }
       for (int t = 0; !fail && t < m->nseg; t++) {
-        double l = v_norm(quat_log(q_mul(d->seg_quat[t], q_conj(w->seg_prev[t])))) * m->seg_len0[t];
+        double l = vd_norm(quat_log(vd_quat_mul(d->seg_quat[t], vd_quat_conj(w->seg_prev[t])))) * m->seg_len0[t];
         if (l > mv) mv = l;
       }
       double hp = c.h, hn;

@@ -103,28 +103,11 @@ static void built_free(built* b) {
 static vd_status build_rod(const rod* rd, built* out, vd_error* err) {
   memset(out, 0, sizeof *out);
   double l = rd->len / rd->n;
-  vd_plant_spec* s = vd_plant_spec_create();
-  if (!s) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
-  vd_vec3 up = fabs(rd->dir.z) < 0.9 ? vd_v3(0, 0, 1) : vd_v3(1, 0, 0);
-  int a = vd_plant_add_node(s, vd_scale(rd->dir, -l));
-  int b = vd_plant_add_node(s, vd_v3(0, 0, 0));
-  int c = vd_plant_add_node(s, vd_scale(rd->dir, rd->len));
-  vd_segment_spec g = vd_segment_spec_default();
-  g.node0 = a, g.node1 = b, g.r0 = g.r1 = rd->r, g.label = 1, g.instance = 1, g.up = up;
-  int s0 = vd_plant_add_segment(s, &g);
-  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
-  vd_plant_add_segment(s, &g);
-  vd_status st = vd_plant_set_label(s, 1, "stem");
-  double rs = 0;
-  if (!st && rd->tip_mass > 0) {
-    vd_sphere_spec f = vd_sphere_spec_default();
-    rs = 0.01;
-    f.center = vd_scale(rd->dir, rd->len), f.radius = rs, f.node = c, f.parent = 1, f.label = 2, f.instance = 3;
-    vd_plant_add_sphere(s, &f);
-    st = vd_plant_set_label(s, 2, "fruit");
-  }
-  if (!st) st = vd_plant_compile(s, &out->pm, err);
-  vd_plant_spec_destroy(s);
+  vd_beam_def bd = vd_beam_def_default();
+  bd.dir = rd->dir, bd.length = rd->len, bd.radius = rd->r, bd.clamp = l;
+  double rs = rd->tip_mass > 0 ? 0.01 : 0;
+  bd.fruit_radius = rs;
+  vd_status st = vd_plant_beam_model(&bd, &out->pm, err);
   if (st) return st;
   vd_sim_def def = vd_sim_def_default();
   def.segment_length = l;
@@ -560,7 +543,7 @@ static void case_end_moment(vctx* v) {
     check(v, nc, "discrete", "tip distance to reference (m)", dd, 0, 1e-6 * rd.len, 1,
           "N = %d, M = 2 pi EI/L; joint moments %s/flexibility%s", n, quat_measure() ? "sin(theta)" : "theta",
           ok && pr.ok ? "" : " [not converged]");
-    check(v, nc, "continuum", "tip distance from root / L", v_norm(tip) / rd.len, 0, 1.0 / n, 1,
+    check(v, nc, "continuum", "tip distance from root / L", vd_norm(tip) / rd.len, 0, 1.0 / n, 1,
           "a full circle brings the tip back to the root; tolerance 1/N (end half segment%s)",
           quat_measure() ? ", sin law" : "");
     built_free(&b);
@@ -608,7 +591,7 @@ static void case_torsion(vctx* v) {
   int ok;
   vd_vec3 tip = rod_statics(&b, vd_v3(0, 0, 0), vd_v3(t, 0, 0), 0, 0, 1, &ok);
   int ts = b.m->node_owner[tip_node(&b)];
-  vd_vec3 rot = quat_log(q_mul(b.d->seg_quat[ts], q_conj(b.m->seg_quat0[ts])));
+  vd_vec3 rot = quat_log(vd_quat_mul(b.d->seg_quat[ts], vd_quat_conj(b.m->seg_quat0[ts])));
   double* flex = vd_malloc((size_t)n * sizeof(double));
   if (!flex) {
     built_free(&b);
@@ -861,23 +844,10 @@ static void case_greenhill(vctx* v) {
 // a pedicel-like rod with a fruit hanging off its end by a breakable calyx joint
 static vd_status build_fruit_rod(double fbreak, built* out, vd_error* err) {
   memset(out, 0, sizeof *out);
-  vd_plant_spec* s = vd_plant_spec_create();
-  if (!s) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
   double len = 0.1, l = len / 10, rs = 0.012;
-  int a = vd_plant_add_node(s, vd_v3(-l, 0, 0)), b = vd_plant_add_node(s, vd_v3(0, 0, 0));
-  int c = vd_plant_add_node(s, vd_v3(len, 0, 0));
-  vd_segment_spec g = vd_segment_spec_default();
-  g.node0 = a, g.node1 = b, g.r0 = g.r1 = 0.001, g.label = 1, g.instance = 1, g.up = vd_v3(0, 0, 1);
-  int s0 = vd_plant_add_segment(s, &g);
-  g.node0 = b, g.node1 = c, g.parent = s0, g.instance = 2;
-  int s1 = vd_plant_add_segment(s, &g);
-  vd_sphere_spec f = vd_sphere_spec_default();
-  f.center = vd_v3(len + rs, 0, 0), f.radius = rs, f.parent = s1, f.label = 2, f.instance = 3;
-  vd_plant_add_sphere(s, &f);
-  vd_status st = vd_plant_set_label(s, 1, "stem");
-  if (!st) st = vd_plant_set_label(s, 2, "fruit");
-  if (!st) st = vd_plant_compile(s, &out->pm, err);
-  vd_plant_spec_destroy(s);
+  vd_beam_def bd = vd_beam_def_default();
+  bd.length = len, bd.clamp = l, bd.fruit_radius = rs, bd.fruit_offset = rs, bd.fruit_on_node = 0;
+  vd_status st = vd_plant_beam_model(&bd, &out->pm, err);
   if (st) return st;
   vd_sim_def def = vd_sim_def_default();
   def.segment_length = l;
@@ -1020,7 +990,7 @@ static void case_contacts(vctx* v) {
 static double seg_seg_dist(vd_vec3 a, vd_vec3 b, vd_vec3 c, vd_vec3 dd) {
   vd_vec3 d1 = vd_sub(b, a), d2 = vd_sub(dd, c), r = vd_sub(a, c);
   double aa = vd_dot(d1, d1), e = vd_dot(d2, d2), f = vd_dot(d2, r), s = 0, t = 0;
-  if (aa <= 1e-30 && e <= 1e-30) return v_norm(r);
+  if (aa <= 1e-30 && e <= 1e-30) return vd_norm(r);
   if (aa <= 1e-30) {
     t = f / e;
   } else {
@@ -1038,7 +1008,7 @@ static double seg_seg_dist(vd_vec3 a, vd_vec3 b, vd_vec3 c, vd_vec3 dd) {
   }
   s = s < 0 ? 0 : s > 1 ? 1 : s;
   t = t < 0 ? 0 : t > 1 ? 1 : t;
-  return v_norm(vd_sub(vd_madd(a, d1, s), vd_madd(c, d2, t)));
+  return vd_norm(vd_sub(vd_madd(a, d1, s), vd_madd(c, d2, t)));
 }
 
 // two crossing cantilevers, the upper one pushed down through the lower one; the deepest
@@ -1090,7 +1060,7 @@ static double crossing_rods(vctx* v, int self, int* ncontact_max) {
   int push = -1;
   double best = 1e300;
   for (int i = 0; i < m->nnode; i++) {
-    double e = v_norm(vd_sub(m->node_pos0[i], vd_v3(l / 2, 0, z)));
+    double e = vd_norm(vd_sub(m->node_pos0[i], vd_v3(l / 2, 0, z)));
     if (e < best) best = e, push = i;
   }
   double deepest = 0;
