@@ -21,7 +21,7 @@
 // vector, curve) as a NaN-boxed handle into the lsystem's object table. The table is swept
 // after each step (objects no module refers to are released) and emptied when a derivation
 // starts, so handles of an older derivation's string are stale (they read back as None).
-#include "lsys/lsys_py.h"  // Python.h first: it sets the feature macros
+#include "lsys/py/lsys_py.h"  // Python.h first: it sets the feature macros
 
 #include <limits.h>
 #include <math.h>
@@ -31,7 +31,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "lsys_shim.h"  // generated from lsys_shim.py: lsys_shim_py[]
+#include "lpyshim.h"  // generated from the package lpyshim: lpyshim_files[]
 
 #ifndef VD_PYTHON_HOME
 #define VD_PYTHON_HOME "/usr"
@@ -128,37 +128,79 @@ static void start_watchdog(void) {
   pthread_attr_destroy(&a);
 }
 
-// read the shim (embedded Python source) into a private module and build the base namespace
-static int load_shim(void) {
-  PyObject* mod = vd_module_create();
-  if (!mod) return 0;
-  PyObject* ns = PyDict_New();
-  if (!ns) {
-    Py_DECREF(mod);
-    return 0;
+// The shim: the package lpyshim (embedded Python sources) as the private package
+// _verdant_lpyshim. __init__ runs first; its __all__ lists the modules in the order they run,
+// each registered in sys.modules so that their relative imports find each other; `_vd` (the C
+// module) is there before them. The last, engine, holds what the C side calls.
+#define SHIM_PKG "_verdant_lpyshim"
+
+static const char* shim_source(const char* module) {
+  for (int i = 0; i < lpyshim_files_count; i++)
+    if (!strcmp(lpyshim_files[i].module, module)) return lpyshim_files[i].source;
+  return NULL;
+}
+
+// run the shim's module `module` (a name of lpyshim_files) as `qualname`; a new reference
+static PyObject* shim_module(const char* qualname, const char* module) {
+  const char* src = shim_source(module);
+  if (!src) return PyErr_Format(PyExc_ImportError, "the shim has no module %s", module);
+  PyObject* m = PyModule_New(qualname);
+  PyObject* d = m ? PyModule_GetDict(m) : NULL;  // borrowed
+  PyObject* pkg = PyUnicode_FromString(SHIM_PKG);
+  char fname[96];
+  snprintf(fname, sizeof fname, "<verdant lpyshim/%s.py>", module);
+  int bad = !d || !pkg || PyDict_SetItemString(d, "__builtins__", PyEval_GetBuiltins()) ||
+            PyDict_SetItemString(d, "__package__", pkg) || PyDict_SetItemString(PyImport_GetModuleDict(), qualname, m);
+  Py_XDECREF(pkg);
+  if (bad) {
+    Py_XDECREF(m);
+    return NULL;
   }
-  PyDict_SetItemString(ns, "__builtins__", PyEval_GetBuiltins());
-  PyDict_SetItemString(ns, "__name__", PyUnicode_FromString("verdant_lsys_shim"));
-  PyDict_SetItemString(ns, "_vd", mod);
-  Py_DECREF(mod);
-  PyObject* code = Py_CompileString(lsys_shim_py, "<verdant lsys_shim.py>", Py_file_input);
-  PyObject* r = code ? PyEval_EvalCode(code, ns, ns) : NULL;
+  PyObject* code = Py_CompileString(src, fname, Py_file_input);
+  PyObject* r = code ? PyEval_EvalCode(code, d, d) : NULL;
   Py_XDECREF(code);
   if (!r) {
-    Py_DECREF(ns);
-    return 0;
+    Py_DECREF(m);
+    return NULL;
   }
   Py_DECREF(r);
-  PyObject* base = PyDict_GetItemString(ns, "BASE");  // borrowed
-  if (!base || !PyDict_Check(base)) {
-    PyErr_SetString(PyExc_RuntimeError, "the shim defines no BASE namespace");
-    Py_DECREF(ns);
-    return 0;
+  return m;
+}
+
+// load the shim's package and keep the engine module's namespace and its BASE namespace
+static int load_shim(void) {
+  PyObject* vd = vd_module_create();
+  PyObject* pkg = vd ? shim_module(SHIM_PKG, "__init__") : NULL;
+  PyObject* all = pkg ? PyObject_GetAttrString(pkg, "__all__") : NULL;
+  PyObject* path = PyList_New(0);
+  PyObject* eng = NULL;
+  int ok = all && PyList_Check(all) && path && !PyObject_SetAttrString(pkg, "__path__", path) &&
+           !PyDict_SetItemString(PyImport_GetModuleDict(), SHIM_PKG "._vd", vd) &&
+           !PyObject_SetAttrString(pkg, "_vd", vd);
+  Py_XDECREF(path);
+  for (Py_ssize_t i = 0; ok && i < PyList_GET_SIZE(all); i++) {
+    const char* name = PyUnicode_AsUTF8(PyList_GET_ITEM(all, i));
+    char qual[64];
+    snprintf(qual, sizeof qual, SHIM_PKG ".%s", name ? name : "");
+    PyObject* m = name ? shim_module(qual, name) : NULL;
+    ok = m && !PyObject_SetAttrString(pkg, name, m);
+    Py_XDECREF(eng);
+    eng = m;
   }
-  Py_INCREF(base);
-  g_base = base;
-  g_shim = ns;
-  return 1;
+  PyObject* ns = ok && eng ? PyModule_GetDict(eng) : NULL;  // borrowed: the last module's
+  PyObject* base = ns ? PyDict_GetItemString(ns, "BASE") : NULL;  // borrowed
+  if (ok && (!base || !PyDict_Check(base))) PyErr_SetString(PyExc_RuntimeError, "the shim defines no BASE namespace");
+  if (base && PyDict_Check(base)) {
+    Py_INCREF(base);
+    Py_INCREF(ns);
+    g_base = base;
+    g_shim = ns;
+  }
+  Py_XDECREF(eng);
+  Py_XDECREF(all);
+  Py_XDECREF(pkg);
+  Py_XDECREF(vd);
+  return g_shim != NULL;
 }
 
 static void shim_failed(void) {
@@ -288,7 +330,7 @@ void lsys_py_leave(vd_lsystem* ls) {
 static vd_status status_of(PyObject* type) {
   if (PyErr_GivenExceptionMatches(type, PyExc_SyntaxError)) return VD_ERR_SYNTAX;
   if (PyErr_GivenExceptionMatches(type, PyExc_NameError)) return VD_ERR_NAME;
-  // a PlantGL / L-Py name the shim does not have (lsys_shim.py _NotInShim): a refusal
+  // a PlantGL / L-Py name the shim does not have (lpyshim/engine.py _NotInShim): a refusal
   PyObject* nis = g_shim ? PyDict_GetItemString(g_shim, "_NotInShim") : NULL;  // borrowed
   if (nis && PyErr_GivenExceptionMatches(type, nis)) return VD_ERR_UNSUPPORTED;
   if (PyErr_GivenExceptionMatches(type, PyExc_AttributeError)) return VD_ERR_NAME;
