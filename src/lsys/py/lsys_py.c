@@ -140,17 +140,17 @@ static const char* shim_source(const char* module) {
   return NULL;
 }
 
-// run the shim's module `module` (a name of lpyshim_files) as `qualname`; a new reference
-static PyObject* shim_module(const char* qualname, const char* module) {
-  const char* src = shim_source(module);
-  if (!src) return PyErr_Format(PyExc_ImportError, "the shim has no module %s", module);
-  PyObject* m = PyModule_New(qualname);
+// run the shim's module `file` (a name of lpyshim_files) as the module `as`; a new reference
+static PyObject* shim_module(const char* as, const char* file) {
+  const char* src = shim_source(file);
+  if (!src) return PyErr_Format(PyExc_ImportError, "the shim has no module %s", file);
+  PyObject* m = PyModule_New(as);
   PyObject* d = m ? PyModule_GetDict(m) : NULL;  // borrowed
   PyObject* pkg = PyUnicode_FromString(SHIM_PKG);
   char fname[96];
-  snprintf(fname, sizeof fname, "<verdant lpyshim/%s.py>", module);
+  snprintf(fname, sizeof fname, "<verdant lpyshim/%s.py>", file);
   int bad = !d || !pkg || PyDict_SetItemString(d, "__builtins__", PyEval_GetBuiltins()) ||
-            PyDict_SetItemString(d, "__package__", pkg) || PyDict_SetItemString(PyImport_GetModuleDict(), qualname, m);
+            PyDict_SetItemString(d, "__package__", pkg) || PyDict_SetItemString(PyImport_GetModuleDict(), as, m);
   Py_XDECREF(pkg);
   if (bad) {
     Py_XDECREF(m);
@@ -180,9 +180,9 @@ static int load_shim(void) {
   Py_XDECREF(path);
   for (Py_ssize_t i = 0; ok && i < PyList_GET_SIZE(all); i++) {
     const char* name = PyUnicode_AsUTF8(PyList_GET_ITEM(all, i));
-    char qual[64];
-    snprintf(qual, sizeof qual, SHIM_PKG ".%s", name ? name : "");
-    PyObject* m = name ? shim_module(qual, name) : NULL;
+    char as[64];
+    snprintf(as, sizeof as, SHIM_PKG ".%s", name ? name : "");
+    PyObject* m = name ? shim_module(as, name) : NULL;
     ok = m && !PyObject_SetAttrString(pkg, name, m);
     Py_XDECREF(eng);
     eng = m;
