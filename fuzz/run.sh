@@ -29,7 +29,7 @@ newest_h=$(ls -t include/verdant/*.h src/*/*.h src/lsys/py/*.h fuzz/*.h "$OUT/ge
 objs=()
 jobs=$(nproc 2>/dev/null || echo 2)
 # (the robot module only for its scene parser: MuJoCo is not linked)
-for src in src/core/*.c src/plant/*.c src/lsys/*.c src/lsys/py/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/sim/*.c src/robot/robot_scene.c; do
+for src in src/core/*.c src/plant/*.c src/lsys/*.c src/lsys/py/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/phys/*.c src/sim/*.c src/mss/*.c src/robot/robot_scene.c; do
   obj="$OUT/obj/$(basename "${src%.c}").o"
   objs+=("$obj")
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$newest_h" -nt "$obj" ]; then

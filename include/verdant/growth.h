@@ -28,6 +28,7 @@
 
 #include "verdant/core.h"
 #include "verdant/lsys.h"
+#include "verdant/mss.h"
 #include "verdant/plant.h"
 #include "verdant/sim.h"
 

@@ -1,22 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Small dense linear algebra (3x3, 6x6 Cholesky) and quaternion maps for the rod solvers, and
-// the clock of the stage profile.
-#define _POSIX_C_SOURCE 199309L
-#include <time.h>
-
-#include "sim_internal.h"
-
-double sim_clock(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-const char* vd_sim_stage_name(vd_sim_stage s) {
-  static const char* names[VD_SIM_STAGE_COUNT] = {"forces", "predict", "contacts", "eval",    "factor",
-                                                  "solve",  "project", "velocity", "fracture"};
-  return s >= 0 && s < VD_SIM_STAGE_COUNT ? names[s] : "?";
-}
+// Small dense linear algebra (3x3, 6x6 Cholesky) and quaternion maps for both engines.
+#include "phys_internal.h"
 
 int m3_solve_spd(const double* a, vd_vec3 b, vd_vec3* x) {
   // Cholesky of the 3x3 matrix, then two triangular solves

@@ -15,7 +15,7 @@
 //
 // Each member is a point mass plus a small sphere of its node's radius (2/5 m r^2), so the
 // inertia of a straight trunk (points on a line) is never singular.
-#include "sim_mss_internal.h"
+#include "mss_internal.h"
 
 // ---------------------------------------------------------------------------------------------
 // the body alone

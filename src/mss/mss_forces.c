@@ -15,32 +15,7 @@
 // falls as 1/d^2). Gravitropism by the sine law (Dumais 2013) pushes every node but the buds
 // across its internode, upward, with gravi_k sin A (A the internode's angle to the vertical);
 // Bastien et al.'s AC model acts on the rest shape instead (sim_mss_stress.c).
-#include "sim_mss_internal.h"
-
-vd_vec3 vd_wind_at(vd_vec3 mean, double gust_amplitude, double gust_period, const double* series, int nseries,
-                   double t) {
-  // a time series replaces the mean wind and the gusts; linear between rows, held at the ends
-  if (series && nseries > 0) {
-    const double* w = series;
-    if (t <= w[0] || nseries == 1) return vd_v3(w[1], w[2], w[3]);
-    const double* z = w + 4 * (nseries - 1);
-    if (t > z[0]) return vd_v3(z[1], z[2], z[3]);
-    // the first row i with t <= t_i, by bisection (long series: no scan per step)
-    int lo = 0, hi = nseries - 1;  // t > t_lo, t <= t_hi
-    while (hi - lo > 1) {
-      int mid = lo + (hi - lo) / 2;
-      if (t <= w[4 * mid]) hi = mid;
-      else lo = mid;
-    }
-    const double* a = w + 4 * (hi - 1);
-    const double* b = w + 4 * hi;
-    double s = b[0] > a[0] ? (t - a[0]) / (b[0] - a[0]) : 1.0;
-    return vd_v3(a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]));
-  }
-  double f = 1.0;
-  if (gust_period > 0) f += gust_amplitude * sin(2 * VD_PI * t / gust_period);
-  return vd_scale(mean, f);
-}
+#include "mss_internal.h"
 
 // the upward direction: against gravity, +z without gravity
 static vd_vec3 up_dir(const vd_mss_opt* o) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Wood of a few species for mass-spring trees: modulus of elasticity, density and modulus of
 // rupture, with their sources (docs/physics.md, "Wood and breaking").
-#include "sim_internal.h"
+#include "phys_internal.h"
 
 // Sources. Hopea odorata (merawan, the seed's species): density 620-930 kg/m^3 at 15 % moisture
 // (PROSEA 5(1) Timber trees, via GlobinMed; facts-robot-trees.md section 6), the middle taken;

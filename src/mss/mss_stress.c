@@ -20,7 +20,7 @@
 // d omega / dt = beta l-bar (q x up) - gamma omega, |q x up| = sin A. Its steady shape has
 // dA/ds = -sin A / L_c with L_c = gamma / beta: A(s) = 2 atan(tan(A0 / 2) exp(-s / L_c)), and the
 // bending number B = beta L / gamma fixes the tip angle (facts-robot-trees.md section 7).
-#include "sim_mss_internal.h"
+#include "mss_internal.h"
 
 void mss_subtrees(const vd_mss_model* m, const vd_mss_data* d, mss_work* w) {
   int nn = m->nnode;

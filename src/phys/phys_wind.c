@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: MIT
-// Wind time series files: CSV rows t,vx,vy,vz (s, m/s), times not decreasing; a first line that
-// is not numeric is a header, '#' starts a comment line (docs/formats.md). Errors name the line
-// and column and say what was expected.
+// Wind for both engines: the velocity at a time (gusts or a series, vd_wind_at), and wind time
+// series files: CSV rows t,vx,vy,vz (s, m/s), times not decreasing; a first line that is not
+// numeric is a header, '#' starts a comment line (docs/formats.md). Errors name the line and
+// column and say what was expected.
 #include <errno.h>
 #include <stdlib.h>
 
-#include "sim_internal.h"
+#include "phys_internal.h"
 
 // one number of a row at s (leading blanks allowed): finite, and within +-lim; *end after it
 static int row_number(const char* s, double lim, double* out, const char** end) {
@@ -110,4 +111,29 @@ vd_status vd_sim_read_wind(const char* path, double** rows, int* n, vd_error* er
   st = vd_sim_parse_wind(text, len, path, rows, n, err);
   vd_free(text, len + 1);
   return st;
+}
+
+vd_vec3 vd_wind_at(vd_vec3 mean, double gust_amplitude, double gust_period, const double* series, int nseries,
+                   double t) {
+  // a time series replaces the mean wind and the gusts; linear between rows, held at the ends
+  if (series && nseries > 0) {
+    const double* w = series;
+    if (t <= w[0] || nseries == 1) return vd_v3(w[1], w[2], w[3]);
+    const double* z = w + 4 * (nseries - 1);
+    if (t > z[0]) return vd_v3(z[1], z[2], z[3]);
+    // the first row i with t <= t_i, by bisection (long series: no scan per step)
+    int lo = 0, hi = nseries - 1;  // t > t_lo, t <= t_hi
+    while (hi - lo > 1) {
+      int mid = lo + (hi - lo) / 2;
+      if (t <= w[4 * mid]) hi = mid;
+      else lo = mid;
+    }
+    const double* a = w + 4 * (hi - 1);
+    const double* b = w + 4 * hi;
+    double s = b[0] > a[0] ? (t - a[0]) / (b[0] - a[0]) : 1.0;
+    return vd_v3(a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2]), a[3] + s * (b[3] - a[3]));
+  }
+  double f = 1.0;
+  if (gust_period > 0) f += gust_amplitude * sin(2 * VD_PI * t / gust_period);
+  return vd_scale(mean, f);
 }

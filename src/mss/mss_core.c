@@ -14,7 +14,7 @@
 // travels one node per substep; the implicit solve couples the whole tree every substep.
 #include <stdio.h>
 
-#include "sim_mss_internal.h"
+#include "mss_internal.h"
 
 vd_mss_def vd_mss_def_default(void) {
   vd_mss_def d;

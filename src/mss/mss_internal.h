@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
-// Private pieces of the mass-spring trees (sim_mss*.c, sim_rigid.c): the scratch of a state and
-// the functions the files share.
-#ifndef VERDANT_SIM_MSS_INTERNAL_H
-#define VERDANT_SIM_MSS_INTERNAL_H
+// Private pieces of the mass-spring trees (mss_*.c): the scratch of a state and the functions the
+// files share.
+#ifndef VERDANT_MSS_INTERNAL_H
+#define VERDANT_MSS_INTERNAL_H
 
-#include "sim_internal.h"
+#include "phys/phys_internal.h"
+#include "verdant/mss.h"
 
 // Scratch of one state, one block (vd_mss_data::work).
 typedef struct mss_work {
