@@ -3,6 +3,7 @@
 // integrators against a damped oscillator, the implicit solver against a cantilever's closed form,
 // the rigid body (RK4, precession, eqs. 6-8), soil laws, stress by sections, breaking, bad settings.
 #include <stdlib.h>
+#include <string.h>
 
 #include "test.h"
 #include "verdant/verdant.h"
@@ -77,6 +78,32 @@ TEST(mss, bad_settings) {
   o = vd_mss_opt_default();
   o.gravity.x = NAN;
   CHECK_INT(vd_mss_opt_check(&o, &e), VD_ERR_VALUE);
+  vd_model_destroy(p);
+}
+
+// the step contract both engines share (vd_sim_step): a substep that makes a non-finite state
+// returns VD_ERR_VALUE, is counted by kind and is put back; a good one returns VD_OK
+TEST(mss, step_status_and_typed_warnings) {
+  vd_model* p = chain(4, 1.0, 0.01, vd_v3(0, 0, 1), 3);
+  REQUIRE(p);
+  vd_mss_def def = vd_mss_def_default();
+  vd_mss_model* m = NULL;
+  vd_error e = {0};
+  REQUIRE(vd_mss_build(p, &def, NULL, &m, &e) == VD_OK);
+  vd_mss_data* d = vd_mss_data_create(m);
+  REQUIRE(d);
+  CHECK_INT(vd_mss_step(m, d), VD_OK);
+  CHECK(d->nwarning == 0);
+  vd_vec3 before = d->pos[m->main_tip];
+  d->vel[m->main_tip] = vd_v3(NAN, 0, 0);  // what a blown-up state would carry
+  CHECK_INT(vd_mss_step(m, d), VD_ERR_VALUE);
+  CHECK(d->warning[VD_MSS_WARN_NONFINITE] == 1 && d->nwarning == 1);
+  CHECK(d->pos[m->main_tip].x == before.x && d->pos[m->main_tip].z == before.z);
+  CHECK(d->vel[m->main_tip].x == 0);  // the motion stopped
+  CHECK(!strcmp(vd_mss_warning_name(VD_MSS_WARN_CG), "cg"));
+  CHECK_INT(vd_mss_step(m, d), VD_OK);
+  vd_mss_data_destroy(d);
+  vd_mss_model_destroy(m);
   vd_model_destroy(p);
 }
 

@@ -160,6 +160,16 @@ typedef struct vd_mss_opt {
 // growth_zone_age 2 years, soil 1, breaking 1, strain_limit 1e-4, rigid_release 1.
 vd_mss_opt vd_mss_opt_default(void);
 
+// Kinds of numerical warnings, counted in vd_mss_data::warning (as the rods' vd_sim_warning).
+typedef enum vd_mss_warning {
+  VD_MSS_WARN_NONFINITE = 0,  // a substep made a non-finite state: undone, the motion stopped
+  VD_MSS_WARN_CG,             // conjugate gradients ended above their tolerance (substep kept)
+  VD_MSS_WARN_COUNT
+} vd_mss_warning;
+
+// Lower-case name of a warning kind ("nonfinite", "cg").
+const char* vd_mss_warning_name(vd_mss_warning w);
+
 // node flags
 #define VD_MSS_FIXED 1u   // clamped: never moves
 #define VD_MSS_SOIL 2u    // in the soil: held up to node_soil (N)
@@ -270,8 +280,8 @@ typedef struct vd_mss_data {
   vd_mss_event* event;    // events (nevent, capacity cap_event)
   int nevent, cap_event;
   int64_t cg_iterations;  // conjugate-gradient iterations over all substeps
-  int64_t cg_unconverged; // substeps whose iterations ended above the tolerance
-  int64_t nonfinite;      // substeps that made a non-finite state (undone, velocities zeroed)
+  int64_t nwarning;       // numerical warnings of every kind (the sum of warning[])
+  int64_t warning[VD_MSS_WARN_COUNT];  // numerical warnings by kind (vd_mss_warning)
   void* work;             // scratch (private)
   size_t work_bytes;      // its size
   size_t nbytes;          // size of the state block
@@ -291,7 +301,11 @@ vd_mss_data* vd_mss_data_create(const vd_mss_model* m);
 // Free a state (NULL is fine).
 void vd_mss_data_destroy(vd_mss_data* d);
 // Advance one substep of m->opt.dt (Algorithm 1; Algorithm 2 when the state has a rigid part).
-void vd_mss_step(const vd_mss_model* m, vd_mss_data* d);
+// The step contract of both engines (vd_sim_step): a substep that makes a non-finite state is
+// put back to its start with the motion stopped, counted as VD_MSS_WARN_NONFINITE, and
+// VD_ERR_VALUE is returned; else VD_OK (conjugate gradients that end above their tolerance are
+// counted as VD_MSS_WARN_CG, the substep kept). The state never holds a non-finite number.
+vd_status vd_mss_step(const vd_mss_model* m, vd_mss_data* d);
 // Join the flagged nodes (join[i] != 0, nnode) to the rigid body by eqs. 6-8; paper_eq8 1 adds
 // the old body's angular momentum as eq. 8 is written, 0 the corrected term (docs/physics.md).
 // lcheck (Nullable, 2 x 3) gets the angular momentum about the new centre of mass the joined

@@ -132,8 +132,26 @@ static int carry_find(const carry* c, uint64_t key) {
 // ---------------------------------------------------------------------------------------------
 // the grower
 
+// The physics engine of a grower: everything the loop does differently for the mass-spring trees
+// (mss, mrl) and the rods goes through one of these (the table is engine_of, at the end of the
+// engines' section); the loop itself never asks which engine it runs.
+typedef struct growth_engine {
+  vd_status (*build)(vd_growth* g, vd_error* err);          // physics of g->plant (old freed)
+  vd_status (*map)(vd_growth* g, int grown, vd_error* err); // attachments; state from the carried one
+  vd_status (*step)(vd_growth* g);                          // one substep: its status (vd_sim_step)
+  vd_status (*end_age)(vd_growth* g, vd_error* err);        // after the substeps: time, events, masses
+  void (*read)(vd_growth* g);                               // plant nodes' positions and velocities
+  void (*carry)(vd_growth* g);                              // the engine's part of the carried record
+  void (*settle)(vd_growth* g);                             // stress of the state as it stands
+  void (*stats)(const vd_growth* g, vd_growth_stats* out);  // the engine's part of the summary
+  void (*stress)(const vd_growth* g, double* ns, double* ss); // per node and segment (NaN: none)
+} growth_engine;
+
+static const growth_engine* engine_of(vd_growth_model m);
+
 struct vd_growth {
   vd_growth_def def;
+  const growth_engine* eng;  // engine_of(def.model)
   vd_lsystem* ls;
   vd_lstring str;          // derived string
   int64_t* uid;            // module ids (str.n, capacity cap_uid)
@@ -386,29 +404,32 @@ static void plant_keys(vd_growth* g, const vd_plant_spec* s) {
 }
 
 // the physics of the plant now: mass-spring model, or rods
-static vd_status build_physics(vd_growth* g, vd_error* err) {
+static vd_status build_rods(vd_growth* g, vd_error* err) {
   free_physics(g);
   const vd_growth_def* def = &g->def;
-  if (def->model == VD_GROWTH_RODS) {
-    vd_sim_def rdef = def->rods;
-    int soil = def->mss.soil.method != VD_SOIL_CLAMP;
-    if (soil) rdef.clamp_roots = 0;
-    if (g->plant->nseg == 0) return VD_OK;  // nothing to simulate yet (an axiom that draws nothing)
-    vd_status st = vd_sim_build(g->plant, &rdef, &g->rm, err);
-    if (st) return st;
-    vd_vec3 gr = g->rm->opt.gravity;
-    g->rm->opt = def->rod_opt;
-    g->rm->opt.gravity = gr;
-    g->rd = vd_sim_data_create(g->rm);
-    g->rpd = vd_data_create(g->plant);
-    if (!g->rd || !g->rpd) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-    g->rd->time = g->time;
-    if (soil) {
-      vd_soil so = def->mss.soil;
-      if ((st = vd_sim_soil_attach(g->rm, g->rd, &so, &g->soil, err))) return st;
-    }
-    return VD_OK;
+  vd_sim_def rdef = def->rods;
+  int soil = def->mss.soil.method != VD_SOIL_CLAMP;
+  if (soil) rdef.clamp_roots = 0;
+  if (g->plant->nseg == 0) return VD_OK;  // nothing to simulate yet (an axiom that draws nothing)
+  vd_status st = vd_sim_build(g->plant, &rdef, &g->rm, err);
+  if (st) return st;
+  vd_vec3 gr = g->rm->opt.gravity;
+  g->rm->opt = def->rod_opt;
+  g->rm->opt.gravity = gr;
+  g->rd = vd_sim_data_create(g->rm);
+  g->rpd = vd_data_create(g->plant);
+  if (!g->rd || !g->rpd) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  g->rd->time = g->time;
+  if (soil) {
+    vd_soil so = def->mss.soil;
+    if ((st = vd_sim_soil_attach(g->rm, g->rd, &so, &g->soil, err))) return st;
   }
+  return VD_OK;
+}
+
+static vd_status build_mss(vd_growth* g, vd_error* err) {
+  free_physics(g);
+  const vd_growth_def* def = &g->def;
   vd_mss_def mdef = def->mss;
   if (def->model == VD_GROWTH_MSS) mdef.rigid_age = INFINITY;
   vd_status st = vd_mss_build(g->plant, &mdef, NULL, &g->mm, err);
@@ -739,25 +760,32 @@ static vd_status rebuild(vd_growth* g, int grown, vd_error* err) {
   st = vd_plant_compile(rs, &g->plant, err);
   vd_plant_spec_destroy(rs);
   if (st) return st;
-  if ((st = build_physics(g, err))) return st;
-  // attachments: plant node -> mass-spring node
+  if ((st = g->eng->build(g, err))) return st;
   for (int i = 0; i < spec->nnode; i++) g->pmap[i] = -1;
-  if (g->mm) {
-    int* phys = g->attach;  // flags first, then each node's attachment (read before written)
-    for (int i = 0; i < spec->nnode; i++) {
-      g->pmap[i] = i < g->mm->nplant ? g->mm->plant_node[i] : -1;
-      phys[i] = g->pmap[i] >= 0;
-    }
-    int* at = vd_malloc(sizeof(int) * (size_t)(spec->nnode ? spec->nnode : 1));
-    if (!at) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-    for (int i = 0; i < spec->nnode; i++) at[i] = find_attach(spec, g->owner_seg, phys, i);
-    memcpy(g->attach, at, sizeof(int) * (size_t)spec->nnode);
-    vd_free(at, sizeof(int) * (size_t)(spec->nnode ? spec->nnode : 1));
-    if ((st = map_mss(g, grown, err))) return st;
-  } else {
-    for (int i = 0; i < spec->nnode; i++) g->attach[i] = i;
-    if (g->rm) map_rods(g);
+  return g->eng->map(g, grown, err);
+}
+
+// attachments: plant node -> mass-spring node; the state from the carried one
+static vd_status attach_mss(vd_growth* g, int grown, vd_error* err) {
+  const vd_plant_spec* spec = g->spec;
+  int* phys = g->attach;  // flags first, then each node's attachment (read before written)
+  for (int i = 0; i < spec->nnode; i++) {
+    g->pmap[i] = i < g->mm->nplant ? g->mm->plant_node[i] : -1;
+    phys[i] = g->pmap[i] >= 0;
   }
+  int* at = vd_malloc(sizeof(int) * (size_t)(spec->nnode ? spec->nnode : 1));
+  if (!at) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  for (int i = 0; i < spec->nnode; i++) at[i] = find_attach(spec, g->owner_seg, phys, i);
+  memcpy(g->attach, at, sizeof(int) * (size_t)spec->nnode);
+  vd_free(at, sizeof(int) * (size_t)(spec->nnode ? spec->nnode : 1));
+  return map_mss(g, grown, err);
+}
+
+// rods: every plant node is its own; the rod state from the carried one
+static vd_status attach_rods(vd_growth* g, int grown, vd_error* err) {
+  (void)grown, (void)err;
+  for (int i = 0; i < g->spec->nnode; i++) g->attach[i] = i;
+  if (g->rm) map_rods(g);
   return VD_OK;
 }
 
@@ -765,26 +793,27 @@ static vd_status rebuild(vd_growth* g, int grown, vd_error* err) {
 // the state after the physics: positions of every plant node, the carried record
 
 // the plant's node positions and velocities from the physics
-static void read_physics(vd_growth* g) {
+static void read_mss(vd_growth* g) {
   const vd_plant_spec* s = g->spec;
-  if (g->mm) {
-    const vd_mss_data* d = g->md;
-    for (int i = 0; i < s->nnode; i++) {
-      int k = g->pmap[i];
-      if (k < 0) continue;
-      g->pos[i] = d->pos[k];
-      g->vel[i] = d->vel[k];
-    }
-    // the rest follow the node they hang from
-    for (int i = 0; i < s->nnode; i++) {
-      int a = g->attach[i];
-      if (g->pmap[i] >= 0 || a < 0) continue;
-      vd_quat q = node_turn(s, g->owner_seg, g->rest, g->pos, a);
-      g->pos[i] = vd_add(g->pos[a], vd_quat_rotate(q, vd_sub(g->rest[i], g->rest[a])));
-      g->vel[i] = g->vel[a];
-    }
-    return;
+  const vd_mss_data* d = g->md;
+  for (int i = 0; i < s->nnode; i++) {
+    int k = g->pmap[i];
+    if (k < 0) continue;
+    g->pos[i] = d->pos[k];
+    g->vel[i] = d->vel[k];
   }
+  // the rest follow the node they hang from
+  for (int i = 0; i < s->nnode; i++) {
+    int a = g->attach[i];
+    if (g->pmap[i] >= 0 || a < 0) continue;
+    vd_quat q = node_turn(s, g->owner_seg, g->rest, g->pos, a);
+    g->pos[i] = vd_add(g->pos[a], vd_quat_rotate(q, vd_sub(g->rest[i], g->rest[a])));
+    g->vel[i] = g->vel[a];
+  }
+}
+
+static void read_rods(vd_growth* g) {
+  const vd_plant_spec* s = g->spec;
   if (!g->rm) return;  // no rods: the plant stays where it is
   vd_sim_to_plant(g->rm, g->rd, g->plant, g->rpd);
   for (int i = 0; i < s->nnode; i++) {
@@ -795,7 +824,7 @@ static void read_physics(vd_growth* g) {
 
 static vd_status carry_out(vd_growth* g, vd_error* err) {
   const vd_plant_spec* s = g->spec;
-  read_physics(g);
+  g->eng->read(g);
   if (!carry_alloc(&g->c, s->nnode)) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   for (int i = 0; i < s->nnode; i++) {
     g->c.key[i] = g->key[i];
@@ -805,24 +834,31 @@ static vd_status carry_out(vd_growth* g, vd_error* err) {
     g->c.vel[i] = g->vel[i];
     g->c.parent[i] = g->owner_seg[i] >= 0 ? s->seg[g->owner_seg[i]].node0 : -1;
     g->c.stiff[i] = g->owner_seg[i] >= 0 ? seg_stiffness(g, s, g->owner_seg[i]) : 0;
+  }
+  g->eng->carry(g);
+  carry_index(&g->c);
+  return VD_OK;
+}
+
+// the mass-spring part of the carried record: masses, the rigid part, the soil's state
+static void carry_mss(vd_growth* g) {
+  for (int i = 0; i < g->spec->nnode; i++) {
     int k = g->pmap[i];
     // the node's own plant node carries it (not the aliases of a shared base)
-    if (k >= 0 && g->md && g->mm && !g->md->removed[k] && g->mm->node_plant[k] == i) {
+    if (k >= 0 && !g->md->removed[k] && g->mm->node_plant[k] == i) {
       g->c.mass[i] = g->md->mass[k];
       g->c.rigid[i] = g->md->rigid[k];
       g->c.body[i] = g->md->body[k];
       g->c.yielded[i] = g->md->yielded[k];
     }
   }
-  carry_index(&g->c);
-  if (g->md) {
-    g->rb = g->md->rb;
-    g->uprooted = g->md->uprooted;
-    g->anchor_failed = g->md->anchor_failed;
-    g->anchor_load = fmax(g->anchor_load, g->md->anchor_load);
-  }
-  return VD_OK;
+  g->rb = g->md->rb;
+  g->uprooted = g->md->uprooted;
+  g->anchor_failed = g->md->anchor_failed;
+  g->anchor_load = fmax(g->anchor_load, g->md->anchor_load);
 }
+
+static void carry_rods(vd_growth* g) { (void)g; }  // the rods carry positions only
 
 // ---------------------------------------------------------------------------------------------
 // create, step
@@ -864,6 +900,7 @@ vd_status vd_growth_create(vd_lsystem* ls, const vd_growth_def* def, vd_growth**
   vd_growth* g = vd_calloc(1, sizeof *g);
   if (!g) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   g->def = *def;
+  g->eng = engine_of(def->model);
   g->ls = ls;
   g->str = vd_lstring_empty();
   g->rb.q = vd_quat_identity();
@@ -1056,24 +1093,10 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
   if ((st = check_light(g, err))) return st;
   // the substeps
   for (int k = 0; k < g->def.substeps; k++) {
-    if (g->mm) {
-      vd_mss_step(g->mm, g->md);
-    } else if (g->rm) {
-      if (vd_sim_step(g->rm, g->rd)) g->unstable++;
-      vd_sim_soil_update(g->rm, g->rd, g->soil);
-    }
+    if (g->eng->step(g)) g->unstable++;
     g->substeps++;
   }
-  if (g->mm) {
-    g->time = g->md->time;
-    collect_events(g);
-    if ((st = end_mss(g, err))) return st;
-  } else if (g->rm) {
-    g->time = g->rd->time;
-    rods_breaking(g);
-  } else {
-    g->time += g->def.substeps * g->def.rod_opt.dt;
-  }
+  if ((st = g->eng->end_age(g, err))) return st;
   if ((st = carry_out(g, err))) return st;
   // broken branches leave the L-string, and the plant is rebuilt without them
   if (g->nbroken_step) {
@@ -1082,7 +1105,7 @@ vd_status vd_growth_step(vd_growth* g, vd_error* err) {
     if ((st = carry_out(g, err))) return st;
   }
   // stress of the tree as it stands now (also without breaking, and after a rebuild)
-  if (g->mm) vd_mss_stress_now(g->mm, g->md);
+  g->eng->settle(g);
   return VD_OK;
 }
 
@@ -1120,24 +1143,35 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
   out->anchor_failed = g->anchor_failed;
   out->anchor_load = g->anchor_load;
   out->drawn_height = fmax(g->drawn_max, drawn_height(g));
-  if (g->mm) {
-    const vd_mss_model* m = g->mm;
-    const vd_mss_data* d = g->md;
-    out->nphys = m->nnode;
-    out->nrigid = d->rb.n;
-    out->height = vd_mss_height(m, d);
-    out->height0 = m->height0;
-    out->max_displacement = vd_mss_max_displacement(m, d, NULL);
-    out->tip_displacement = m->main_tip >= 0 ? vd_norm(vd_sub(d->pos[m->main_tip], m->node_rest[m->main_tip])) : 0;
-    for (int s = 0; s < m->ninter; s++) out->max_stress = fmax(out->max_stress, d->spring_stress[s]);
-    for (int k = 0; k < m->nnode; k++) out->total_mass += d->removed[k] ? 0 : d->mass[k];
-    out->kinetic_energy = vd_mss_kinetic_energy(m, d);
-    out->cg_iterations = d->cg_iterations;
-    out->unstable = d->nonfinite + g->unstable;
-    out->uprooted = d->uprooted;
-    out->anchor_failed = d->anchor_failed;
-    out->anchor_load = fmax(g->anchor_load, d->anchor_load);
-  } else if (g->rm) {
+  g->eng->stats(g, out);
+  // judged against the drawn height, which no lean of the rest shape moves
+  double h0 = out->drawn_height > 0 ? out->drawn_height : out->height0;
+  out->diverged = !isfinite(out->height) || !isfinite(out->max_displacement) ||
+                  (h0 > 0 && (out->height > 1.5 * h0 || out->max_displacement > 2 * h0));
+  out->collapsed = out->diverged || (h0 > 0 && out->height < VD_GROWTH_COLLAPSE * h0);
+}
+
+static void stats_mss(const vd_growth* g, vd_growth_stats* out) {
+  const vd_mss_model* m = g->mm;
+  const vd_mss_data* d = g->md;
+  out->nphys = m->nnode;
+  out->nrigid = d->rb.n;
+  out->height = vd_mss_height(m, d);
+  out->height0 = m->height0;
+  out->max_displacement = vd_mss_max_displacement(m, d, NULL);
+  out->tip_displacement = m->main_tip >= 0 ? vd_norm(vd_sub(d->pos[m->main_tip], m->node_rest[m->main_tip])) : 0;
+  for (int s = 0; s < m->ninter; s++) out->max_stress = fmax(out->max_stress, d->spring_stress[s]);
+  for (int k = 0; k < m->nnode; k++) out->total_mass += d->removed[k] ? 0 : d->mass[k];
+  out->kinetic_energy = vd_mss_kinetic_energy(m, d);
+  out->cg_iterations = d->cg_iterations;
+  out->unstable = d->warning[VD_MSS_WARN_NONFINITE];
+  out->uprooted = d->uprooted;
+  out->anchor_failed = d->anchor_failed;
+  out->anchor_load = fmax(g->anchor_load, d->anchor_load);
+}
+
+static void stats_rods(const vd_growth* g, vd_growth_stats* out) {
+  if (g->rm) {
     const vd_sim_model* m = g->rm;
     const vd_sim_data* d = g->rd;
     out->nphys = m->nnode;
@@ -1167,11 +1201,6 @@ void vd_growth_get_stats(const vd_growth* g, vd_growth_stats* out) {
       vd_free(st, sizeof(double) * (size_t)(g->plant->nseg ? g->plant->nseg : 1));
     }
   }
-  // judged against the drawn height, which no lean of the rest shape moves
-  double h0 = out->drawn_height > 0 ? out->drawn_height : out->height0;
-  out->diverged = !isfinite(out->height) || !isfinite(out->max_displacement) ||
-                  (h0 > 0 && (out->height > 1.5 * h0 || out->max_displacement > 2 * h0));
-  out->collapsed = out->diverged || (h0 > 0 && out->height < VD_GROWTH_COLLAPSE * h0);
 }
 
 vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err) {
@@ -1216,20 +1245,7 @@ vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err
   {
     for (int i = 0; i < s->nnode; i++) ns[i] = NAN;
     for (int j = 0; j < s->nseg; j++) ss[j] = NAN;
-    if (g->mm) {
-      const vd_mss_model* m = g->mm;
-      const vd_mss_data* d = g->md;
-      for (int i = 0; i < s->nnode; i++)
-        if (g->pmap[i] >= 0) ns[i] = d->node_stress[g->pmap[i]];
-      for (int q = 0; q < m->ninter; q++) ss[m->spring_plant[q]] = d->spring_stress[q];
-    } else if (g->rm) {
-      vd_sim_plant_stress(g->rm, g->rd, g->plant, ss);
-      for (int j = 0; j < s->nseg; j++) {
-        if (!isfinite(ss[j])) continue;
-        int n = s->seg[j].node1;
-        ns[n] = isfinite(ns[n]) ? fmax(ns[n], ss[j]) : ss[j];
-      }
-    }
+    g->eng->stress(g, ns, ss);
     if (vd_plant_set_stress(p, ns, ss)) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
   vd_free(ns, sizeof(double) * (size_t)(s->nnode ? s->nnode : 1));
@@ -1241,3 +1257,62 @@ vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err
   *out = p;
   return VD_OK;
 }
+
+static void stress_mss(const vd_growth* g, double* ns, double* ss) {
+  const vd_mss_model* m = g->mm;
+  const vd_mss_data* d = g->md;
+  for (int i = 0; i < g->spec->nnode; i++)
+    if (g->pmap[i] >= 0) ns[i] = d->node_stress[g->pmap[i]];
+  for (int q = 0; q < m->ninter; q++) ss[m->spring_plant[q]] = d->spring_stress[q];
+}
+
+static void stress_rods(const vd_growth* g, double* ns, double* ss) {
+  const vd_plant_spec* s = g->spec;
+  if (!g->rm) return;
+  vd_sim_plant_stress(g->rm, g->rd, g->plant, ss);
+  for (int j = 0; j < s->nseg; j++) {
+    if (!isfinite(ss[j])) continue;
+    int n = s->seg[j].node1;
+    ns[n] = isfinite(ns[n]) ? fmax(ns[n], ss[j]) : ss[j];
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// the engines' substeps and age ends, and the one table the loop dispatches through
+
+static vd_status step_mss(vd_growth* g) { return vd_mss_step(g->mm, g->md); }
+
+static vd_status step_rods(vd_growth* g) {
+  if (!g->rm) return VD_OK;
+  vd_status st = vd_sim_step(g->rm, g->rd);
+  vd_sim_soil_update(g->rm, g->rd, g->soil);
+  return st;
+}
+
+static vd_status end_age_mss(vd_growth* g, vd_error* err) {
+  g->time = g->md->time;
+  collect_events(g);
+  return end_mss(g, err);
+}
+
+static vd_status end_age_rods(vd_growth* g, vd_error* err) {
+  (void)err;
+  if (!g->rm) {
+    g->time += g->def.substeps * g->def.rod_opt.dt;
+    return VD_OK;
+  }
+  g->time = g->rd->time;
+  rods_breaking(g);
+  return VD_OK;
+}
+
+static void settle_mss(vd_growth* g) { vd_mss_stress_now(g->mm, g->md); }
+
+static void settle_rods(vd_growth* g) { (void)g; }  // the rods' stress is computed when read
+
+static const growth_engine engine_mss = {build_mss, attach_mss, step_mss, end_age_mss, read_mss,
+                                         carry_mss, settle_mss, stats_mss, stress_mss};
+static const growth_engine engine_rods = {build_rods, attach_rods, step_rods, end_age_rods, read_rods,
+                                          carry_rods, settle_rods, stats_rods, stress_rods};
+
+static const growth_engine* engine_of(vd_growth_model m) { return m == VD_GROWTH_RODS ? &engine_rods : &engine_mss; }

@@ -1104,7 +1104,7 @@ static void solve_implicit(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
     for (int i = 0; i < nn; i++) w->cg_p[i] = vd_madd(w->cg_z[i], w->cg_p[i], beta);
   }
   d->cg_iterations += it;
-  if (!conv) d->cg_unconverged++;
+  if (!conv) mss_warn(d, VD_MSS_WARN_CG);
 }
 
 // eqs. 3 and 4: the velocity change into w->cg_x
@@ -1274,7 +1274,7 @@ static double tilt_of(const vd_mss_model* m, const vd_mss_data* d) {
   return 0;
 }
 
-void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
+vd_status vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
   mss_work* w = d->work;
   int nn = m->nnode;
   double h = m->opt.dt;
@@ -1367,7 +1367,7 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     memcpy(d->pos, w->pos0, sizeof(vd_vec3) * (size_t)nn);
     for (int i = 0; i < nn; i++) d->vel[i] = d->dv[i] = vd_v3(0, 0, 0);
     d->rb.p = d->rb.L = vd_v3(0, 0, 0);
-    d->nonfinite++;
+    mss_warn(d, VD_MSS_WARN_NONFINITE);
   }
   // accelerations (the stress of the rigid part reads them): a held body was stopped by the soil
   // or a clamp, which is a reaction, not an acceleration of its wood
@@ -1410,10 +1410,16 @@ void vd_mss_step(const vd_mss_model* m, vd_mss_data* d) {
     }
     if (removed_rigid) vd_mss_rigid_update(m, d);
   }
+  return bad ? VD_ERR_VALUE : VD_OK;
 }
 
 // ---------------------------------------------------------------------------------------------
 // summaries
+
+const char* vd_mss_warning_name(vd_mss_warning w) {
+  static const char* names[VD_MSS_WARN_COUNT] = {"nonfinite", "cg"};
+  return w >= 0 && w < VD_MSS_WARN_COUNT ? names[w] : "?";
+}
 
 vd_vec3 vd_mss_momentum(const vd_mss_model* m, const vd_mss_data* d) {
   vd_vec3 p = d->rb.n > 0 ? d->rb.p : vd_v3(0, 0, 0);

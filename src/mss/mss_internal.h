@@ -55,6 +55,12 @@ int mss_remove_subtree(const vd_mss_model* m, vd_mss_data* d, int s);
 // Add an event; 0 when out of memory.
 int mss_event(vd_mss_data* d, const vd_mss_event* e);
 
+// Count one numerical warning of kind k (vd_mss_warning) in d->warning and d->nwarning.
+static inline void mss_warn(vd_mss_data* d, int k) {
+  d->warning[k]++;
+  d->nwarning++;
+}
+
 // whether a node moves with the springs (not fixed, not rigid, not removed)
 static inline int mss_free(const vd_mss_model* m, const vd_mss_data* d, int i) {
   return !(m->node_flags[i] & VD_MSS_FIXED) && !d->rigid[i] && !d->removed[i];
