@@ -73,7 +73,7 @@ def main():
                     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
                     t0 = time.perf_counter()
                     p = subprocess.run([verdant, "cloud", plant, "--seed", "1", "--points", str(n),
-                                        "--threads", str(threads), "-o", out, "--stats"],
+                                        "--threads", str(threads), "-o", out, "--stats", "--profile"],
                                        check=True, capture_output=True, text=True)
                     wall = time.perf_counter() - t0
                     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -87,7 +87,7 @@ def main():
                 for _ in range(reps):
                     t0 = time.perf_counter()
                     subprocess.run([verdant, "cloud", plant, "--seed", "1", "--points", str(n),
-                                    "--threads", str(threads), "-o", out, "--stats"],
+                                    "--threads", str(threads), "-o", out, "--stats", "--profile"],
                                    check=True, capture_output=True)
                     over = min(over, time.perf_counter() - t0)
                 s = st["seconds"]

@@ -57,6 +57,8 @@ void cli_plant_opts_init(cli_plant_opts* o);
 int cli_plant_opt(cli_plant_opts* o, const char* cmd, int argc, char** argv, int* i);
 // Help text lines for the plant options.
 extern const char* cli_plant_help;
+// Declare the plant options' files to the output layer: PLANT read, --lstring and --frames written.
+void cli_out_plant_opts(const cli_plant_opts* o);
 
 // Load the plant: derive an .lpy (and keep its derived string's module counts in stats), read
 // a plant file, or build a plant from a curves file. On success *out is a new spec.
@@ -113,20 +115,17 @@ int cli_parse_num(const char* s, double* out);
       return cli_usage_error(cmd, "%s expects %s, got '%s'", a, what, val);                        \
     (dst) = x_;                                                                                    \
   } while (0)
-// Interrupts: SIGINT and SIGTERM remove the temporary files of the outputs being written (the
-// watched ones), then end the process by the same signal. Call once from main.
+// Interrupts: SIGINT and SIGTERM remove every output of the run (cli_out_rollback), then end the
+// process by the same signal. Call once from main.
 void cli_signals_init(void);
-// Watch an output about to be written with vd_outfile (its temporary name is removed if a
-// signal ends the run); returns a slot for cli_unwatch, -1 when every slot is taken.
-int cli_watch(const char* path);
-// Stop watching (after the output was committed or aborted); -1 is ignored.
-void cli_unwatch(int slot);
 
 // Monotonic seconds.
 double cli_now(void);
 // A progress bar on stderr: "\rWHAT [####    ] TEXT" (frac in [0, 1]); the caller ends it with
 // a newline. Callers show it only when stderr is a terminal (cli_plant_opts.progress).
 void cli_progress_bar(const char* what, double frac, const char* text);
+// the end of a bar: its line cleared, nothing left on screen
+void cli_progress_clear(void);
 // When to redraw a bar: at the first call, then at most ten times a second; off when on is 0.
 typedef struct cli_progress {
   int on, shown;
@@ -138,36 +137,50 @@ void cli_progress_end(cli_progress* p);
 // Does path end with ext (case-insensitive, ext with the dot)?
 int cli_has_ext(const char* path, const char* ext);
 
-// Inputs and outputs (cli_paths.c). Is a the same file as b (both exist, same device and inode)?
+// The output layer (cli_paths.c): every file a command writes goes through it. A command
+// declares what it reads and writes before the first byte (what: the option or role, named in
+// messages), then cli_out_check refuses (exit 2, naming both) an output that is an input (same
+// inode: another spelling, a hard or symbolic link), an input inside an output folder under a
+// name written there, two outputs that are one file, and an output that cannot be written. The
+// library's writers (vd_outfile, vd_outdir_make) refuse any other path and keep each file under a
+// temporary name beside its target; main() calls cli_out_finish, which puts them all in place
+// when the command succeeded, else removes them (as the SIGINT/SIGTERM handler does).
+// Is a the same file as b (both exist, same device and inode)?
 int cli_same_file(const char* a, const char* b);
-// No output may replace an input: when one of the nout outputs is one of the nin inputs (NULL
-// entries skipped) print which and return EXIT_USAGE, else 0.
-int cli_check_outputs(const char* cmd, const char* const* out, int nout, const char* const* in, int nin);
-// Does the folder dir hold the file path (path's parent folder is dir, by inode)?
-int cli_in_folder(const char* dir, const char* path);
+// Install the layer as the library's output guard (main, before any command runs).
+void cli_out_init(void);
+// A file the command reads (missing files are compared by name).
+void cli_out_input(const char* what, const char* path);
+// A file the command writes.
+void cli_out_file(const char* what, const char* path);
+// A folder the command writes into: members are fnmatch patterns (relative, '/' matched only by
+// '/') of the files written there, made with their folders as needed; replace: files matching
+// them that an earlier run left and this run does not write are removed when the command succeeds.
+void cli_out_folder(const char* what, const char* dir, const char* const* members, int nmember, int replace);
+// The same, named in messages as shown (a --frames pattern) rather than as the folder.
+void cli_out_pattern(const char* what, const char* shown, const char* dir, const char* const* members, int nmember,
+                     int replace);
+// Compare every declared output with every input and output, check each can be written: 0, or
+// EXIT_USAGE after printing why (nothing touched).
+int cli_out_check(const char* cmd);
+// The name that holds the file written to path now: its temporary name until the command ends.
+const char* cli_out_current(const char* path, char* buf, size_t cap);
+// Put these complete outputs in place now (ok), or drop them: an item of a batch that resumes.
+// Nonzero when one could not be put in place.
+int cli_out_publish(const char* const* paths, int n, int ok);
+// The end of the command with exit code rc: 0 puts every output in place (EXIT_FAIL when one
+// cannot be), else every output and folder made goes. Returns the exit code.
+int cli_out_finish(const char* cmd, int rc);
+// For the signal handler: remove every temporary file and folder made (async-signal-safe).
+void cli_out_rollback(void);
+// Remove path when it is a temporary file of this layer left by a process that is gone (killed
+// by SIGKILL, power loss): "<name>.tmp.<pid>" or ".bak.<pid>"; 1 when removed.
+int cli_out_drop_orphan(const char* path);
 
 // The files of a plant output: path, and for .obj its material library (.mtl); returns the count.
 int cli_plant_files(const char* path, char files[2][4200]);
-// A command's outputs, written together or not at all.
-typedef struct cli_outset {
-  int n, cap;            // outputs
-  char** path;           // the outputs (n)
-  char** backup;         // where the file an output replaces waits, NULL or "" when none (n)
-  unsigned char* fresh;  // 1 when the output did not exist before (n)
-  unsigned char* stale;  // 1 for a file this run does not write, removed when the set completes (n)
-  int slot;              // entry in the signal handler's table, -1 none
-} cli_outset;
-// Before writing: every output must be writable (not a folder, in a folder that exists and takes
-// files: else VD_ERR_IO naming it, nothing touched); the files they replace are kept aside.
-// stale (Nullable, n entries): outputs of an earlier run this one does not write (frames.bin of a
-// run now writing frames.jsonl), removed when the set completes.
-vd_status cli_outset_begin(cli_outset* s, const char* const* paths, int n, const unsigned char* stale,
-                           vd_error* err);
-// After writing: ok drops the kept files; else every output is removed and the files they
-// replaced are put back. Ends the set (cli_outset_begin failed: nothing to end).
-void cli_outset_end(cli_outset* s, int ok);
-// For the signal handler: put back every set in progress (async-signal-safe).
-void cli_outsets_rollback(void);
+// Declare a plant output (the file, and for .obj its .mtl).
+void cli_out_plant(const char* what, const char* path);
 
 // Write a plant by the extension of path (.json, .obj, .ply; ascii: PLY as text).
 vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err);
@@ -217,7 +230,8 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
 // Points per label table entry (count has c->nlabel slots); 0 when out of memory.
 int cli_label_counts(const vd_cloud* c, int64_t* count);
 // The --stats JSON of a result (caller deletes it), NULL when out of memory.
-struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total);
+// profile: also the threads, the seconds per stage and the rates (timings: not the same bytes twice)
+struct cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total, int profile);
 
 // Simulation runs on disk (cli_run.c): the rod build settings of rod.json, the colliders of
 // colliders.jsonl, and a run read back frame by frame.
@@ -232,10 +246,14 @@ vd_status cli_rod_json_write(const vd_sim_model* m, const vd_model* plant, const
 // A run's frames being written: DIR/frames.bin (or .jsonl) and DIR/colliders.jsonl.
 typedef struct cli_frames {
   vd_outfile frames, colliders;
-  int frames_open, colliders_open, jsonl, watch, cwatch;  // zero the struct, watches -1
+  int frames_open, colliders_open, jsonl;  // zero the struct
   size_t fbuf_n;
   unsigned char* bbuf;
 } cli_frames;
+// The files a simulation run folder holds (sim -o DIR, its --batch items): fnmatch patterns for
+// cli_out_folder.
+extern const char* const cli_run_members[];
+extern const int cli_run_nmember;
 // Open the frames files of a run folder (temporary names until cli_frames_end).
 vd_status cli_frames_begin(cli_frames* o, const vd_sim_model* m, const char* dir, int jsonl,
                            vd_error* err);

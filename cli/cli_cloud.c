@@ -50,8 +50,10 @@ static const char* cloud_usage =
     "options:\n"
     "  -o, --output OUT      the cloud file (written under a temporary name, then renamed)\n"
     "      --stats           print a JSON summary on stdout: points, labels (points per label),\n"
-    "                        instances, bbox_min, bbox_max (m), area (m^2), rejected counts,\n"
-    "                        seconds per stage, points_per_second\n";
+    "                        instances, bbox_min, bbox_max (m), area (m^2), rejected counts;\n"
+    "                        the same bytes for the same inputs\n"
+    "      --profile         --stats adds threads, seconds per stage and points_per_second:\n"
+    "                        timings, which differ per run\n";
 
 void cli_cloud_opts_init(cli_cloud_opts* o) {
   memset(o, 0, sizeof *o);
@@ -346,9 +348,7 @@ vd_status cli_cloud_make(const cli_plant_opts* po, const cli_cloud_opts* co, con
     cloud_bar bar = {{po->progress, 0, 0}, "writing ", 0};
     wd.progress = cloud_progress;
     wd.progress_user = &bar;
-    int w = cli_watch(out);
     st = vd_cloud_write(&cloud, out, &wd, err);
-    cli_unwatch(w);
     cli_progress_end(&bar.bar);
     if (st) res->write_failed = 1;
   }
@@ -416,7 +416,7 @@ int cli_label_counts(const vd_cloud* c, int64_t* count) {
   return 1;
 }
 
-cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
+cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total, int profile) {
   const vd_cloud* c = &r->cloud;
   const vd_cloud_stats* s = &r->stats;
   cJSON* root = cJSON_CreateObject();
@@ -466,6 +466,7 @@ cJSON* cli_cloud_stats_json(const cli_cloud_result* r, double seconds_total) {
   cJSON_AddNumberToObject(rej, "occluded", (double)s->rejected_occluded);
   cJSON_AddNumberToObject(rej, "noise", (double)s->rejected_noise);
   cJSON_AddNumberToObject(root, "missed_rays", (double)s->missed);
+  if (!profile) return root;
   cJSON_AddNumberToObject(root, "threads", s->threads);
   cJSON* t = cJSON_AddObjectToObject(root, "seconds");
   cJSON_AddNumberToObject(t, "load", r->seconds_load);
@@ -489,7 +490,7 @@ int cli_cloud(int argc, char** argv) {
   cli_cloud_opts co;
   cli_cloud_opts_init(&co);
   const char* out = NULL;
-  int stats = 0;
+  int stats = 0, profile = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -509,6 +510,8 @@ int cli_cloud(int argc, char** argv) {
       out = argv[++i];
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error("cloud", "unknown option '%s'", a);
     } else if (!po.path) {
@@ -519,11 +522,15 @@ int cli_cloud(int argc, char** argv) {
   }
   if (!po.path) return cli_usage_error("cloud", "missing PLANT (an .lpy or plant .json file)");
   if (!out && !stats) return cli_usage_error("cloud", "nothing to do: give -o OUT and/or --stats");
+  if (profile && !stats) return cli_usage_error("cloud", "--profile adds timings to --stats; give --stats");
   if (out && vd_cloud_format_of(out) == VD_CLOUD_AUTO)
     return cli_usage_error("cloud", "output '%s': unknown format (use .ply, .pcd, .xyz, .csv or .las)", out);
   if (cli_cloud_check(&co, "cloud") || cli_cloud_check_output(&co, "cloud", out)) return EXIT_USAGE;
-  const char* ins[2] = {po.path, co.scanners_file};
-  if (out && cli_check_outputs("cloud", &out, 1, ins, 2)) return EXIT_USAGE;
+  // the files: the plant and the scanners read, the cloud written
+  cli_out_plant_opts(&po);
+  cli_out_input("--scanners", co.scanners_file);
+  cli_out_file("-o", out);
+  if (cli_out_check("cloud")) return EXIT_USAGE;
   vd_error err = {0};
   cli_cloud_result res;
   vd_status st = cli_cloud_make(&po, &co, out, &res, &err);
@@ -532,7 +539,7 @@ int cli_cloud(int argc, char** argv) {
     return res.write_failed && st == VD_ERR_IO ? EXIT_FAIL : code;
   }
   if (stats) {
-    cJSON* root = cli_cloud_stats_json(&res, cli_now() - start);
+    cJSON* root = cli_cloud_stats_json(&res, cli_now() - start, profile);
     char* text = root ? cJSON_Print(root) : NULL;
     if (text) {
       fputs(text, stdout);

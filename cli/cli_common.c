@@ -48,17 +48,10 @@ int cli_usage_error(const char* cmd, const char* fmt, ...) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// interrupts: temporary names of the outputs in progress, removed by the signal handler (only
-// async-signal-safe calls there: atomic loads, unlink, signal, raise)
-
-#define CLI_WATCH_SLOTS 2080  // two files per dataset job (--jobs 1024) and a few more
-static char watch_path[CLI_WATCH_SLOTS][4224];
-static atomic_int watch_used[CLI_WATCH_SLOTS];
+// interrupts: the output layer removes what the run wrote (only async-signal-safe calls there)
 
 static void on_signal(int sig) {
-  for (int k = 0; k < CLI_WATCH_SLOTS; k++)
-    if (atomic_load(&watch_used[k]) == 1) unlink(watch_path[k]);
-  cli_outsets_rollback();  // outputs of a set already in place go, the files they replaced come back
+  cli_out_rollback();  // temporary files and folders made; an earlier run is left as it was
   signal(sig, SIG_DFL);
   raise(sig);
 }
@@ -74,23 +67,6 @@ void cli_signals_init(void) {
   sigaction(SIGTERM, &sa, NULL);
 }
 
-int cli_watch(const char* path) {
-  for (int k = 0; k < CLI_WATCH_SLOTS; k++) {
-    int expect = 0;
-    // claim a free slot (2 = being filled, not yet seen by the handler), fill it, publish it
-    if (atomic_compare_exchange_strong(&watch_used[k], &expect, 2)) {
-      vd_outfile_tmp_path(path, watch_path[k], sizeof watch_path[k]);
-      atomic_store(&watch_used[k], 1);
-      return k;
-    }
-  }
-  return -1;
-}
-
-void cli_unwatch(int slot) {
-  if (slot >= 0 && slot < CLI_WATCH_SLOTS) atomic_store(&watch_used[slot], 0);
-}
-
 double cli_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -103,12 +79,12 @@ int cli_has_ext(const char* path, const char* ext) {
 }
 
 // the derived L-string as JSON (--lstring): module names and parameters (numbers or strings),
-// written to a temporary name and renamed when complete
+// written through the output layer (vd_outfile)
 static vd_status write_lstring_json(const char* path, const vd_lsystem* ls, const vd_lstring* s, vd_error* err) {
-  char tmp[4096];
-  snprintf(tmp, sizeof tmp, "%s.tmp%d", path, (int)getpid());
-  FILE* f = fopen(tmp, "wb");
-  if (!f) return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot write: %s", strerror(errno));
+  vd_outfile out;
+  vd_status st = vd_outfile_open(&out, path, err);
+  if (st) return st;
+  FILE* f = out.fp;
   fprintf(f, "{\"format\": \"verdant-lstring\", \"version\": 1, \"modules\": [");
   for (int64_t i = 0; i < s->n; i++) {
     fputs(i ? ",\n[" : "\n[", f);
@@ -139,12 +115,50 @@ static vd_status write_lstring_json(const char* path, const vd_lsystem* ls, cons
     fputc(']', f);
   }
   fputs("\n]}\n", f);
-  int bad = ferror(f);
-  if (fclose(f) != 0 || bad || rename(tmp, path) != 0) {
-    remove(tmp);
-    return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot write: %s", strerror(errno));
+  return vd_outfile_commit(&out, err);
+}
+
+// the files a --frames pattern writes, as an fnmatch pattern (the %d field any text); 0 when
+// it does not fit
+static int frames_glob(const char* name, char* buf, size_t cap) {
+  size_t k = 0;
+  for (const char* c = name; *c && k + 2 < cap; c++) {
+    if (c[0] == '%' && c[1] == '%') {
+      buf[k++] = '%', c++;
+    } else if (c[0] == '%') {
+      while (c[1] && c[1] != 'd') c++;
+      buf[k++] = '*';
+      if (c[1]) c++;
+    } else {
+      if (strchr("*?[\\", *c)) buf[k++] = '\\';
+      buf[k++] = *c;
+    }
   }
-  return VD_OK;
+  buf[k] = 0;
+  return k + 2 < cap;
+}
+
+void cli_out_plant_opts(const cli_plant_opts* o) {
+  cli_out_input("PLANT", o->path);
+  if (o->lstring_out) cli_out_file("--lstring", o->lstring_out);
+  if (o->frames) {
+    // the frames' folder, every name the pattern makes (and their .mtl for OBJ)
+    const char* slash = strrchr(o->frames, '/');
+    char dir[4200], glob[2][4200];
+    if (!slash)
+      snprintf(dir, sizeof dir, ".");
+    else
+      snprintf(dir, sizeof dir, "%.*s", slash == o->frames ? 1 : (int)(slash - o->frames), o->frames);
+    int n = frames_glob(slash ? slash + 1 : o->frames, glob[0], sizeof glob[0]) ? 1 : 0;
+    if (n && cli_has_ext(glob[0], ".obj")) {
+      size_t len = strlen(glob[0]);
+      memcpy(glob[1], glob[0], len - 4);
+      memcpy(glob[1] + len - 4, ".mtl", 5);
+      n = 2;
+    }
+    const char* members[2] = {glob[0], glob[1]};
+    cli_out_pattern("--frames", o->frames, dir, members, n, 0);
+  }
 }
 
 const char* cli_plant_help =
@@ -342,8 +356,13 @@ int cli_progress_due(cli_progress* p) {
   return 1;
 }
 
+void cli_progress_clear(void) {
+  fputs("\r\033[K", stderr);
+  fflush(stderr);
+}
+
 void cli_progress_end(cli_progress* p) {
-  if (p->shown) fputc('\n', stderr);
+  if (p->shown) cli_progress_clear();
   p->shown = 0;
 }
 
@@ -355,7 +374,7 @@ static int progress_cb(void* user, int step, int steps, int64_t modules) {
   for (int k = 0; k < w; k++) bar[k] = k < fill ? '#' : ' ';
   bar[w] = 0;
   fprintf(stderr, "\rderiving [%s] step %d/%d, %lld modules", bar, step, steps, (long long)modules);
-  if (step == steps) fprintf(stderr, "\n");
+  if (step == steps) cli_progress_clear();
   fflush(stderr);
   return 0;
 }
@@ -447,16 +466,6 @@ static int write_frame(void* user, int frame, const vd_lstring* s, const vd_plan
     w->st = vd_error_set(w->err, VD_ERR_ARG, w->o->frames, 0, 0, "frame %d: the file name is too long", frame);
     return 1;
   }
-  // no frame may replace the input (another spelling of it, a hard or symbolic link)
-  char files[2][4200];
-  int nf = cli_plant_files(path, files);
-  for (int i = 0; i < nf; i++)
-    if (cli_same_file(files[i], w->o->path)) {
-      w->st = vd_error_set(w->err, VD_ERR_ARG, w->o->frames, 0, 0,
-                           "frame %d: '%s' would replace the input '%s'; choose another pattern", frame, files[i],
-                           w->o->path);
-      return 1;
-    }
   vd_plant_spec* p = vd_plant_spec_copy(plant);
   w->st = p ? name_labels(w->o, w->ls, p, w->err) : vd_error_set(w->err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   if (!w->st) w->st = cli_write_plant(p, path, 0, w->err);
@@ -465,14 +474,78 @@ static int write_frame(void* user, int frame, const vd_lstring* s, const vd_plan
   return w->st != VD_OK;
 }
 
-// a failed run leaves no frame behind
-static void remove_frames(const frame_writer* w) {
-  for (int k = 0; k < w->last; k++) {
-    char files[2][4200], path[4200];
-    if (!cli_frame_name(w->o->frames, k, path, sizeof path)) continue;
-    int nf = cli_plant_files(path, files);
-    for (int i = 0; i < nf; i++) remove(files[i]);
+// an L-system's run: its --set overrides, derivation (or animation), interpretation, the
+// turtle, --call; the plant in *out
+static vd_status run_lsystem(const cli_plant_opts* o, vd_lsystem* ls, vd_plant_spec** out, cli_grow_info* info,
+                             vd_error* err) {
+  info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
+  vd_status st = VD_OK;
+  for (int i = 0; !st && i < o->nset; i++) {
+    char name[128];
+    const char* eq = strchr(o->set[i], '=');
+    size_t n = (size_t)(eq - o->set[i]);
+    if (n >= sizeof name) n = sizeof name - 1;
+    memcpy(name, o->set[i], n);
+    name[n] = 0;
+    st = vd_lsys_set_global(ls, name, eq + 1, err);
   }
+  vd_plant_spec* plant = st ? NULL : vd_plant_spec_create();
+  if (!st && !plant) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
+  vd_lsys_def def = vd_lsys_def_default();
+  def.steps = o->steps;
+  def.seed = o->seed;
+  def.max_modules = o->max_modules;
+  def.max_ops = o->max_ops;
+  if (o->progress) def.progress = progress_cb;
+  double t0 = cli_now();
+  frame_writer fw = {o, ls, err, VD_OK, 0};
+  if (o->frames) def.frame = write_frame, def.frame_user = &fw;
+  // an animation draws every frame and ends with the plant of the last (the turtle's time is in
+  // the derivation's)
+  if (!st) st = o->animate ? vd_lsys_animate(ls, &def, &derived, plant, err) : vd_lsys_derive(ls, &def, &derived, err);
+  if (fw.st) st = fw.st;
+  double t1 = cli_now();
+  if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
+  if (!st && !o->animate) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
+  if (!st && !o->animate) {
+    vd_turtle_def td = vd_turtle_def_default();
+    st = vd_turtle_run(ls, &geo, &td, plant, err);
+  }
+  double t2 = cli_now();
+  // the file's functions, after the run (a check() of its asserts)
+  for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
+  if (!st) st = name_labels(o, ls, plant, err);
+  if (!st && !derived.n && !vd_lsys_axiom_line(ls))
+    fprintf(stderr, "verdant: %s:1:1: warning: the file has no Axiom: line, so its L-string starts empty and the "
+            "plant is empty\n", o->path);
+  if (!st) {
+    // module counts by symbol for --stats
+    info->modules = derived.n;
+    info->nsym = vd_lsys_symbol_count(ls);
+    info->sym_count = vd_calloc((size_t)info->nsym, sizeof(int64_t));
+    info->sym_name = vd_calloc((size_t)info->nsym, sizeof(char*));
+    if (!info->sym_count || !info->sym_name) {
+      st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+    } else {
+      for (int64_t i = 0; i < derived.n; i++) info->sym_count[derived.sym[i]]++;
+      for (int k = 0; k < info->nsym && !st; k++) {
+        info->sym_name[k] = vd_strdup(vd_lsys_symbol_name(ls, k));
+        if (!info->sym_name[k]) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
+      }
+    }
+    info->seconds_derive = t1 - t0;
+    info->seconds_turtle = t2 - t1;
+  }
+  vd_lstring_free(&derived);
+  vd_lstring_free(&geo);
+  if (st) {
+    vd_plant_spec_destroy(plant);
+    cli_grow_info_free(info);
+    return st;
+  }
+  *out = plant;
+  return VD_OK;
 }
 
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
@@ -517,72 +590,14 @@ vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_
   vd_lsystem* ls;
   st = vd_lsys_load_engine(o->path, (vd_lsys_engine)o->engine, &ls, err);
   if (st) return st;
-  info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
-  for (int i = 0; !st && i < o->nset; i++) {
-    char name[128];
-    const char* eq = strchr(o->set[i], '=');
-    size_t n = (size_t)(eq - o->set[i]);
-    if (n >= sizeof name) n = sizeof name - 1;
-    memcpy(name, o->set[i], n);
-    name[n] = 0;
-    st = vd_lsys_set_global(ls, name, eq + 1, err);
+  st = run_lsystem(o, ls, out, info, err);
+  // what the native engine refuses only when it runs: the automatic choice runs it in CPython
+  if (st && vd_lsys_fallback(&ls, st)) {
+    memset(err, 0, sizeof *err);
+    st = run_lsystem(o, ls, out, info, err);
   }
-  vd_plant_spec* plant = st ? NULL : vd_plant_spec_create();
-  if (!st && !plant) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
-  vd_lsys_def def = vd_lsys_def_default();
-  def.steps = o->steps;
-  def.seed = o->seed;
-  def.max_modules = o->max_modules;
-  def.max_ops = o->max_ops;
-  if (o->progress) def.progress = progress_cb;
-  double t0 = cli_now();
-  frame_writer fw = {o, ls, err, VD_OK, 0};
-  if (o->frames) def.frame = write_frame, def.frame_user = &fw;
-  // an animation draws every frame and ends with the plant of the last (the turtle's time is in
-  // the derivation's)
-  if (!st) st = o->animate ? vd_lsys_animate(ls, &def, &derived, plant, err) : vd_lsys_derive(ls, &def, &derived, err);
-  if (fw.st) st = fw.st;
-  double t1 = cli_now();
-  if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
-  if (!st && !o->animate) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
-  if (!st && !o->animate) {
-    vd_turtle_def td = vd_turtle_def_default();
-    st = vd_turtle_run(ls, &geo, &td, plant, err);
-  }
-  double t2 = cli_now();
-  // the file's functions, after the run (a check() of its asserts)
-  for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
-  if (!st) st = name_labels(o, ls, plant, err);
-  if (st && o->frames) remove_frames(&fw);
-  if (!st) {
-    // module counts by symbol for --stats
-    info->modules = derived.n;
-    info->nsym = vd_lsys_symbol_count(ls);
-    info->sym_count = vd_calloc((size_t)info->nsym, sizeof(int64_t));
-    info->sym_name = vd_calloc((size_t)info->nsym, sizeof(char*));
-    if (!info->sym_count || !info->sym_name) {
-      st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-    } else {
-      for (int64_t i = 0; i < derived.n; i++) info->sym_count[derived.sym[i]]++;
-      for (int k = 0; k < info->nsym && !st; k++) {
-        info->sym_name[k] = vd_strdup(vd_lsys_symbol_name(ls, k));
-        if (!info->sym_name[k]) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-      }
-    }
-    info->seconds_derive = t1 - t0;
-    info->seconds_turtle = t2 - t1;
-  }
-  vd_lstring_free(&derived);
-  vd_lstring_free(&geo);
   vd_lsys_destroy(ls);
-  if (st) {
-    vd_plant_spec_destroy(plant);
-    cli_grow_info_free(info);
-    return st;
-  }
-  *out = plant;
-  return VD_OK;
+  return st;
 }
 
 void cli_grow_info_free(cli_grow_info* info) {

@@ -54,7 +54,8 @@ static const char* dataset_usage =
     "                        by the item; needs an OpenGL context (EGL, software without a GPU)\n"
     "      --image-size WxH  size of those pictures in pixels (default 640x480)\n"
     "      --force           remake complete items too\n"
-    "      --stats           print a JSON summary on stdout (made, skipped, seconds, items/s)\n";
+    "      --stats           print a JSON summary on stdout (made, skipped, points, manifest)\n"
+    "      --profile         --stats adds seconds and items_per_second (timings)\n";
 
 typedef struct vary {
   char name[64];
@@ -150,7 +151,6 @@ static vd_status write_json(const char* path, const cJSON* root, int pretty, vd_
   char* text = pretty ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
   if (!text) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
@@ -158,7 +158,6 @@ static vd_status write_json(const char* path, const cJSON* root, int pretty, vd_
     st = vd_outfile_commit(&f, err);
     vd_outfile_abort(&f);
   }
-  cli_unwatch(w);
   cJSON_free(text);
   return st;
 }
@@ -241,11 +240,11 @@ static int remove_stale(const dataset* ds) {
       long index = strtol(e->d_name + 5, &iend, 10);
       mine = iend != e->d_name + 5 && index >= 0 && index % ds->nshard == ds->shard;
     }
+    if (!mine) continue;
     // only when no process of that id runs here (another machine's run keeps its files)
-    if (!mine || kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
     char path[4200];
     snprintf(path, sizeof path, "%s/%s", ds->dir, e->d_name);
-    removed += unlink(path) == 0;
+    removed += cli_out_drop_orphan(path);
   }
   closedir(dir);
   return removed;
@@ -388,9 +387,9 @@ static vd_status make_item_files(const dataset* ds, render_pool* pool, const cli
     return st;
   }
   // the record: seed, values, counts, the file's size and checksum
-  char hex[65];
+  char hex[65], now[4300];
   int64_t bytes;
-  if (!sha256_file(cpath, hex, &bytes)) {
+  if (!sha256_file(cli_out_current(cpath, now, sizeof now), hex, &bytes)) {
     *out_failed = 1;
     vd_cloud_free(&res.cloud);
     return vd_error_set(err, VD_ERR_IO, cpath, 0, 0, "cannot read back the cloud: %s", strerror(errno));
@@ -455,7 +454,7 @@ static void progress(const dataset* ds, int done, int total, double t0) {
     bar[k] = k < fill ? '#' : ' ';
   bar[w] = 0;
   fprintf(stderr, "\rdataset [%s] %d/%d items, %.1f items/s, ETA %.0f s   ", bar, done, total, rate, eta);
-  if (done == total) fputc('\n', stderr);
+  if (done == total) cli_progress_clear();
   fflush(stderr);
 }
 
@@ -611,10 +610,8 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
   char path[4200];
   snprintf(path, sizeof path, "%s/manifest.json", ds->dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (st) {
-    cli_unwatch(w);
     cJSON_Delete(labels);
     return -1;
   }
@@ -679,7 +676,6 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
     cJSON* rec = complete_record(ds, i, &mismatch);
     if (!rec) {  // removed since the first pass
       vd_outfile_abort(&f);
-      cli_unwatch(w);
       return 1;
     }
     if (!ds->instance_labels) cJSON_DeleteItemFromObjectCaseSensitive(rec, "labels");
@@ -697,12 +693,10 @@ static int write_manifest(const dataset* ds, const cli_plant_opts* po, vd_error*
   fputs("]\n}\n", fp);
   if (!ok) {
     vd_outfile_abort(&f);
-    cli_unwatch(w);
     vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
     return -1;
   }
   st = vd_outfile_commit(&f, err);
-  cli_unwatch(w);
   return st ? -1 : 0;
 }
 
@@ -726,10 +720,14 @@ static vd_status make_item(const dataset* ds, render_pool* pool, const cli_plant
     for (int k = 0; k < 5 && !st; k++)
       if (!(path[2 + 5 * v + k] = vd_strdup(buf[k]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   }
-  cli_outset set;
-  if (!st && (st = cli_outset_begin(&set, (const char* const*)path, n, NULL, err)) == VD_OK) {
+  if (!st) {
+    // a complete item is put in place now (an interrupted dataset resumes from it); a failed one
+    // leaves the item of an earlier run as it was
     st = make_item_files(ds, pool, po0, co, i, points, out_failed, err);
-    cli_outset_end(&set, st == VD_OK);
+    if (cli_out_publish((const char* const*)path, n, st == VD_OK) && !st) {
+      st = vd_error_set(err, VD_ERR_IO, path[0], 0, 0, "cannot put the item's files in place");
+      *out_failed = 1;
+    }
   } else {
     *out_failed = st != VD_ERR_NOMEM;
   }
@@ -783,7 +781,7 @@ static int check_vary(const dataset* ds, const char* path) {
 // options that do not change what an item holds: left out of the parameter id
 static int neutral_option(const char* a, int* takes_value) {
   static const char* with_value[] = {"-o", "--output", "--jobs", "--shard", "--threads", "-K", "--count"};
-  static const char* flags[] = {"--force", "--no-progress", "--stats"};
+  static const char* flags[] = {"--force", "--no-progress", "--stats", "--profile"};
   for (size_t k = 0; k < sizeof with_value / sizeof *with_value; k++)
     if (!strcmp(a, with_value[k])) return *takes_value = 1, 1;
   for (size_t k = 0; k < sizeof flags / sizeof *flags; k++)
@@ -805,7 +803,7 @@ int cli_dataset(int argc, char** argv) {
   ds.argc = argc, ds.argv = argv;
   int image_size_given = 0;
   ds.progress = po.progress;
-  int stats = 0;
+  int stats = 0, profile = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -865,6 +863,8 @@ int cli_dataset(int argc, char** argv) {
       ds.force = 1;
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      profile = 1;
     } else if (a[0] == '-' && a[1]) {
       return cli_usage_error("dataset", "unknown option '%s'", a);
     } else if (!po.path) {
@@ -876,6 +876,7 @@ int cli_dataset(int argc, char** argv) {
   if (!po.path) return cli_usage_error("dataset", "missing PLANT (an .lpy or plant .json file)");
   if (ds.count < 0) return cli_usage_error("dataset", "missing --count K");
   if (!ds.dir) return cli_usage_error("dataset", "missing -o DIR");
+  if (profile && !stats) return cli_usage_error("dataset", "--profile adds timings to --stats; give --stats");
   if (ds.nvary && !cli_has_ext(po.path, ".lpy")) return cli_usage_error("dataset", "--vary applies to .lpy files only");
   if (cli_cloud_check(&co, "dataset") || cli_cloud_check_output(&co, "dataset", ds.ext)) return EXIT_USAGE;
   if (co.has_cloud_seed)
@@ -885,15 +886,13 @@ int cli_dataset(int argc, char** argv) {
   if (ds.view.given && !ds.images)
     return cli_usage_error("dataset", "the picture options (--no-shadows, --palette, --view-*, --vary-light, "
                                       "--vary-background, ...) go with --images N");
-  // no output may replace an input: the dataset writes manifest.json and item_* in DIR
-  const char* ins[2] = {po.path, co.scanners_file};
-  for (int k = 0; k < 2; k++) {
-    const char* base = ins[k] ? strrchr(ins[k], '/') : NULL;
-    base = base ? base + 1 : ins[k];
-    if (ins[k] && cli_in_folder(ds.dir, ins[k]) && (!strcmp(base, "manifest.json") || !strncmp(base, "item_", 5)))
-      return cli_usage_error("dataset", "the input '%s' lies in the dataset folder '%s' under a name the dataset "
-                             "writes (manifest.json, item_*); move it or choose another folder", ins[k], ds.dir);
-  }
+  // the files: the plant and the scanners read; the dataset folder written (manifest.json and
+  // item_*; complete items are kept, so an interrupted dataset resumes)
+  static const char* const members[] = {"manifest.json", "item_*"};
+  cli_out_plant_opts(&po);
+  cli_out_input("--scanners", co.scanners_file);
+  cli_out_folder("-o", ds.dir, members, 2, 0);
+  if (cli_out_check("dataset")) return EXIT_USAGE;
   ds.master = po.seed;
   ds.instance_labels = co.labels_instance;
   ds.progress = po.progress;
@@ -918,10 +917,11 @@ int cli_dataset(int argc, char** argv) {
     cJSON_Delete(ds.arguments);
     return EXIT_USAGE;
   }
-  int made_dir = mkdir(ds.dir, 0777) == 0;
-  if (!made_dir && errno != EEXIST) {
+  vd_error derr = {0};
+  vd_status dst = vd_outdir_make(ds.dir, &derr);
+  if (dst) {
     cJSON_Delete(ds.arguments);
-    fprintf(stderr, "verdant dataset: %s: cannot create the folder: %s\n", ds.dir, strerror(errno));
+    cli_report("dataset", &derr, dst);
     return EXIT_FAIL;
   }
   remove_stale(&ds);
@@ -967,7 +967,6 @@ int cli_dataset(int argc, char** argv) {
       vd_free(todo, (size_t)ds.count * sizeof(int));
       cJSON_Delete(ds.arguments);
       cli_report("dataset", &first, st);
-      if (made_dir) rmdir(ds.dir);
       return EXIT_FAIL;
     }
     pool_put(&pool, slot);
@@ -1002,11 +1001,10 @@ int cli_dataset(int argc, char** argv) {
   pool_free(&pool);
   if (failed_item >= 0) {
     cJSON_Delete(ds.arguments);
-    if (ds.progress) fputc('\n', stderr);
+    if (ds.progress) cli_progress_clear();
     char buf[1024];
     fprintf(stderr, "verdant dataset: item %d: %s\n", failed_item,
             first.status ? vd_error_format(&first, buf, sizeof buf) : vd_status_str(first_st));
-    if (made_dir) rmdir(ds.dir);  // a folder made for a dataset that failed goes when empty
     // writing the dataset failed (disk full, unwritable) or memory ran out: a failed run;
     // anything else is bad input
     return failed_output || first_st == VD_ERR_NOMEM ? EXIT_FAIL : cli_exit_code(first_st);
@@ -1018,9 +1016,10 @@ int cli_dataset(int argc, char** argv) {
   if (m < 0) return cli_report("dataset", &err, err.status);
   double el = cli_now() - t0;
   if (stats) {
-    printf("{\n\t\"made\":\t%d,\n\t\"skipped\":\t%d,\n\t\"points\":\t%lld,\n\t\"manifest\":\t%s,\n"
-           "\t\"seconds\":\t%.6f,\n\t\"items_per_second\":\t%.3f\n}\n",
-           done, skipped, (long long)points, m == 0 ? "true" : "false", el, el > 0 ? done / el : 0.0);
+    printf("{\n\t\"made\":\t%d,\n\t\"skipped\":\t%d,\n\t\"points\":\t%lld,\n\t\"manifest\":\t%s", done, skipped,
+           (long long)points, m == 0 ? "true" : "false");
+    if (profile) printf(",\n\t\"seconds\":\t%.6f,\n\t\"items_per_second\":\t%.3f", el, el > 0 ? done / el : 0.0);
+    printf("\n}\n");
   }
   return EXIT_OK;
 }

@@ -21,7 +21,8 @@ static const char* grow_help =
     "      --stats           print a JSON summary on stdout (modules, module_counts, segments,\n"
     "                        spheres, leaves, labels (instances per label), organs (per label:\n"
     "                        count, length, area, volume, mean diameter), bbox_min, bbox_max (m),\n"
-    "                        total_length (m))\n"
+    "                        total_length (m)); the same bytes for the same inputs\n"
+    "      --profile         --stats adds seconds (derive, turtle): timings, which differ per run\n"
     "      --traits FILE     per-instance traits as CSV: instance, label, label_name, organ,\n"
     "                        segments, spheres, meshes, length_m, area_m2, diameter_m, volume_m3,\n"
     "                        bbox (m)\n"
@@ -120,7 +121,8 @@ static cJSON* vec_json(vd_vec3 v) {
   return cJSON_CreateDoubleArray(a, 3);
 }
 
-static int print_stats(const vd_plant_spec* p, const cli_grow_info* info, const vd_organ_traits* tr, int ntr) {
+static int print_stats(const vd_plant_spec* p, const cli_grow_info* info, const vd_organ_traits* tr, int ntr,
+                       int profile) {
   cJSON* root = cJSON_CreateObject();
   if (!root) return 0;
   vd_plant_stats ps;
@@ -143,9 +145,11 @@ static int print_stats(const vd_plant_spec* p, const cli_grow_info* info, const 
   cJSON_AddItemToObject(root, "bbox_min", vec_json(ps.bbox_min));
   cJSON_AddItemToObject(root, "bbox_max", vec_json(ps.bbox_max));
   cJSON_AddNumberToObject(root, "total_length", ps.total_length);
-  cJSON* t = cJSON_AddObjectToObject(root, "seconds");
-  cJSON_AddNumberToObject(t, "derive", info->seconds_derive);
-  cJSON_AddNumberToObject(t, "turtle", info->seconds_turtle);
+  if (profile) {
+    cJSON* t = cJSON_AddObjectToObject(root, "seconds");
+    cJSON_AddNumberToObject(t, "derive", info->seconds_derive);
+    cJSON_AddNumberToObject(t, "turtle", info->seconds_turtle);
+  }
   char* text = cJSON_Print(root);
   int ok = text != NULL;
   if (text) {
@@ -162,7 +166,7 @@ int cli_grow(int argc, char** argv) {
   cli_plant_opts_init(&po);
   const char* out = NULL;
   const char* traits = NULL;
-  int stats = 0, ascii = 0;
+  int stats = 0, ascii = 0, profile = 0;
   for (int i = 1; i < argc; i++) {
     const char* a = argv[i];
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -178,6 +182,8 @@ int cli_grow(int argc, char** argv) {
       out = argv[++i];
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      profile = 1;
     } else if (!strcmp(a, "--traits")) {
       if (i + 1 >= argc) return cli_usage_error("grow", "%s needs a file name", a);
       if (traits) return cli_usage_error("grow", "--traits given 2 times");
@@ -218,13 +224,14 @@ int cli_grow(int argc, char** argv) {
     return cli_usage_error("grow", "nothing to do: give -o OUT, --frames PATTERN, --traits FILE, --call NAME and/or --stats");
   if (out && !cli_has_ext(out, ".json") && !cli_has_ext(out, ".obj") && !cli_has_ext(out, ".ply"))
     return cli_usage_error("grow", "output '%s': unknown format (use .json, .obj or .ply)", out);
+  if (profile && !stats) return cli_usage_error("grow", "--profile adds timings to --stats; give --stats");
   if (ascii && !(out && cli_has_ext(out, ".ply")))
     return cli_usage_error("grow", "--ascii applies to a .ply output (plant JSON and OBJ are text already)");
-  char files[2][4200];
-  const char* outs[3] = {files[0], files[1], NULL};
-  int nf = out ? cli_plant_files(out, files) : 0;
-  if (traits) outs[nf++] = traits;
-  if (cli_check_outputs("grow", outs, nf, (const char* const[]){po.path}, 1)) return EXIT_USAGE;
+  // the files: declared and checked before anything runs
+  cli_out_plant_opts(&po);
+  if (out) cli_out_plant("-o", out);
+  if (traits) cli_out_file("--traits", traits);
+  if (cli_out_check("grow")) return EXIT_USAGE;
   vd_error err = {0};
   vd_plant_spec* plant;
   cli_grow_info info;
@@ -239,20 +246,11 @@ int cli_grow(int argc, char** argv) {
     vd_error_set(&err, st, "", 0, 0, "out of memory");
     return cli_report("grow", &err, st);
   }
-  // the file, its material library and the traits: together or not at all
-  cli_outset set;
-  if (nf && (st = cli_outset_begin(&set, outs, nf, NULL, &err))) {
-    vd_plant_spec_destroy(plant);
-    cli_grow_info_free(&info);
-    vd_free(tr, (size_t)ntr * sizeof *tr);
-    cli_report("grow", &err, st);
-    return EXIT_FAIL;
-  }
+  // the file, its material library and the traits: in place together when the command ends
   if (out) st = cli_write_plant(plant, out, ascii, &err);
   if (!st && traits) st = write_traits(traits, plant, tr, ntr, &err);
-  if (nf) cli_outset_end(&set, st == VD_OK);
   cli_blame_input(&err, po.path);  // a plant that does not compile (output errors name the output)
-  if (!st && stats && !print_stats(plant, &info, tr, ntr)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  if (!st && stats && !print_stats(plant, &info, tr, ntr, profile)) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   vd_free(tr, (size_t)ntr * sizeof *tr);
   vd_plant_spec_destroy(plant);
   cli_grow_info_free(&info);

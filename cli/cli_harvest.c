@@ -7,6 +7,7 @@
 // RUN/episodes.csv and RUN/summary.json with success rates and force statistics.
 #define _POSIX_C_SOURCE 200809L
 #include <cjson/cJSON.h>
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -28,7 +29,10 @@ static const char* harvest_help =
     "\n"
     "  -o, --output RUN   write RUN/summary.json, RUN/events.csv, RUN/trajectory.csv and the\n"
     "                     frames that 'verdant render RUN/' draws (plant and robot)\n"
-    "      --stats        print the summary (JSON) on stdout\n"
+    "      --stats        print the summary (JSON) on stdout; the same bytes for the same\n"
+    "                     inputs, as RUN/summary.json\n"
+    "      --profile      the summaries add wall_seconds and real_time_factor (a batch:\n"
+    "                     wall_seconds, episodes_per_minute): timings, which differ per run\n"
     "      --episodes N   a batch of N episodes, randomised as the scene's \"episodes\" says\n"
     "                     (plant seed, target, method parameters; one seed per episode):\n"
     "                     RUN/episodes/NNNNNN.json each, RUN/episodes.csv, RUN/summary.json\n"
@@ -44,7 +48,7 @@ static const char* harvest_help =
 typedef struct harvest_opts {
   const char* scene;
   const char* out;
-  int stats, episodes, jobs, progress, two_way;  // two_way: -1 the scene's
+  int stats, episodes, jobs, progress, two_way, profile;  // two_way: -1 the scene's
   uint64_t seed;
   const char* frames;
   double duration;  // < 0: the scene's
@@ -65,6 +69,8 @@ static int parse_args(int argc, char** argv, harvest_opts* o) {
       o->out = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      o->profile = 1;
     } else if (!strcmp(a, "--episodes")) {
       TAKE();
       int64_t n;
@@ -182,13 +188,11 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
 // write text to path atomically
 static vd_status write_text(const char* path, const char* text, vd_error* err) {
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     st = vd_outfile_commit(&f, err);
   }
-  cli_unwatch(w);
   return st;
 }
 
@@ -209,10 +213,8 @@ static vd_status write_events(const vd_harvest* h, const char* dir, vd_error* er
   char path[4200];
   snprintf(path, sizeof path, "%s/events.csv", dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (st) {
-    cli_unwatch(w);
     return st;
   }
   fputs("time_s,event,value,segment,instance,class,force_N,moment_Nm,site\n", f.fp);
@@ -229,7 +231,6 @@ static vd_status write_events(const vd_harvest* h, const char* dir, vd_error* er
             e->kind == VD_EV_DETACH ? vd_harvest_site_name(e->site) : "");
   }
   st = vd_outfile_commit(&f, err);
-  cli_unwatch(w);
   return st;
 }
 
@@ -238,7 +239,7 @@ typedef struct episode_out {
   const harvest_opts* o;
   cli_frames frames;
   vd_outfile traj;
-  int traj_open, traj_watch, progress;
+  int traj_open, progress;
   double next_frame, fps;
   int write_failed;
 } episode_out;
@@ -290,6 +291,33 @@ static void override(const harvest_opts* o, vd_scene* s) {
   if (o->frames) s->frames = !strcmp(o->frames, "none") ? 0 : !strcmp(o->frames, "bin") ? 1 : 2;
 }
 
+// the outcome of an episode as one line on stderr (without --stats: the run folder alone would
+// say nothing, terminal or not)
+static void outcome_line(const vd_harvest* h, const char* out) {
+  vd_harvest_summary r;
+  vd_harvest_summarize(h, &r);
+  char detail[160] = "";
+  if (r.detached)
+    snprintf(detail, sizeof detail, ", detached at %.3f s (site %s, pull force %.3g N)", r.time,
+             vd_harvest_site_name(r.site), r.pull_force);
+  fprintf(stderr, "verdant harvest: %s: fruit %d %s%s; %s\n", r.reason, r.target_instance,
+          r.grasped ? "grasped" : "not grasped", detail, out);
+}
+
+// the files a scene names are there; else exit 2 naming the key, the path and the folder a
+// relative path is read from (a broken "../tomato.lpy" said only that a file was missing)
+static int scene_files_exist(const vd_scene* s) {
+  const char* key[2] = {"plant.file", "robot.mjcf"};
+  const char* path[2] = {s->plant_path, s->robot_path};
+  for (int k = 0; k < 2; k++)
+    if (path[k][0] && access(path[k], F_OK) != 0) {
+      fprintf(stderr, "verdant harvest: %s: %s: '%s' does not exist (%s; a relative path is read from the scene's folder)\n",
+              s->path, key[k], path[k], strerror(errno));
+      return 0;
+    }
+  return 1;
+}
+
 static int run_one(const harvest_opts* o, vd_scene* s) {
   vd_error err = {0};
   vd_plant_spec* spec = NULL;
@@ -299,7 +327,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
   episode_out eo;
   memset(&eo, 0, sizeof eo);
   eo.o = o;
-  eo.frames.watch = eo.frames.cwatch = eo.traj_watch = -1;
   eo.fps = s->fps;
   eo.progress = o->progress;
   vd_status st = scene_plant(s, &spec, &plant, &err);
@@ -316,12 +343,10 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     // no reachable target: a clean outcome, said on stderr
     char buf[1024];
     fprintf(stderr, "verdant harvest: %s\n", vd_error_format(&err, buf, sizeof buf));
-    st = VD_OK;
   }
   // the run folder: a simulation run (for 'verdant render RUN/') plus the harvest's files
   if (o->out) {
-    if (mkdir(o->out, 0777) && errno != EEXIST)
-      st = vd_error_set(&err, VD_ERR_IO, o->out, 0, 0, "cannot create the output folder: %s", strerror(errno));
+    st = vd_outdir_make(o->out, &err);
     if (!st) st = cli_rod_json_write(vd_harvest_sim_model(h), plant, &s->sim_def, o->out, &err);
     char path[4200];
     if (!st) {
@@ -331,7 +356,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     if (!st && s->frames) st = cli_frames_begin(&eo.frames, vd_harvest_sim_model(h), o->out, s->frames == 2, &err);
     if (!st) {
       snprintf(path, sizeof path, "%s/trajectory.csv", o->out);
-      eo.traj_watch = cli_watch(path);
       st = vd_outfile_open(&eo.traj, path, &err);
       if (!st) {
         eo.traj_open = 1;
@@ -351,7 +375,7 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
   double t0 = cli_now();
   st = vd_harvest_run(h, on_step, &eo, &err);
   double wall = cli_now() - t0;
-  if (eo.progress) progress_bar(vd_harvest_sim_data(h)->time, s->duration), fputc('\n', stderr);
+  if (eo.progress) cli_progress_clear();
   if (st && !eo.write_failed) {
     cli_report("harvest", &err, st);
     code = EXIT_FAIL;
@@ -368,15 +392,16 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     if (!st) st = write_events(h, o->out, &err);
     char path[4200];
     snprintf(path, sizeof path, "%s/summary.json", o->out);
-    if (!st) st = write_json(path, summary_json(h, wall), &err);
+    if (!st) st = write_json(path, summary_json(h, o->profile ? wall : -1), &err);
     if (st) {
       cli_report("harvest", &err, st);
       code = EXIT_FAIL;
       goto done;
     }
   }
+  if (!o->stats) outcome_line(h, o->out);
   if (o->stats) {
-    cJSON* j = summary_json(h, wall);
+    cJSON* j = summary_json(h, o->profile ? wall : -1);
     char* text = j ? cJSON_Print(j) : NULL;
     cJSON_Delete(j);
     if (!text) {
@@ -388,7 +413,6 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
   }
 done:
   if (eo.traj_open) vd_outfile_abort(&eo.traj);
-  cli_unwatch(eo.traj_watch);
   cli_frames_abort(&eo.frames);
   vd_harvest_destroy(h);
   vd_model_destroy(plant);
@@ -445,6 +469,23 @@ static cJSON* complete_record(const batch* b, int k, int* mismatch) {
   return r;
 }
 
+// which of episodes 0..n-1 have a record file in the folder sub (calloc'd flags; NULL out of
+// memory): one listing of the folder, not a look-up per episode, so that a batch of millions
+// starts at once
+static unsigned char* recorded_episodes(const char* sub, int n) {
+  unsigned char* has = vd_calloc((size_t)n, 1);
+  DIR* d = has ? opendir(sub) : NULL;
+  if (!d) return has;
+  const struct dirent* e;
+  while ((e = readdir(d))) {
+    char* end;
+    long k = strtol(e->d_name, &end, 10);
+    if (end != e->d_name && !strcmp(end, ".json") && k >= 0 && k < n) has[k] = 1;
+  }
+  closedir(d);
+  return has;
+}
+
 // run episode k and write its record
 static vd_status make_episode(const batch* b, int k, vd_error* err) {
   vd_scene s;
@@ -476,6 +517,9 @@ static vd_status make_episode(const batch* b, int k, vd_error* err) {
     char path[4300];
     record_path(b, k, path, sizeof path);
     st = write_json(path, r, err);
+    // a complete episode is kept even when the batch stops later (it resumes from there)
+    const char* done[1] = {path};
+    if (!st && cli_out_publish(done, 1, 1)) st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot put the record in place");
   }
   vd_harvest_destroy(h);
   vd_model_destroy(plant);
@@ -489,7 +533,8 @@ static int cmp_double(const void* a, const void* b) {
   return x < y ? -1 : x > y;
 }
 
-// statistics of n values (sorted in place): count, mean, sd, min, quartiles, max
+// statistics of n values (sorted in place): count, mean, sd, min, quartiles (linear
+// interpolation: vd_quantile_sorted), max
 static cJSON* stats_json(double* v, int n) {
   cJSON* o = cJSON_CreateObject();
   cJSON_AddNumberToObject(o, "n", n);
@@ -502,9 +547,9 @@ static cJSON* stats_json(double* v, int n) {
   cJSON_AddNumberToObject(o, "mean", mean);
   cJSON_AddNumberToObject(o, "sd", n > 1 ? sqrt(s2 / (n - 1)) : 0);
   cJSON_AddNumberToObject(o, "min", v[0]);
-  cJSON_AddNumberToObject(o, "q25", v[(n - 1) / 4]);
-  cJSON_AddNumberToObject(o, "median", v[(n - 1) / 2]);
-  cJSON_AddNumberToObject(o, "q75", v[3 * (n - 1) / 4]);
+  cJSON_AddNumberToObject(o, "q25", vd_quantile_sorted(v, n, 0.25));
+  cJSON_AddNumberToObject(o, "median", vd_quantile_sorted(v, n, 0.5));
+  cJSON_AddNumberToObject(o, "q75", vd_quantile_sorted(v, n, 0.75));
   cJSON_AddNumberToObject(o, "max", v[n - 1]);
   return o;
 }
@@ -525,7 +570,6 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
   char path[4300];
   snprintf(path, sizeof path, "%s/episodes.csv", b->dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, &err);
   double* force = vd_malloc(sizeof(double) * (size_t)n * 2);
   double* pforce = force ? force + n : NULL;
@@ -572,7 +616,6 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
     if (st) vd_outfile_abort(&f);
     else st = vd_outfile_commit(&f, &err);
   }
-  cli_unwatch(w);
   cJSON* o = st ? NULL : cJSON_CreateObject();
   if (o) {
     cJSON_AddStringToObject(o, "format", "verdant-harvest-batch");
@@ -598,8 +641,10 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
     cJSON_AddItemToObject(o, "pedicel_force", stats_json(pforce, nf));
     cJSON_AddNumberToObject(o, "made", made);
     cJSON_AddNumberToObject(o, "skipped", skipped);
-    cJSON_AddNumberToObject(o, "wall_seconds", wall);
-    cJSON_AddNumberToObject(o, "episodes_per_minute", wall > 0 ? 60.0 * made / wall : 0);
+    if (b->o->profile) {  // timings: only when asked (the same inputs write the same bytes)
+      cJSON_AddNumberToObject(o, "wall_seconds", wall);
+      cJSON_AddNumberToObject(o, "episodes_per_minute", wall > 0 ? 60.0 * made / wall : 0);
+    }
   }
   vd_free(force, sizeof(double) * (size_t)n * 2);
   if (!st && !o) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
@@ -614,8 +659,8 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
   }
   if (text) puts(text);
   else
-    fprintf(stderr, "verdant harvest: %d episodes: success rate %.3f (%d harvested, %d detached, %d grasped); %s\n",
-            n, n ? (double)nharvest / n : 0, nharvest, ndetached, ngrasp, path);
+    fprintf(stderr, "verdant harvest: %d episode%s: success rate %.3f (%d harvested, %d detached, %d grasped); %s\n",
+            n, n == 1 ? "" : "s", n ? (double)nharvest / n : 0, nharvest, ndetached, ngrasp, path);
   free(text);
   return EXIT_OK;
 }
@@ -627,6 +672,7 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
   b.o = o;
   b.scene = s;
   snprintf(b.dir, sizeof b.dir, "%s", o->out);
+  for (size_t l = strlen(b.dir); l > 1 && b.dir[l - 1] == '/'; l--) b.dir[l - 1] = 0;  // RUN/ -> RUN/summary.json
   char* text;
   size_t len;
   vd_error err = {0};
@@ -639,22 +685,28 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
   snprintf(b.key, sizeof b.key, "%016llx", (unsigned long long)key);
   char sub[4300];
   snprintf(sub, sizeof sub, "%s/episodes", b.dir);
-  if ((mkdir(b.dir, 0777) && errno != EEXIST) || (mkdir(sub, 0777) && errno != EEXIST)) {
-    fprintf(stderr, "verdant harvest: %s: cannot create the folder: %s\n", sub, strerror(errno));
+  if ((st = vd_outdir_make(b.dir, &err)) || (st = vd_outdir_make(sub, &err))) {
+    cli_report("harvest", &err, st);
     return EXIT_FAIL;
   }
   int n = o->episodes;
   int* todo = vd_malloc(sizeof(int) * (size_t)n);
-  if (!todo) return cli_report("harvest", NULL, VD_ERR_NOMEM);
+  unsigned char* has = recorded_episodes(sub, n);
+  if (!todo || !has) {
+    vd_free(todo, sizeof(int) * (size_t)n);
+    vd_free(has, (size_t)n);
+    return cli_report("harvest", NULL, VD_ERR_NOMEM);
+  }
   int ntodo = 0, skipped = 0, mismatch_at = -1;
   for (int k = 0; k < n; k++) {
     int mm = 0;
-    cJSON* r = complete_record(&b, k, &mm);
+    cJSON* r = has[k] ? complete_record(&b, k, &mm) : NULL;
     if (mm && mismatch_at < 0) mismatch_at = k;
     if (r) skipped++;
     else todo[ntodo++] = k;
     cJSON_Delete(r);
   }
+  vd_free(has, (size_t)n);
   if (mismatch_at >= 0) {
     vd_free(todo, sizeof(int) * (size_t)n);
     fprintf(stderr,
@@ -667,7 +719,7 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
   int done = 0, failed = -1;
   vd_error first = {0};
   vd_status first_st = VD_OK;
-  if (o->progress) fprintf(stderr, "harvest: %d episodes (%d complete already)\n", n, skipped);
+  if (o->progress) fprintf(stderr, "harvest: %d episode%s (%d complete already)\n", n, n == 1 ? "" : "s", skipped);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(o->jobs)
   for (int i = 0; i < ntodo; i++) {
     int stop;
@@ -689,7 +741,7 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
       }
     }
   }
-  if (o->progress) fputc('\n', stderr);
+  if (o->progress) cli_progress_clear();
   vd_free(todo, sizeof(int) * (size_t)n);
   if (failed >= 0) {
     char buf[1024];
@@ -715,12 +767,36 @@ int cli_harvest(int argc, char** argv) {
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc;
   if (!o.scene) return cli_usage_error("harvest", "missing SCENE (a scene .json file)");
-  if (!o.out && !o.stats) return cli_usage_error("harvest", "nothing to do: give -o RUN and/or --stats");
+  // a scene that cannot be read says so before "nothing to do"
   vd_scene s;
   vd_error err = {0};
   vd_status st = vd_scene_read(o.scene, &s, &err);
   if (st) return cli_report("harvest", &err, st);
+  if (!scene_files_exist(&s)) {
+    vd_scene_free(&s);
+    return EXIT_USAGE;
+  }
+  if (!o.out && !o.stats) {
+    vd_scene_free(&s);
+    return cli_usage_error("harvest", "nothing to do: give -o RUN and/or --stats");
+  }
   override(&o, &s);
+  // the files: the scene and what it names read; the run folder written (a single run replaces
+  // an earlier one's files; a batch keeps its complete episodes and resumes)
+  static const char* const run_files[] = {"summary.json", "events.csv", "trajectory.csv"};
+  static const char* const batch_files[] = {"summary.json", "episodes.csv", "episodes/*.json"};
+  const char* members[32];
+  int nm = 0;
+  for (int k = 0; !o.episodes && k < cli_run_nmember && nm < 29; k++) members[nm++] = cli_run_members[k];
+  for (int k = 0; k < 3; k++) members[nm++] = o.episodes ? batch_files[k] : run_files[k];
+  cli_out_input("SCENE", o.scene);
+  cli_out_input("the scene's plant", s.plant_path);
+  cli_out_input("the scene's robot", s.robot_path);
+  if (o.out) cli_out_folder("-o", o.out, members, nm, !o.episodes);
+  if (cli_out_check("harvest")) {
+    vd_scene_free(&s);
+    return EXIT_USAGE;
+  }
   rc = o.episodes ? run_batch(&o, &s) : run_one(&o, &s);
   vd_scene_free(&s);
   return rc;

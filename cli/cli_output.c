@@ -42,13 +42,12 @@ int cli_plant_files(const char* path, char files[2][4200]) {
   return 2;
 }
 
-vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
-  // the file and, for OBJ, its material library: temporary names removed if a signal ends the run
+void cli_out_plant(const char* what, const char* path) {
   char files[2][4200];
   int nf = cli_plant_files(path, files);
-  int w0 = cli_watch(path), w1 = nf > 1 ? cli_watch(files[1]) : -1;
-  vd_status st = write_plant(plant, path, ascii, err);
-  cli_unwatch(w0);
-  cli_unwatch(w1);
-  return st;
+  for (int k = 0; k < nf; k++) cli_out_file(what, files[k]);
+}
+
+vd_status cli_write_plant(const vd_plant_spec* plant, const char* path, int ascii, vd_error* err) {
+  return write_plant(plant, path, ascii, err);
 }

@@ -60,9 +60,11 @@ static const char* render_help =
 static const char* render_help_run =
     "simulation runs (RUN/ holds rod.json, plant_initial.json, frames, colliders.jsonl):\n"
     "  -o OUT.png            one frame: the one nearest --time T (s), default the last\n"
-    "  -o DIR/               every frame: DIR/frame_00000.png ... (and their depth, masks and\n"
+    "  -o DIR/               every frame (a name ending in /, a folder or without extension):\n"
+    "                        DIR/frame_00000.png ... (and their depth, masks and\n"
     "                        sidecars), DIR/frames.json (index: frame times and files)\n"
-    "      --time T          simulated time of the frame to draw (s), nearest frame\n"
+    "      --time T          simulated time of the frame to draw (s), nearest frame; within\n"
+    "                        the run's time range\n"
     "      --mp4 OUT.mp4     every frame as an H.264 video (needs Debian's ffmpeg; skipped\n"
     "                        with a message when it is not installed)\n"
     "      --fps N           frame rate of the video (default: the run's, from its frame times)\n"
@@ -370,17 +372,9 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
   sibling(out, "label.png", p_label, sizeof p_label);
   sibling(out, "instance.png", p_inst, sizeof p_inst);
   snprintf(p_json, sizeof p_json, "%s.json", out);
-  // the files appear together or not at all; an interrupt removes their temporary files
-  char set_path[5][4200];
-  const char* set_out[5];
-  int nset = cli_frame_files(out, depth, masks, set_path);
-  for (int k = 0; k < nset; k++) set_out[k] = set_path[k];
-  cli_outset set;
-  vd_status st = cli_outset_begin(&set, set_out, nset, NULL, err);
-  if (st) return st;
-  int watch[5] = {cli_watch(out), cli_watch(p_depth), cli_watch(p_label), cli_watch(p_inst), cli_watch(p_json)};
-  // colour, then depth and masks, then the sidecar naming them
-  st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
+  // colour, then depth and masks, then the sidecar naming them (the output layer puts them in
+  // place together)
+  vd_status st = vd_render_write_png(f, VD_LAYER_COLOR, out, err);
   if (!st && depth) st = vd_render_write_png(f, VD_LAYER_DEPTH, p_depth, err);
   if (!st && masks) st = vd_render_write_png(f, VD_LAYER_LABEL, p_label, err);
   if (!st && masks) st = vd_render_write_png(f, VD_LAYER_INSTANCE, p_inst, err);
@@ -396,8 +390,6 @@ vd_status cli_frame_write(const vd_frame* f, const char* out, int depth, int mas
     files[nf] = NULL;
     st = vd_render_write_json(f, files, p_json, err);
   }
-  for (int k = 0; k < 5; k++) cli_unwatch(watch[k]);
-  cli_outset_end(&set, st == VD_OK);
   return st;
 }
 
@@ -438,13 +430,13 @@ int cli_render(int argc, char** argv) {
     return cli_usage_error("render", "--time, --mp4, --fps and --displacement-from first apply to "
                                      "simulation runs (a folder of 'verdant sim -o')");
   {
-    // no output may replace an input (the plant file, the robot)
+    // the files: the plant (or cloud) and the robot read, the picture and its layers written
     char files[5][4200];
-    const char* outs[5];
     int nout = cli_frame_files(o.out, o.depth, o.masks, files);
-    for (int k = 0; k < nout; k++) outs[k] = files[k];
-    const char* ins[2] = {o.po.path, o.def.robot_mjcf};
-    if (cli_check_outputs("render", outs, nout, ins, 2)) return EXIT_USAGE;
+    cli_out_plant_opts(&o.po);
+    cli_out_input("--robot", o.def.robot_mjcf);
+    for (int k = 0; k < nout; k++) cli_out_file("-o", files[k]);
+    if (cli_out_check("render")) return EXIT_USAGE;
   }
   // meshes (.obj, a .ply with faces: what 'verdant grow' writes), point clouds in any format the
   // cloud module reads; everything else is a plant

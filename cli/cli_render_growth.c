@@ -89,6 +89,26 @@ int cli_render_growth(const cli_render_opts* o) {
   vd_model* model = NULL;
   vd_status st = read_index(o->po.path, &s, &n, &err);
   if (st) return cli_report(cmd, &err, st);
+  // the files: the run's index and ages and the robot read; a picture (and its layers) or a
+  // folder of one per age written (an earlier render's ages there that this one does not draw go)
+  static const char* const age_files[] = {"age_*.png", "age_*.png.json"};
+  char idx[4300];
+  snprintf(idx, sizeof idx, "%s/growth.json", o->po.path);
+  cli_out_input("RUN", o->po.path);
+  cli_out_input("RUN", idx);
+  for (int k = 0; k < n; k++) cli_out_input("RUN", s[k].file);
+  cli_out_input("--robot", o->def.robot_mjcf);
+  if (folder) {
+    cli_out_folder("-o", o->out, age_files, 2, 1);
+  } else {
+    char files[5][4200];
+    int nf = cli_frame_files(o->out, o->depth, o->masks, files);
+    for (int k = 0; k < nf; k++) cli_out_file("-o", files[k]);
+  }
+  if (cli_out_check(cmd)) {
+    vd_free(s, sizeof(snap) * (size_t)(n ? n : 1));
+    return EXIT_USAGE;
+  }
   // which ages: the one nearest --time (default the last), or all into a folder
   int want = n - 1;
   if (o->has_time)
@@ -141,10 +161,7 @@ int cli_render_growth(const cli_render_opts* o) {
     cam = cli_render_camera(o, lo, hi);
   }
   if (st) goto fail;
-  if (folder && mkdir(o->out, 0777) && errno != EEXIST) {
-    st = vd_error_set(&err, VD_ERR_IO, o->out, 0, 0, "cannot create the folder: %s", strerror(errno));
-    goto fail;
-  }
+  if (folder && (st = vd_outdir_make(o->out, &err))) goto fail;
   unsigned layers = VD_LAYER_COLOR | (o->depth ? VD_LAYER_DEPTH : 0) | (o->masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
   for (int k = folder ? 0 : want; k <= (folder ? n - 1 : want); k++) {
     vd_plant_spec_destroy(spec);

@@ -91,15 +91,18 @@ static int on_path(const char* name) {
 typedef struct video {
   pid_t pid;
   FILE* pipe;
-  char tmp[4200];
+  vd_outfile of;  // the video through the output layer: ffmpeg writes its temporary name
+  int of_open;
 } video;
 
 // start ffmpeg reading w x h RGB frames at fps from a pipe into a temporary file beside path
 static vd_status video_start(video* v, const char* path, int w, int h, double fps, vd_error* err) {
+  vd_status st = vd_outfile_open(&v->of, path, err);
+  if (st) return st;
+  v->of_open = 1;
   int fd[2];
   if (pipe(fd) != 0)
     return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot make a pipe: %s", strerror(errno));
-  snprintf(v->tmp, sizeof v->tmp, "%s.tmp.%ld", path, (long)getpid());
   char size[64], rate[64];
   snprintf(size, sizeof size, "%dx%d", w, h);
   snprintf(rate, sizeof rate, "%.6g", fps);
@@ -131,7 +134,7 @@ static vd_status video_start(video* v, const char* path, int w, int h, double fp
                   "+faststart",
                   "-f",
                   "mp4",
-                  v->tmp,
+                  v->of.tmp,
                   NULL};
   // -nostdin only stops ffmpeg reading keys from the terminal; the frames come through pipe:0
   posix_spawn_file_actions_t fa;
@@ -155,9 +158,14 @@ static vd_status video_start(video* v, const char* path, int w, int h, double fp
   return VD_OK;
 }
 
-// close the pipe, wait for ffmpeg; on success (ok) rename the video into place, else remove it
+// close the pipe, wait for ffmpeg; on success (ok) hand the video to the output layer, else
+// remove it
 static vd_status video_finish(video* v, const char* path, int ok, vd_error* err) {
-  if (!v->pid) return VD_OK;
+  if (!v->pid) {
+    if (v->of_open) vd_outfile_abort(&v->of);
+    v->of_open = 0;
+    return VD_OK;
+  }
   int bad = v->pipe ? fclose(v->pipe) != 0 : 0;
   v->pipe = NULL;
   int status = 0;
@@ -169,9 +177,9 @@ static vd_status video_finish(video* v, const char* path, int ok, vd_error* err)
     st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "ffmpeg failed (%s %d)",
                       WIFEXITED(status) ? "exit status" : "signal",
                       WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
-  else if (ok && rename(v->tmp, path) != 0)
-    st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot rename into place: %s", strerror(errno));
-  if (!ok || st) remove(v->tmp);
+  if (ok && !st) st = vd_outfile_commit(&v->of, err);
+  else vd_outfile_abort(&v->of);
+  v->of_open = 0;
   return st;
 }
 
@@ -234,39 +242,6 @@ static vd_status write_index(const cli_render_opts* o, const cli_run* run, const
 // ---------------------------------------------------------------------------------------------
 // the command
 
-// the set of every file the command writes: one frame (and its siblings) or every frame of the
-// folder and its index, the video
-static vd_status begin_outputs(const cli_render_opts* o, const cli_run* run, const char* folder, const char* mp4,
-                               int single, cli_outset* set, vd_error* err) {
-  int per = 1 + (o->depth || o->masks) + o->depth + 2 * o->masks;
-  int cap = (folder ? run->nframe * per + 1 : 0) + (single ? per : 0) + 1, n = 0;
-  char** path = vd_calloc((size_t)cap, sizeof(char*));
-  if (!path) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  vd_status st = VD_OK;
-  char files[5][4200];
-  for (int k = 0; !st && folder && k <= run->nframe; k++) {
-    int nf = 1;
-    if (k < run->nframe) {
-      char png[4200];
-      snprintf(png, sizeof png, "%s/frame_%05d.png", folder, k);
-      nf = cli_frame_files(png, o->depth, o->masks, files);
-    } else {
-      snprintf(files[0], sizeof files[0], "%s/frames.json", folder);
-    }
-    for (int i = 0; i < nf && !st; i++)
-      if (!(path[n++] = vd_strdup(files[i]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  }
-  int nf = !st && single ? cli_frame_files(o->out, o->depth, o->masks, files) : 0;
-  if (!st && mp4) snprintf(files[nf++], sizeof files[0], "%s", mp4);
-  for (int i = 0; i < nf && !st; i++)
-    if (!(path[n++] = vd_strdup(files[i]))) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  if (!st) st = cli_outset_begin(set, (const char* const*)path, n, NULL, err);
-  for (int i = 0; i < n; i++)
-    if (path[i]) vd_free(path[i], strlen(path[i]) + 1);
-  vd_free(path, (size_t)cap * sizeof(char*));
-  return st;
-}
-
 // the colliders of a frame as solids (planes are the floor's business, meshes are not drawn)
 static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int ncol,
                                vd_error* err) {
@@ -287,6 +262,16 @@ static vd_status add_colliders(vd_renderer* r, const vd_sim_collider* col, int n
   return st;
 }
 
+// -o names a folder for every frame: DIR/, an existing folder or a name without an extension
+// (g.jpg is a mistyped picture, not a folder to fill with frames)
+static int folder_name(const char* out) {
+  size_t n = strlen(out);
+  struct stat sb;
+  if ((n && out[n - 1] == '/') || (!stat(out, &sb) && S_ISDIR(sb.st_mode))) return 1;
+  const char* base = strrchr(out, '/');
+  return strchr(base ? base + 1 : out, '.') == NULL;
+}
+
 int cli_render_run(const cli_render_opts* o) {
   const char* cmd = "render";
   // what to write
@@ -294,26 +279,34 @@ int cli_render_run(const cli_render_opts* o) {
   const char* folder = o->out && !single ? o->out : NULL;
   if (!o->out && !o->mp4)
     return cli_usage_error(cmd, "missing -o OUT.png, -o DIR/ or --mp4 OUT.mp4 for the run");
+  if (folder && !folder_name(folder))
+    return cli_usage_error(cmd,
+                           "-o %s: a run is drawn as PNG: -o OUT.png for one frame, -o DIR/ (a folder) for "
+                           "every frame",
+                           folder);
   if (o->has_time && !single) return cli_usage_error(cmd, "--time picks the frame of -o OUT.png");
   if (o->po.steps >= 0 || o->po.seed || o->po.nset || o->po.nlabel)
     return cli_usage_error(
         cmd, "-n, --seed, --set and --label apply to .lpy plants; a run holds its plant");
   {
-    // no output may replace a file of the run or the robot
-    static const char* run_files[] = {"rod.json", "plant_initial.json", "frames.bin", "frames.jsonl",
-                                      "colliders.jsonl", "plant.json", "events.csv"};
-    char ipath[8][4200], opath[7][4200];
-    const char* ins[8];
-    const char* outs[7];
-    int nin = 0, nout = 0;
-    for (size_t k = 0; k < sizeof run_files / sizeof *run_files; k++, nin++)
-      snprintf(ipath[nin], sizeof ipath[nin], "%s/%s", o->po.path, run_files[k]), ins[nin] = ipath[nin];
-    ins[nin++] = o->def.robot_mjcf;
-    if (single) nout = cli_frame_files(o->out, o->depth, o->masks, opath);
-    if (folder) snprintf(opath[nout++], sizeof opath[0], "%s/frames.json", folder);
-    if (o->mp4) snprintf(opath[nout++], sizeof opath[0], "%s", o->mp4);
-    for (int k = 0; k < nout; k++) outs[k] = opath[k];
-    if (cli_check_outputs(cmd, outs, nout, ins, nin)) return EXIT_USAGE;
+    // the files: the run's files and the robot read; one picture (and its layers), or a folder
+    // of frames (an earlier render's frames there that this one does not draw go), the video
+    static const char* const frame_files[] = {"frames.json", "frame_*.png", "frame_*.png.json"};
+    cli_out_input("RUN", o->po.path);
+    for (int k = 0; k < cli_run_nmember; k++) {
+      char p[4200];
+      snprintf(p, sizeof p, "%s/%s", o->po.path, cli_run_members[k]);
+      if (!strchr(p, '*')) cli_out_input("RUN", p);
+    }
+    cli_out_input("--robot", o->def.robot_mjcf);
+    if (single) {
+      char opath[5][4200];
+      int nout = cli_frame_files(o->out, o->depth, o->masks, opath);
+      for (int k = 0; k < nout; k++) cli_out_file("-o", opath[k]);
+    }
+    if (folder) cli_out_folder("-o", folder, frame_files, 3, 1);
+    cli_out_file("--mp4", o->mp4);
+    if (cli_out_check(cmd)) return EXIT_USAGE;
   }
   const char* mp4 = o->mp4;
   if (mp4 && !on_path("ffmpeg")) {
@@ -335,10 +328,17 @@ int cli_render_run(const cli_render_opts* o) {
   memset(&vid, 0, sizeof vid);
   int progress = o->po.progress;
   int writing = 0; // the failure, if any, is in writing the outputs
-  int made_dir = 0, has_set = 0;
-  cli_outset set;
   if ((st = cli_run_open(o->po.path, &run, &err))) return cli_report(cmd, &err, st);
   const vd_model* pm = run.plant;
+  if (o->has_time) {
+    // --time picks a frame of the run: a time outside it is a mistake, not the nearest end
+    double t0 = vd_sim_frames_time(run.frames, 0), t1 = vd_sim_frames_time(run.frames, run.nframe - 1);
+    double tol = run.nframe > 1 ? (t1 - t0) / (run.nframe - 1) : 0;  // half a frame either side
+    if (!(o->time >= t0 - 0.5 * tol - 1e-9 && o->time <= t1 + 0.5 * tol + 1e-9)) {
+      cli_run_close(&run);
+      return cli_usage_error(cmd, "--time %g: the run %s has frames from %g to %g s", o->time, o->po.path, t0, t1);
+    }
+  }
   int want = o->has_time ? vd_sim_frames_nearest(run.frames, o->time) : run.nframe - 1;
   int all = folder || mp4;
   // first pass: the box swept by the plant and the colliders; the colour scale of the whole run
@@ -395,16 +395,7 @@ int cli_render_run(const cli_render_opts* o) {
     cam = cli_render_camera(o, lo, hi);
   }
   writing = 1;
-  if (folder && mkdir(folder, 0777) == 0)
-    made_dir = 1;
-  else if (folder && errno != EEXIST) {
-    st = vd_error_set(&err, VD_ERR_IO, folder, 0, 0, "cannot create the folder: %s",
-                      strerror(errno));
-    goto fail;
-  }
-  // every file of the command appears together or not at all
-  if ((st = begin_outputs(o, &run, folder, mp4, single, &set, &err))) goto fail;
-  has_set = 1;
+  if (folder && (st = vd_outdir_make(folder, &err))) goto fail;
   // frames: one, or every one into the folder and the video
   unsigned layers = VD_LAYER_COLOR | (o->depth ? VD_LAYER_DEPTH : 0) |
                     (o->masks ? VD_LAYER_LABEL | VD_LAYER_INSTANCE : 0);
@@ -446,19 +437,17 @@ int cli_render_run(const cli_render_opts* o) {
       goto fail;
     }
   }
-  if (progress) fputc('\n', stderr);
+  if (progress) cli_progress_clear();
   if (folder && (st = write_index(o, &run, folder, &f, &err))) goto fail;
   if (mp4 && (st = video_finish(&vid, mp4, 1, &err))) goto fail;
   goto done;
 fail:
-  if (progress) fputc('\n', stderr);
+  if (progress) cli_progress_clear();
   // bad run files are bad input (2); a failure to write or to encode is a failed run (1)
   code = cli_report(cmd, &err, st);
   if (writing) code = EXIT_FAIL;
 done:
   if (vid.pid) video_finish(&vid, mp4, 0, NULL);
-  if (has_set) cli_outset_end(&set, code == EXIT_OK);
-  if (made_dir && code != EXIT_OK) rmdir(folder);  // only when empty
   vd_render_destroy(r);
   vd_free(stress, sizeof(double) * (size_t)(pm->nseg ? pm->nseg : 1));
   vd_data_destroy(ref);

@@ -169,17 +169,20 @@ static void put_f32(unsigned char* b, float f) {
   put_u32(b, u);
 }
 
+const char* const cli_run_members[] = {"frames.bin",         "frames.jsonl", "colliders.jsonl",
+                                       "rod.json",           "plant_initial.json", "events.csv",
+                                       "plant.json",         "item_*/plant.json",  "item_*/events.csv"};
+const int cli_run_nmember = (int)(sizeof cli_run_members / sizeof *cli_run_members);
+
 vd_status cli_frames_begin(cli_frames* o, const vd_sim_model* m, const char* dir, int jsonl, vd_error* err) {
   char path[4096];
   snprintf(path, sizeof path, "%s/frames.%s", dir, jsonl ? "jsonl" : "bin");
-  o->watch = cli_watch(path);
   vd_status st = vd_outfile_open(&o->frames, path, err);
   if (st) return st;
   o->frames_open = 1;
   o->jsonl = jsonl;
   // the colliders' poses at the same instants (for pictures of the run)
   snprintf(path, sizeof path, "%s/colliders.jsonl", dir);
-  o->cwatch = cli_watch(path);
   if ((st = vd_outfile_open(&o->colliders, path, err))) return st;
   o->colliders_open = 1;
   if (!jsonl) {
@@ -267,14 +270,12 @@ vd_status cli_rod_json_write(const vd_sim_model* m, const vd_model* plant, const
   char path[4096];
   snprintf(path, sizeof path, "%s/rod.json", dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     fputc('\n', f.fp);
     st = vd_outfile_commit(&f, err);
   }
-  cli_unwatch(w);
   cJSON_free(text);
   return st;
 }
@@ -298,9 +299,6 @@ void cli_frames_abort(cli_frames* o) {
   if (o->frames_open) vd_outfile_abort(&o->frames);
   if (o->colliders_open) vd_outfile_abort(&o->colliders);
   o->frames_open = o->colliders_open = 0;
-  cli_unwatch(o->watch);
-  cli_unwatch(o->cwatch);
-  o->watch = o->cwatch = -1;
   vd_free(o->bbuf, o->fbuf_n);
   o->bbuf = NULL;
 }

@@ -98,14 +98,16 @@ static const char* sim_help_output =
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             print a JSON summary on stdout: max_displacement (m, all nodes from\n"
     "                          their initial positions), tip_displacement (m, end of the main\n"
-    "                          axis), kinetic_energy (J), events, steps_per_second, ...\n"
+    "                          axis), kinetic_energy (J), events, ...; the same bytes for the\n"
+    "                          same inputs\n"
     "      --batch N           run N plants side by side: item i grown with the seed drawn from\n"
     "                          (--seed, i) as dataset does (the same plant N times for a plant\n"
     "                          file); --stats prints one record per item, -o DIR writes\n"
     "                          DIR/item_NNNNNN/ (plant.json, events.csv); frames are not written\n"
     "      --jobs J            items run at once (threads), default 1\n"
     "      --profile           time each stage of the steps and the frame output; --stats then\n"
-    "                          has stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
+    "                          has wall_seconds, steps_per_second, real_time_factor and\n"
+    "                          stage_seconds (forces, predict, contacts, eval, factor, solve,\n"
     "                          project, velocity, fracture, frames)\n";
 
 // a closed triangle mesh from a Wavefront OBJ file: "v x y z" and "f i j k ..." lines (1-based
@@ -378,12 +380,8 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
   char path[4096];
   snprintf(path, sizeof path, "%s/events.csv", dir);
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
-  if (st) {
-    cli_unwatch(w);
-    return st;
-  }
+  if (st) return st;
   fputs("time_s,segment,node,label,label_name,instance,class,force_N,moment_Nm,cs,cb_per_m,cause\n", f.fp);
   for (int k = 0; k < d->nevent; k++) {
     const vd_sim_event* e = &d->event[k];
@@ -391,9 +389,7 @@ static vd_status write_events(const vd_sim_data* d, const vd_model* plant, const
             label_name(plant, e->label), e->instance, vd_sim_class_name(e->cls), e->force, e->moment, e->cs, e->cb,
             cause_name(e->cause));
   }
-  st = vd_outfile_commit(&f, err);
-  cli_unwatch(w);
-  return st;
+  return vd_outfile_commit(&f, err);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -427,9 +423,11 @@ static int print_stats(const vd_sim_model* m, const vd_sim_data* d, const vd_mod
   cJSON_AddNumberToObject(root, "nevents", d->nevent);
   cJSON_AddNumberToObject(root, "steps", (double)steps);
   cJSON_AddNumberToObject(root, "time", d->time);
-  cJSON_AddNumberToObject(root, "wall_seconds", wall);
-  cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
-  cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * m->opt.dt / wall : 0);
+  if (d->profile) {  // timings: only when asked, so that the same inputs print the same bytes
+    cJSON_AddNumberToObject(root, "wall_seconds", wall);
+    cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
+    cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * m->opt.dt / wall : 0);
+  }
   if (settle_steps >= 0) {
     cJSON_AddBoolToObject(root, "settled", settled);
     cJSON_AddNumberToObject(root, "settle_steps", settle_steps);
@@ -691,27 +689,6 @@ static int parse_args(int argc, char** argv, sim_opts* o) {
   return EXIT_OK;
 }
 
-// the outputs of a run: the run folder's files (those of another --frames choice stale: an
-// earlier run's, removed when this one completes) and --final; returns the count
-#define SIM_MAX_OUT 9
-static int run_outputs(const sim_opts* o, char path[SIM_MAX_OUT][4200], unsigned char stale[SIM_MAX_OUT]) {
-  static const char* run_files[] = {"frames.bin", "frames.jsonl", "colliders.jsonl", "rod.json",
-                                    "plant_initial.json", "events.csv", "plant.json"};
-  int n = 0, dn = o->out ? (int)strlen(o->out) : 0;
-  while (dn > 1 && o->out[dn - 1] == '/') dn--;
-  const char* frames = o->frames ? o->frames : "bin";
-  for (size_t k = 0; o->out && k < sizeof run_files / sizeof *run_files; k++) {
-    snprintf(path[n], sizeof path[0], "%.*s/%s", dn, o->out, run_files[k]);
-    stale[n++] = (k == 0 && strcmp(frames, "bin") != 0) || (k == 1 && strcmp(frames, "jsonl") != 0) ||
-                 (k == 2 && !strcmp(frames, "none"));
-  }
-  if (o->final) {
-    int nf = cli_plant_files(o->final, path + n);
-    for (int k = 0; k < nf; k++) stale[n++] = 0;
-  }
-  return n;
-}
-
 // options that do nothing without another one are refused, not ignored
 static int check_applies(const sim_opts* o) {
   const char* cmd = "sim";
@@ -727,16 +704,16 @@ static int check_applies(const sim_opts* o) {
   return 0;
 }
 
-// no output may replace an input (the plant, the wind series, collider meshes)
+// the files of a run, declared to the output layer and checked: the plant, the wind series and
+// collider meshes read; the run folder (an earlier run's files there that this one does not
+// write go when it completes) and --final written
 static int check_clash(const sim_opts* o) {
-  char opath[SIM_MAX_OUT][4200];
-  unsigned char stale[SIM_MAX_OUT];
-  const char* outs[SIM_MAX_OUT];
-  const char* ins[10] = {o->po.path, o->wind_file};
-  int nin = 2, nout = run_outputs(o, opath, stale);
-  for (int k = 0; k < o->nmesh; k++) ins[nin++] = o->mesh_path[k];
-  for (int k = 0; k < nout; k++) outs[k] = opath[k];
-  return cli_check_outputs("sim", outs, nout, ins, nin);
+  cli_out_plant_opts(&o->po);
+  cli_out_input("--wind-file", o->wind_file);
+  for (int k = 0; k < o->nmesh; k++) cli_out_input("--collider-mesh", o->mesh_path[k]);
+  if (o->out) cli_out_folder("-o", o->out, cli_run_members, cli_run_nmember, 1);
+  if (o->final) cli_out_plant("--final", o->final);
+  return cli_out_check("sim");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -847,8 +824,7 @@ static void batch_run(const sim_opts* o, int i, double nsteps, const double* win
   if (!st && o->out) {
     char dir[4200], path[4300];
     snprintf(dir, sizeof dir, "%s/item_%06d", o->out, i);
-    if (mkdir(dir, 0777) && errno != EEXIST)
-      st = vd_error_set(err, VD_ERR_IO, dir, 0, 0, "cannot create the folder: %s", strerror(errno));
+    st = vd_outdir_make(dir, err);
     if (!st) st = write_events(d, plant, dir, err);
     if (!st && (st = vd_sim_to_spec(m, d, spec))) vd_error_set(err, st, "", 0, 0, "out of memory writing the final plant");
     snprintf(path, sizeof path, "%s/plant.json", dir);
@@ -869,8 +845,7 @@ static int sim_batch(const sim_opts* o, double nsteps) {
   vd_sdf* sdf[8] = {NULL};
   vd_status st = o->wind_file ? vd_sim_read_wind(o->wind_file, &wind, &nwind, &err) : VD_OK;
   for (int k = 0; !st && k < o->nmesh; k++) st = load_mesh_sdf(o->mesh_path[k], &sdf[k], &err);
-  if (!st && o->out && mkdir(o->out, 0777) && errno != EEXIST)
-    st = vd_error_set(&err, VD_ERR_IO, o->out, 0, 0, "cannot create the output folder: %s", strerror(errno));
+  if (!st && o->out) st = vd_outdir_make(o->out, &err);
   batch_item* r = st ? NULL : vd_calloc((size_t)n, sizeof *r);
   if (!st && !r) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   if (st || !r) {
@@ -903,14 +878,16 @@ static int sim_batch(const sim_opts* o, double nsteps) {
       cJSON_AddNumberToObject(it, "kinetic_energy", r[i].ke);
       cJSON_AddNumberToObject(it, "nevents", r[i].nevent);
       cJSON_AddNumberToObject(it, "warnings", (double)r[i].nwarning);
-      cJSON_AddNumberToObject(it, "wall_seconds", r[i].wall);
+      if (o->profile) cJSON_AddNumberToObject(it, "wall_seconds", r[i].wall);
       cJSON_AddItemToArray(items, it);
       steps += r[i].steps;
     }
     cJSON_AddNumberToObject(root, "jobs", jobs);
-    cJSON_AddNumberToObject(root, "wall_seconds", wall);
-    cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
-    cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * o->opt.dt / wall : 0);
+    if (o->profile) {
+      cJSON_AddNumberToObject(root, "wall_seconds", wall);
+      cJSON_AddNumberToObject(root, "steps_per_second", wall > 0 ? (double)steps / wall : 0);
+      cJSON_AddNumberToObject(root, "real_time_factor", wall > 0 ? (double)steps * o->opt.dt / wall : 0);
+    }
     char* text = cJSON_Print(root);
     cJSON_Delete(root);
     if (text) fputs(text, stdout), fputc('\n', stdout), cJSON_free(text);
@@ -978,10 +955,8 @@ int cli_sim(int argc, char** argv) {
   vd_sdf* sdf[8] = {NULL};
   cli_frames out;
   memset(&out, 0, sizeof out);
-  out.watch = out.cwatch = -1;
   cli_grow_info info;
-  int code = EXIT_OK, made_dir = 0, has_set = 0;
-  cli_outset set;
+  int code = EXIT_OK;
   vd_status st = cli_load_plant(&o.po, &spec, &info, &err);
   if (!st) cli_grow_info_free(&info);
   if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
@@ -1053,22 +1028,9 @@ int cli_sim(int argc, char** argv) {
     goto done;
   }
   // output folder: failing to write is a failed run (exit 1), not bad input; the run's files
-  // appear together or not at all (a folder made for a failed run goes too)
-  if (o.out) {
-    if (mkdir(o.out, 0777) == 0)
-      made_dir = 1;
-    else if (errno != EEXIST)
-      st = vd_error_set(&err, VD_ERR_IO, o.out, 0, 0, "cannot create the output folder: %s", strerror(errno));
-  }
-  if (!st && (o.out || o.final)) {
-    char opath[SIM_MAX_OUT][4200];
-    unsigned char stale[SIM_MAX_OUT];
-    const char* outs[SIM_MAX_OUT];
-    int nout = run_outputs(&o, opath, stale);
-    for (int k = 0; k < nout; k++) outs[k] = opath[k];
-    st = cli_outset_begin(&set, outs, nout, stale, &err);
-    has_set = !st;
-  }
+  // appear together when the command succeeds (the output layer), a folder made for a failed run
+  // goes
+  if (o.out) st = vd_outdir_make(o.out, &err);
   if (st) {
     cli_report("sim", &err, st);
     code = EXIT_FAIL;
@@ -1213,10 +1175,6 @@ int cli_sim(int argc, char** argv) {
 done:
   if (out.frames_open) vd_outfile_abort(&out.frames);
   if (out.colliders_open) vd_outfile_abort(&out.colliders);
-  if (has_set) cli_outset_end(&set, code == EXIT_OK);
-  if (made_dir && code != EXIT_OK) rmdir(o.out);  // only when empty
-  cli_unwatch(out.watch);
-  cli_unwatch(out.cwatch);
   vd_free(out.bbuf, out.fbuf_n);
   vd_sim_soil_destroy(held);
   vd_sim_data_destroy(d);

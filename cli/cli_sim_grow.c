@@ -19,6 +19,10 @@ static const char* grow_help =
     "--substeps physics substeps, the state carried to the grown plant; stress per node and\n"
     "internode, branches that break, roots that give way. 'verdant render RUN/' draws the ages.\n"
     "\n"
+    "Options apply in any order (--paper, --soil and --species are presets applied first);\n"
+    "an option that does not apply to the run (--clay without a soil, --k0 without --springs\n"
+    "paper, --rigid-age without --model mrl, ...) is an error.\n"
+    "\n"
     "growth:\n"
     "      --grow              this mode\n"
     "      --ages N            age steps, default the file's derivation length (or -n)\n"
@@ -28,7 +32,8 @@ static const char* grow_help =
     "                          (mass-spring, ML-Tree) or rods (verdant's Cosserat rods)\n"
     "      --paper             the paper's own choices: --springs paper --integrator eq3\n"
     "                          --wind-model paper --drag stokes, eq. 8 as printed, no strain\n"
-    "                          limit, no stress-free growth (options after it still apply)\n"
+    "                          limit, no stress-free growth, C_d 1, masses updated at the end\n"
+    "                          of each age step (other options override it wherever they are)\n"
     "      --springs S         material (E A / l and hinges E I / l; default) or paper (k0 d / l\n"
     "                          and springs between alternate nodes)\n"
     "      --integrator I      implicit (default), eq3 (Kang 2001) or eq4 (Kang 2000)\n"
@@ -47,6 +52,8 @@ static const char* grow_help =
     "                          grows without stress on the bent tree)\n"
     "      --strain-limit E    internodes stretched more than E after a substep are put back\n"
     "                          (default 1e-4; 0 off)\n"
+    ;
+static const char* grow_help_forces =
     "forces:\n"
     "      --gravity X,Y,Z     gravity (m/s^2), default 0,0,-9.81\n"
     "      --wind X,Y,Z        mean wind (m/s); pressure 0.613 |v|^2 Pa (eq. 9)\n"
@@ -77,15 +84,33 @@ static const char* grow_help_output =
     "      --ply               also RUN/age_NNN.ply meshes with a per-vertex stress property\n"
     "      --final FILE        also write the final plant as .json, .obj or .ply\n"
     "      --stats             JSON summary on stdout: height, max_displacement, max_stress,\n"
-    "                          broken_branches, uprooted, collapsed, momentum_error, ...\n";
+    "                          broken_branches, uprooted, collapsed, momentum_error, ...; the\n"
+    "                          same bytes for the same inputs\n"
+    "      --profile           --stats adds wall_seconds (a timing, which differs per run)\n";
+
+// options given (for the checks that each applies to the run, whatever their order)
+enum {
+  G_SOIL_METHOD, G_CLAY, G_ORGANIC, G_WATER, G_BULK, G_POISSON, G_PTF, G_UPROOT, G_RIGID_AGE, G_EQ8, G_K0,
+  G_SPRINGS, G_INTEGRATOR, G_DAMPING, G_STRAIN, G_WIND_MODEL, G_DRAG, G_LIGHT, G_GRAVI, G_YOUNG, G_LEAF_CD,
+  G_PAPER, G_CD, G_NOPT
+};
+static const char* const g_names[G_NOPT] = {
+    "--soil-method", "--clay", "--organic", "--water", "--bulk-density", "--poisson", "--ptf", "--uproot-tilt",
+    "--rigid-age", "--eq8", "--k0", "--springs", "--integrator", "--damping", "--strain-limit", "--wind-model",
+    "--drag", "--light", "--gravitropism", "--young", "--leaf-cd", "--paper", "--cd"};
 
 typedef struct grow_opts {
   cli_plant_opts po;
   const char* out;
   const char* final;
   const char* wind_file;
-  int stats, ply, ages;
+  int stats, ply, ages, profile;
   vd_growth_def def;
+  // presets, applied before every other option (pass 0 finds them)
+  int paper;
+  const char* soil;
+  const char* species;
+  int seen[G_NOPT];
 } grow_opts;
 
 // "a,b" or "a,b,c" -> numbers; 'inf' allowed where inf is set
@@ -105,7 +130,9 @@ static int nums(const char* s, double* v, int n, int inf) {
   return 1;
 }
 
-static int parse_args(int argc, char** argv, grow_opts* o) {
+// one pass over the options: the first checks them all and finds the presets (--paper, --soil,
+// --species), the second applies every other option over the presets, so order never matters
+static int parse_pass(int argc, char** argv, grow_opts* o) {
   const char* cmd = "sim --grow";
   vd_growth_def* d = &o->def;
   for (int i = 1; i < argc; i++) {
@@ -133,6 +160,8 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       o->final = val;
     } else if (!strcmp(a, "--stats")) {
       o->stats = 1;
+    } else if (!strcmp(a, "--profile")) {
+      o->profile = 1;
     } else if (!strcmp(a, "--ply")) {
       o->ply = 1;
     } else if (!strcmp(a, "--ages")) {
@@ -154,25 +183,31 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       else if (!strcmp(val, "rods")) d->model = VD_GROWTH_RODS;
       else return cli_usage_error(cmd, "--model expects mss, mrl or rods, got '%s'", val);
     } else if (!strcmp(a, "--paper")) {
-      vd_growth_def_paper(d);
+      o->seen[G_PAPER] = 1;
+      o->paper = 1;
     } else if (!strcmp(a, "--springs")) {
+      o->seen[G_SPRINGS] = 1;
       CLI_VAL();
       if (!strcmp(val, "material")) d->mss.springs = VD_MSS_MATERIAL;
       else if (!strcmp(val, "paper")) d->mss.springs = VD_MSS_PAPER;
       else return cli_usage_error(cmd, "--springs expects material or paper, got '%s'", val);
     } else if (!strcmp(a, "--integrator")) {
+      o->seen[G_INTEGRATOR] = 1;
       CLI_VAL();
       if (!strcmp(val, "implicit")) d->opt.integrator = VD_MSS_IMPLICIT;
       else if (!strcmp(val, "eq3")) d->opt.integrator = VD_MSS_EQ3;
       else if (!strcmp(val, "eq4")) d->opt.integrator = VD_MSS_EQ4;
       else return cli_usage_error(cmd, "--integrator expects implicit, eq3 or eq4, got '%s'", val);
     } else if (!strcmp(a, "--rigid-age")) {
+      o->seen[G_RIGID_AGE] = 1;
       CLI_NUM(d->mss.rigid_age, x_ >= 0, "an age >= 0 (years)");
     } else if (!strcmp(a, "--woody-age")) {
       CLI_NUM(d->mss.woody_age, x_ >= 0, "an age >= 0 (years)");
     } else if (!strcmp(a, "--k0")) {
+      o->seen[G_K0] = 1;
       PAIR(d->mss.k0_green, d->mss.k0_wood, v_[0] > 0 && v_[1] > 0, "GREEN,WOOD spring constants > 0 (N/m)", 0);
     } else if (!strcmp(a, "--damping")) {
+      o->seen[G_DAMPING] = 1;
       CLI_NUM(d->mss.damping, x_ >= 0, "a damping constant c >= 0");
     } else if (!strcmp(a, "--species")) {
       CLI_VAL();
@@ -183,8 +218,9 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
           snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? ", " : "", vd_wood_get(k)->name);
         return cli_usage_error(cmd, "--species: unknown species '%s' (known: %s)", val, list);
       }
-      d->mss.young_wood = w.young, d->mss.density_wood = w.density, d->mss.mor = w.mor;
+      o->species = val;
     } else if (!strcmp(a, "--young")) {
+      o->seen[G_YOUNG] = 1;
       PAIR(d->mss.young_green, d->mss.young_wood, v_[0] > 0 && v_[1] > 0, "GREEN,WOOD moduli > 0 (Pa)", 0);
     } else if (!strcmp(a, "--density")) {
       PAIR(d->mss.density_green, d->mss.density_wood, v_[0] > 0 && v_[1] > 0, "GREEN,WOOD densities > 0 (kg/m^3)", 0);
@@ -193,6 +229,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     } else if (!strcmp(a, "--no-breaking")) {
       d->opt.breaking = 0;
     } else if (!strcmp(a, "--eq8")) {
+      o->seen[G_EQ8] = 1;
       CLI_VAL();
       if (!strcmp(val, "paper")) d->paper_eq8 = 1;
       else if (!strcmp(val, "corrected")) d->paper_eq8 = 0;
@@ -200,6 +237,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
     } else if (!strcmp(a, "--no-stress-free")) {
       d->stress_free = 0;
     } else if (!strcmp(a, "--strain-limit")) {
+      o->seen[G_STRAIN] = 1;
       CLI_NUM(d->opt.strain_limit, x_ >= 0 && x_ < 1, "a relative stretch in [0, 1)");
     } else if (!strcmp(a, "--gravity") || !strcmp(a, "--wind")) {
       CLI_VAL();
@@ -217,11 +255,13 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       CLI_VAL();
       o->wind_file = val;
     } else if (!strcmp(a, "--wind-model")) {
+      o->seen[G_WIND_MODEL] = 1;
       CLI_VAL();
       if (!strcmp(val, "area")) d->opt.wind_model = VD_MSS_WIND_AREA;
       else if (!strcmp(val, "paper")) d->opt.wind_model = VD_MSS_WIND_PAPER;
       else return cli_usage_error(cmd, "--wind-model expects area or paper, got '%s'", val);
     } else if (!strcmp(a, "--drag")) {
+      o->seen[G_DRAG] = 1;
       CLI_VAL();
       if (!strcmp(val, "quadratic")) d->opt.drag = VD_MSS_DRAG_QUADRATIC;
       else if (!strcmp(val, "stokes")) d->opt.drag = VD_MSS_DRAG_STOKES;
@@ -229,10 +269,13 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       else return cli_usage_error(cmd, "--drag expects quadratic, stokes or none, got '%s'", val);
       d->rod_opt.drag = d->opt.drag == VD_MSS_DRAG_QUADRATIC;
     } else if (!strcmp(a, "--cd")) {
+      o->seen[G_CD] = 1;
       CLI_NUM(d->opt.drag_cd, x_ >= 0, "a drag coefficient >= 0");
     } else if (!strcmp(a, "--leaf-cd")) {
+      o->seen[G_LEAF_CD] = 1;
       CLI_NUM(d->opt.leaf_cd, x_ >= 0, "a drag coefficient >= 0");
     } else if (!strcmp(a, "--light")) {
+      o->seen[G_LIGHT] = 1;
       CLI_VAL();
       char buf[256];
       if (strlen(val) >= sizeof buf) return cli_usage_error(cmd, "--light: value too long");
@@ -244,6 +287,7 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
         return cli_usage_error(cmd, "--light expects X,Y,Z[:K] (m, N m^2), got '%s'", val);
       d->opt.light = 1, d->opt.light_pos = vd_v3(v[0], v[1], v[2]), d->opt.light_k = k;
     } else if (!strcmp(a, "--gravitropism")) {
+      o->seen[G_GRAVI] = 1;
       CLI_VAL();
       double v[2];
       if (!strcmp(val, "none")) {
@@ -259,31 +303,39 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
       }
     } else if (!strcmp(a, "--soil")) {
       CLI_VAL();
-      double ground = d->mss.soil.ground;
-      if (vd_soil_preset(val, &d->mss.soil) != VD_OK)
+      vd_soil so;
+      if (vd_soil_preset(val, &so) != VD_OK)
         return cli_usage_error(cmd, "--soil expects clamp, loam, sandy-loam, clay or singapore-residual, got '%s'", val);
-      d->mss.soil.ground = ground;
+      o->soil = val;
     } else if (!strcmp(a, "--soil-method")) {
+      o->seen[G_SOIL_METHOD] = 1;
       CLI_VAL();
       if (!strcmp(val, "imhoff")) d->mss.soil.method = VD_SOIL_IMHOFF2016;
       else if (!strcmp(val, "pang")) d->mss.soil.method = VD_SOIL_PANG2023;
       else return cli_usage_error(cmd, "--soil-method expects imhoff or pang, got '%s'", val);
     } else if (!strcmp(a, "--clay")) {
+      o->seen[G_CLAY] = 1;
       CLI_NUM(d->mss.soil.clay, x_ >= 0 && x_ <= 100, "a clay content in [0, 100] (%)");
     } else if (!strcmp(a, "--organic")) {
+      o->seen[G_ORGANIC] = 1;
       CLI_NUM(d->mss.soil.organic, x_ >= 0 && x_ <= 100,
               "an organic matter content in [0, 100] (%)");
     } else if (!strcmp(a, "--water")) {
+      o->seen[G_WATER] = 1;
       CLI_NUM(d->mss.soil.water, x_ > 0 && x_ <= 1,
               "a volumetric water content in (0, 1] (m^3/m^3)");
     } else if (!strcmp(a, "--bulk-density")) {
+      o->seen[G_BULK] = 1;
       CLI_NUM(d->mss.soil.bulk_density, x_ > 0 && x_ < 3, "a bulk density in (0, 3) (Mg/m^3)");
     } else if (!strcmp(a, "--poisson")) {
+      o->seen[G_POISSON] = 1;
       CLI_NUM(d->mss.soil.poisson, x_ >= 0 && x_ < 0.5, "a Poisson ratio in [0, 0.5)");
     } else if (!strcmp(a, "--ptf")) {
+      o->seen[G_PTF] = 1;
       CLI_VAL();
       if (!nums(val, d->mss.soil.ptf, 8, 0)) return cli_usage_error(cmd, "--ptf expects 8 numbers C0,C1,C2,D0,D1,D2,E0,E1, got '%s'", val);
     } else if (!strcmp(a, "--uproot-tilt")) {
+      o->seen[G_UPROOT] = 1;
       double deg;
       CLI_NUM(deg, x_ > 0 && x_ < 180, "an angle in (0, 180) (degrees)");
       d->uproot_tilt = deg * VD_PI / 180;
@@ -299,18 +351,93 @@ static int parse_args(int argc, char** argv, grow_opts* o) {
   return EXIT_OK;
 }
 
+// an option given where it does not apply: exit 2 naming it and why
+static int not_here(const grow_opts* o, int opt, const char* why) {
+  if (!o->seen[opt]) return 0;
+  cli_usage_error("sim --grow", "%s does not apply here: %s", g_names[opt], why);
+  return 1;
+}
+
+static int parse_args(int argc, char** argv, grow_opts* o) {
+  grow_opts scan = *o;
+  int rc = parse_pass(argc, argv, &scan);
+  if (rc) return rc;
+  // the presets first, in a fixed order; then every other option over them
+  vd_growth_def* d = &o->def;
+  if (scan.paper) vd_growth_def_paper(d);
+  if (scan.soil) {
+    double ground = d->mss.soil.ground;
+    vd_soil_preset(scan.soil, &d->mss.soil);
+    d->mss.soil.ground = ground;
+  }
+  if (scan.species) {
+    vd_wood w;
+    vd_wood_species(scan.species, &w);
+    d->mss.young_wood = w.young, d->mss.density_wood = w.density, d->mss.mor = w.mor;
+  }
+  rc = parse_pass(argc, argv, o);
+  if (rc) return rc;
+  o->paper = scan.paper, o->soil = scan.soil, o->species = scan.species;
+  // options that do not apply to this run are errors, not silently ignored
+  int soil = o->soil && strcmp(o->soil, "clamp") != 0, rods = d->model == VD_GROWTH_RODS;
+  int mrl = d->model == VD_GROWTH_MRL;
+  const char* nosoil = "it describes roots in a soil: give --soil loam, sandy-loam, clay or singapore-residual "
+                       "(clamp, the default, holds the roots fixed)";
+  int opts_soil[] = {G_SOIL_METHOD, G_CLAY, G_ORGANIC, G_WATER, G_BULK, G_POISSON, G_PTF, G_UPROOT};
+  for (size_t k = 0; k < sizeof opts_soil / sizeof *opts_soil; k++)
+    if (!soil && not_here(o, opts_soil[k], nosoil)) return EXIT_USAGE;
+  if (soil && d->mss.soil.method == VD_SOIL_PANG2023) {
+    const char* why = "eq. 12 (--soil-method pang) reads only the bulk density and Poisson's ratio";
+    if (not_here(o, G_CLAY, why) || not_here(o, G_ORGANIC, why) || not_here(o, G_WATER, why) || not_here(o, G_PTF, why))
+      return EXIT_USAGE;
+  }
+  if (soil && d->mss.soil.method == VD_SOIL_IMHOFF2016 &&
+      not_here(o, G_POISSON, "Poisson's ratio is read by eq. 12 only (--soil-method pang)"))
+    return EXIT_USAGE;
+  if (!mrl && (not_here(o, G_RIGID_AGE, "the rigid part is MRL's: give --model mrl") ||
+               not_here(o, G_EQ8, "eq. 8 joins nodes to MRL's rigid part: give --model mrl")))
+    return EXIT_USAGE;
+  if (rods) {
+    const char* why = "it is a setting of the mass-spring models (--model mss or mrl), not of the rods";
+    int opts_mss[] = {G_PAPER, G_SPRINGS, G_INTEGRATOR, G_K0, G_DAMPING, G_STRAIN, G_LIGHT, G_GRAVI, G_UPROOT};
+    for (size_t k = 0; k < sizeof opts_mss / sizeof *opts_mss; k++)
+      if (not_here(o, opts_mss[k], why)) return EXIT_USAGE;
+    if (d->opt.wind_model == VD_MSS_WIND_PAPER &&
+        not_here(o, G_WIND_MODEL, "the rods load the wind on each segment's projected area (--wind-model area)"))
+      return EXIT_USAGE;
+    int wind = vd_norm(d->opt.wind) > 0 || o->wind_file;
+    if (d->opt.drag == VD_MSS_DRAG_STOKES &&
+        not_here(o, G_DRAG, "the rods' air load is quadratic drag on the air's velocity relative to each segment; "
+                            "use --drag quadratic (or none without wind)"))
+      return EXIT_USAGE;
+    if (d->opt.drag == VD_MSS_DRAG_NONE && wind &&
+        not_here(o, G_DRAG, "--drag none turns the rods' air load off, wind included: drop --wind or --drag none"))
+      return EXIT_USAGE;
+  } else {
+    if (d->mss.springs != VD_MSS_PAPER &&
+        not_here(o, G_K0, "k0 sets the paper's springs (eq. 2, k = k0 d / l): add --springs paper"))
+      return EXIT_USAGE;
+    if (d->mss.springs == VD_MSS_PAPER &&
+        not_here(o, G_YOUNG, "--springs paper takes its stiffness from --k0, not from Young's modulus"))
+      return EXIT_USAGE;
+  }
+  // the seed's wind load (eqs. 9-10) takes C_drag 1 (sec. 3.3) unless --cd says otherwise
+  if (d->opt.wind_model == VD_MSS_WIND_PAPER && !o->seen[G_CD]) d->opt.drag_cd = 1;
+  // the rods' leaves are plates: --leaf-cd sets their drag coefficient
+  if (rods && o->seen[G_LEAF_CD]) d->rods.leaf_plate_cd = d->opt.leaf_cd;
+  return EXIT_OK;
+}
+
 // ---------------------------------------------------------------------------------------------
 // outputs
 
 static vd_status write_text(const char* path, const char* text, vd_error* err) {
   vd_outfile f;
-  int w = cli_watch(path);
   vd_status st = vd_outfile_open(&f, path, err);
   if (!st) {
     fputs(text, f.fp);
     st = vd_outfile_commit(&f, err);
   }
-  cli_unwatch(w);
   return st;
 }
 
@@ -365,7 +492,7 @@ static cJSON* stats_json(const vd_growth* g, const vd_growth_def* def, double wa
   cJSON_AddNumberToObject(o, "substeps", (double)s.substeps);
   cJSON_AddNumberToObject(o, "cg_iterations", (double)s.cg_iterations);
   cJSON_AddNumberToObject(o, "unstable_substeps", (double)s.unstable);
-  cJSON_AddNumberToObject(o, "wall_seconds", wall);
+  if (wall >= 0) cJSON_AddNumberToObject(o, "wall_seconds", wall);  // --profile
   int n;
   const vd_growth_event* ev = vd_growth_events(g, &n);
   cJSON* arr = cJSON_AddArrayToObject(o, "events");
@@ -432,6 +559,7 @@ int cli_sim_grow(int argc, char** argv) {
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
       fputs(grow_help, stdout);
+      fputs(grow_help_forces, stdout);
       fputs(grow_help_output, stdout);
       fputs(cli_plant_help, stdout);
       return EXIT_OK;
@@ -448,12 +576,16 @@ int cli_sim_grow(int argc, char** argv) {
   if (!cli_has_ext(o.po.path, ".lpy"))
     return cli_usage_error(cmd, "'%s': --grow needs an .lpy file (the L-system grows the plant step by step)", o.po.path);
   if (!o.out && !o.stats && !o.final) return cli_usage_error(cmd, "nothing to do: give -o RUN/, --final FILE and/or --stats");
+  if (o.profile && !o.stats) return cli_usage_error(cmd, "--profile adds timings to --stats; give --stats");
   if (o.ply && !o.out) return cli_usage_error(cmd, "--ply writes into the run folder: give -o RUN/");
-  {
-    const char* ins[1] = {o.po.path};
-    const char* outs[2] = {o.out, o.final};
-    if (cli_check_outputs(cmd, outs, 2, ins, 1)) return EXIT_USAGE;
-  }
+  // the files: the model and the wind series read; the growth run folder (an earlier run's ages
+  // that this one does not write go when it completes) and --final written
+  static const char* const members[] = {"growth.json", "events.csv", "plant.json", "age_*.json", "age_*.ply"};
+  cli_out_plant_opts(&o.po);
+  cli_out_input("--wind-file", o.wind_file);
+  if (o.out) cli_out_folder("-o", o.out, members, 5, 1);
+  if (o.final) cli_out_plant("--final", o.final);
+  if (cli_out_check(cmd)) return EXIT_USAGE;
   vd_error err = {0};
   vd_lsystem* ls = NULL;
   vd_growth* g = NULL;
@@ -493,9 +625,8 @@ int cli_sim_grow(int argc, char** argv) {
   }
   cJSON_AddItemToObject(index, "snapshots", snaps);
   // the run folder: failing to write is a failed run (exit 1), not bad input
-  if (o.out && mkdir(o.out, 0777) && errno != EEXIST) {
-    vd_error_set(&err, VD_ERR_IO, o.out, 0, 0, "cannot create the output folder: %s", strerror(errno));
-    cli_report(cmd, &err, VD_ERR_IO);
+  if (o.out && (st = vd_outdir_make(o.out, &err))) {
+    cli_report(cmd, &err, st);
     code = EXIT_FAIL;
     goto done;
   }
@@ -506,7 +637,7 @@ int cli_sim_grow(int argc, char** argv) {
     if (o.out && (st = snapshot(g, &o, snaps, &err))) goto failed;
     if (o.po.progress) progress_bar(k + 1, ages, g);
   }
-  if (o.po.progress && ages > 0) fputc('\n', stderr);
+  if (o.po.progress && ages > 0) cli_progress_clear();
   double wall = cli_now() - t0;
   if (st) {
     // a step that failed: bad settings found on the way (a light the tree grew around) or the
@@ -555,7 +686,7 @@ int cli_sim_grow(int argc, char** argv) {
     if (st) goto failed;
   }
   if (o.stats) {
-    cJSON* s = stats_json(g, &o.def, wall);
+    cJSON* s = stats_json(g, &o.def, o.profile ? wall : -1);
     char* text = s ? cJSON_Print(s) : NULL;
     cJSON_Delete(s);
     if (!text) {

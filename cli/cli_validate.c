@@ -30,6 +30,9 @@ static void progress(void* user, const char* name) {
 }
 
 int cli_validate(int argc, char** argv) {
+  // validate writes no outputs: its scratch files (a robot, an exported beam) live in private
+  // mkdtemp folders that the library removes before it returns, so no output layer is asked
+  vd_outfile_set_guard(NULL);
   int json = 0, full = 0;
   const char* filter = NULL;
   cli_plant_opts po;
@@ -84,13 +87,15 @@ int cli_validate(int argc, char** argv) {
   int n = 0;
   double t0 = cli_now();
   st = vd_sim_validate(&def, &r, &n, &err);
-  // the mass-spring trees, growth runs and harvest cases (docs/validation.md) after the rods
-  for (int part = 0; part < 3 && !st; part++) {
+  // the mass-spring trees, growth runs, harvest cases and the flexible export in MuJoCo
+  // (docs/validation.md) after the rods
+  for (int part = 0; part < 4 && !st; part++) {
     vd_validate_result* r2 = NULL;
     int n2 = 0;
     st = part == 0   ? vd_mss_validate(&def, &r2, &n2, &err)
          : part == 1 ? vd_growth_validate(&def, &r2, &n2, &err)
-                     : vd_robot_validate(&def, &r2, &n2, &err);
+         : part == 2 ? vd_robot_validate(&def, &r2, &n2, &err)
+                     : vd_robot_validate_export(&def, &r2, &n2, &err);
     if (!st && n2) {
       vd_validate_result* all = vd_realloc(r, sizeof *r * (size_t)n, sizeof *r * (size_t)(n + n2));
       if (!all) {

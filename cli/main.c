@@ -33,6 +33,7 @@ static const char* main_help =
 int main(int argc, char** argv) {
   vd_set_log(log_to_stderr, NULL);
   cli_signals_init();
+  cli_out_init();  // every output through one layer: declared, checked, in place only on success
   if (argc < 2) {
     fputs(main_help, stderr);
     return EXIT_USAGE;
@@ -48,14 +49,18 @@ int main(int argc, char** argv) {
     printf("verdant %s\n", VD_VERSION_STRING);
     return EXIT_OK;
   }
-  if (!strcmp(cmd, "grow")) return cli_grow(argc - 1, argv + 1);
-  if (!strcmp(cmd, "cloud")) return cli_cloud(argc - 1, argv + 1);
-  if (!strcmp(cmd, "dataset")) return cli_dataset(argc - 1, argv + 1);
-  if (!strcmp(cmd, "render")) return cli_render(argc - 1, argv + 1);
-  if (!strcmp(cmd, "sim")) return cli_sim(argc - 1, argv + 1);
-  if (!strcmp(cmd, "validate")) return cli_validate(argc - 1, argv + 1);
-  if (!strcmp(cmd, "harvest")) return cli_harvest(argc - 1, argv + 1);
-  if (!strcmp(cmd, "export")) return cli_export(argc - 1, argv + 1);
+  static const struct {
+    const char* name;
+    int (*run)(int, char**);
+  } cmds[] = {{"grow", cli_grow},         {"cloud", cli_cloud}, {"dataset", cli_dataset},
+              {"render", cli_render},     {"sim", cli_sim},     {"validate", cli_validate},
+              {"harvest", cli_harvest},   {"export", cli_export}};
+  for (size_t k = 0; k < sizeof cmds / sizeof *cmds; k++)
+    if (!strcmp(cmd, cmds[k].name)) {
+      fflush(stdout);
+      // the outputs go in place only when the whole command succeeded
+      return cli_out_finish(cmd, cmds[k].run(argc - 1, argv + 1));
+    }
   fprintf(stderr, "verdant: unknown command '%s'\n", cmd);
   fputs(main_help, stderr);
   return EXIT_USAGE;

@@ -19,6 +19,23 @@ import sys
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
+# pip builds a wheel through setup.py bdist_wheel: setuptools >= 70.1 has it, older ones need the
+# wheel package. Without either, setuptools says only "invalid command 'bdist_wheel'".
+try:
+    from setuptools.command.bdist_wheel import bdist_wheel as _bdist_wheel  # noqa: F401
+except ImportError:
+    try:
+        from wheel.bdist_wheel import bdist_wheel as _bdist_wheel  # noqa: F401
+    except ImportError:
+        _bdist_wheel = None
+NO_WHEEL_HINT = (
+    f"verdant: {sys.executable} cannot build a wheel: its setuptools has no bdist_wheel command "
+    "and the 'wheel' package is not installed. Install it into that Python "
+    f"({sys.executable} -m pip install wheel, or Debian's python3-wheel), or use Debian's Python: "
+    "python3 -m venv --system-site-packages venv && venv/bin/pip install ./python")
+if _bdist_wheel is None and "bdist_wheel" in sys.argv[1:]:
+    sys.exit(NO_WHEEL_HINT)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.environ.get("VERDANT_SOURCE_DIR") or os.path.dirname(HERE)
 
@@ -51,6 +68,7 @@ setup(
     description="Virtual plants: L-systems to labelled plants, physics, point clouds and images",
     license="MIT",
     packages=["verdant"],
+    package_data={"verdant": ["*.pyi", "py.typed"]},
     package_dir={"verdant": os.path.join(HERE, "verdant")} if HERE != os.getcwd() else {},
     ext_modules=[Extension("verdant._verdant", sources=[])],
     cmdclass={"build_ext": CMakeBuild},

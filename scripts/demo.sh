@@ -18,7 +18,7 @@ lo, hi = d["bbox_min"], d["bbox_max"]
 print(f"   size {hi[0]-lo[0]:.2f} x {hi[1]-lo[1]:.2f} x {hi[2]-lo[2]:.2f} m, {d['total_length']:.2f} m of segments in all")
 PY
 echo "== a labelled point cloud of the tomato (200k points, interior points removed)"
-"$V" cloud data/tomato.lpy --seed 1 --points 200000 -o out/tomato-cloud.ply --stats > out/tomato-cloud-stats.json
+"$V" cloud data/tomato.lpy --seed 1 --points 200000 -o out/tomato-cloud.ply --stats --profile > out/tomato-cloud-stats.json
 "$V" cloud data/tomato.lpy --seed 1 --sensor scan --scanners data/scanners/turntable8.json --noise 0.001 \
   -o out/tomato-scan.ply
 python3 - out/tomato-cloud-stats.json <<'PY' || cat out/tomato-cloud-stats.json
@@ -42,7 +42,7 @@ echo "   tomato-arm.png, tomato-cloud.png"
 echo "== physics: the tomato settles under gravity, then (sag-free) a probe pushes through it"
 "$V" sim data/tomato.lpy --seed 1 --settle --no-progress --stats > out/tomato-settle.json
 "$V" sim data/tomato.lpy --seed 1 --sag-free --duration 1.5 --no-progress \
-  --probe 0.04:0.4,0,0.8:-0.4,0,0.8 -o out/tomato-run --final out/tomato-pushed.obj --stats > out/tomato-probe.json
+  --probe 0.04:0.4,0,0.8:-0.4,0,0.8 -o out/tomato-run --final out/tomato-pushed.obj --stats --profile > out/tomato-probe.json
 python3 - out/tomato-settle.json out/tomato-probe.json <<'PY' || cat out/tomato-settle.json out/tomato-probe.json
 import json, sys
 s, p = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
@@ -60,7 +60,7 @@ else
   echo "   out/tomato-probe.png (install Debian's ffmpeg for a video: verdant render out/tomato-run --mp4 x.mp4)"
 fi
 echo "== harvest: the Lite 6 grasps the nearest reachable cherry tomato and pulls it off"
-"$V" harvest data/scenes/tomato_pull.json -o out/harvest --stats --no-progress > out/harvest-summary.json
+"$V" harvest data/scenes/tomato_pull.json -o out/harvest --stats --profile --no-progress > out/harvest-summary.json
 python3 - out/harvest-summary.json <<'PY' || cat out/harvest-summary.json
 import json, sys
 d = json.load(open(sys.argv[1]))

@@ -9,6 +9,48 @@
 set -u
 cd "$(dirname "$0")/.."
 root=$PWD
+
+# The output layer (docs/reliability.md, "One output layer"): every file a command writes goes
+# through vd_outfile / vd_outdir_make (src/core/core_file.c), which hand it to the CLI's layer
+# (cli/cli_paths.c). Anywhere else, a call that creates, replaces or removes a file or folder
+# by name is a finding: fopen/freopen with a mode that writes, open/openat without O_RDONLY,
+# creat, mkdir, mkdtemp, mkstemp, tmpfile, rename, link, symlink, unlink, remove, rmdir,
+# truncate. Comments and string literals are not searched. `scripts/lint.sh --outputs [FILE.c ...]`
+# runs only this check (no tools needed; exit 1 on a finding).
+output_allowed=(
+  src/core/core_file.c       # the library's writer: temporary name, then the guard or a rename
+  cli/cli_paths.c            # the CLI's output layer: declarations, commit, rollback on signals
+  src/robot/robot_validate.c # `verdant validate`: a scratch robot in a private mkdtemp folder,
+                             # removed before it returns; never an output
+  src/robot/robot_export_check.c # `verdant validate --case export_flex`: an exported beam in a
+                             # private mkdtemp folder, removed before it returns; never an output
+)
+output_check() {
+  local calls='(open|openat|creat|mkdir|mkdirat|mkdtemp|mkstemp|mkostemp|tmpfile|rename|renameat|link|linkat|symlink|unlink|unlinkat|remove|rmdir|truncate|ftruncate)'
+  local f a hits found=0
+  for f in "$@"; do
+    for a in "${output_allowed[@]}"; do [ "$f" = "$a" ] && continue 2; done
+    hits=$({
+      sed -E -e 's://.*$::' -e 's/"([^"\\]|\\.)*"/""/g' "$f" | grep -nE "(^|[^.>_[:alnum:]])$calls[[:space:]]*\(" |
+        grep -vE "(^|[^_[:alnum:]])open(at)?[[:space:]]*\(.*O_RDONLY"
+      sed -E -e 's://.*$::' "$f" | grep -nE "(^|[^.>_[:alnum:]])f(re)?open[[:space:]]*\([^;]*\"[^\"]*[wa+][^\"]*\""
+    } | sort -n -u)
+    if [ -n "$hits" ]; then
+      found=1
+      while IFS= read -r h; do
+        echo "$f:${h%%:*}: a file written outside the output layer (use vd_outfile_open / vd_outdir_make; docs/reliability.md): ${h#*:}"
+      done <<<"$hits"
+    fi
+  done
+  return $found
+}
+if [ "${1:-}" = "--outputs" ]; then
+  shift
+  if [ $# -eq 0 ]; then mapfile -t ofiles < <(find src cli python/src -name '*.c' | sort); else ofiles=("$@"); fi
+  output_check "${ofiles[@]}" && echo "lint: outputs: every file is written through the output layer (${#ofiles[@]} files)" >&2
+  exit $?
+fi
+
 out=${LINT_BUILD:-build-lint}
 jobs=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 for tool in clang-tidy cppcheck cmake; do
@@ -36,6 +78,10 @@ else
 fi
 start=$(date +%s)
 fail=0
+
+# the output layer first (a moment, no tools)
+echo "lint: outputs through the output layer" >&2
+output_check "${files[@]}" || fail=1
 
 # clang-tidy: one file per process, $jobs at a time; the notes it prints on stderr go away
 echo "lint: clang-tidy $(clang-tidy --version | sed -n 's/.*version \([0-9.]*\).*/\1/p') on ${#files[@]} files, $jobs jobs" >&2

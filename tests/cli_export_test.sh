@@ -3,7 +3,7 @@
 # End-to-end tests of `verdant export`: URDF, SDF and MJCF files of the tomato; the MJCF loads in
 # MuJoCo alone and beside the arm (--check, --check-with: always run, no OpenGL needed); the URDF
 # passes check_urdf (liburdfdom-tools) and the SDF `ign sdf -k` (ignition-tools, libsdformat)
-# when they are installed; bad usage is exit 2, an unwritable output exit 1, nothing left.
+# when they are installed; bad usage and an unwritable output are exit 2, nothing left.
 # Usage: cli_export_test.sh VERDANT_BINARY SOURCE_DIR
 source "$(dirname "$0")/cli_lib.sh" cli_export "$@"
 
@@ -32,17 +32,42 @@ if python3 - "$T" <<'PY'
 import json, sys
 t = sys.argv[1]
 alone, arm, far = (json.load(open(f"{t}/{n}.json")) for n in ("alone", "arm", "far"))
-assert alone["joints"] == 0 and alone["plant_bodies"] == alone["bodies"] - 2 > 50, alone
-assert alone["plant_geoms"] == alone["geoms"] and alone["meshes"] > 20, alone
-assert arm["plant_bodies"] == alone["plant_bodies"] and arm["joints"] > 0, arm
+# flexible: three hinge springs per link; plant geoms never touch each other (contype 2,
+# conaffinity 1) but do touch the arm's
+assert alone["joints"] == 3 * (alone["plant_bodies"] - 1) and alone["plant_bodies"] == alone["bodies"] - 2 > 50, alone
+assert alone["plant_geoms"] == alone["geoms"] and alone["meshes"] > 20 and alone["contacts"] == 0, alone
+assert arm["plant_bodies"] == alone["plant_bodies"] and arm["joints"] > alone["joints"], arm
 assert arm["plant_robot_contacts"] > 0 and far["plant_robot_contacts"] == 0, (arm, far)
 PY
 then ok "mjcf loads, alone and with the arm"; else bad "mjcf loads, alone and with the arm"; fi
+# --static: the drawn plant, one rigid body per organ, no joints
+expect "export mjcf static" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/static.xml" --static \
+  --check-with "$SRC/data/robots/arm6.xml"
+cp "$T/out" "$T/static.json"
+# rigid links per organ: masses and no plant joints; 2 links per organ: fewer bodies than auto
+expect "export mjcf rigid" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/rigid.xml" \
+  --links-per-organ rigid --check
+cp "$T/out" "$T/rigid.json"
+expect "export mjcf two links per organ" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/two.xml" \
+  --links-per-organ 2 --check
+cp "$T/out" "$T/two.json"
+if python3 - "$T" <<'PY'
+import json, sys
+t = sys.argv[1]
+alone, st, rigid, two = (json.load(open(f"{t}/{n}.json")) for n in ("alone", "static", "rigid", "two"))
+assert st["plant_robot_contacts"] > 0 and st["plant_bodies"] < alone["plant_bodies"], st
+assert rigid["joints"] == 0 and rigid["plant_bodies"] < two["plant_bodies"] < alone["plant_bodies"], (rigid, two)
+assert two["joints"] == 3 * (two["plant_bodies"] - 1), two
+PY
+then ok "static, rigid and coarser links"; else bad "static, rigid and coarser links"; fi
+expect "export bad links per organ" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.xml" --links-per-organ 0
+expect "export bad damping ratio" 2 "$V" export "$SRC/data/tomato.lpy" -o "$T/x.xml" --damping-ratio -1
 if ls "$T"/*.scene.xml >/dev/null 2>&1; then bad "no scene left behind"; else ok "no scene left behind"; fi
-# the Lite 6, whose MJCF includes its gripper's
+# the Lite 6, whose MJCF includes its gripper's; its keyframe covers its own joints, so the
+# plant comes rigid (MuJoCo 2.2.2 wants a key's qpos to cover every joint of the scene)
 if [ -f "$SRC/data/robots/lite6.xml" ]; then
   expect "export mjcf with the Lite 6" 0 "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/plant.xml" \
-    --check-with "$SRC/data/robots/lite6.xml"
+    --links-per-organ rigid --check-with "$SRC/data/robots/lite6.xml"
   if grep -Eq '"plant_bodies":[[:space:]]+[1-9]' "$T/out" && grep -Eq '"joints":[[:space:]]+[1-9]' "$T/out"; then ok "Lite 6 scene loads"; else bad "Lite 6 scene loads: $(head -c 300 "$T/out")"; fi
 fi
 
@@ -59,12 +84,26 @@ fi
 if command -v ign >/dev/null 2>&1 && ign sdf --help >/dev/null 2>&1; then
   expect "ign sdf -k accepts the SDF" 0 ign sdf -k "$T/plant.sdf"
   if grep -q "^Valid" "$T/out"; then ok "ign sdf says valid"; else bad "ign sdf says valid: $(head -c 300 "$T/out")"; fi
+  # the URDF as Gazebo reads it: every link kept (sdformat drops a massless link with its
+  # subtree and lumps fixed joints), flexible and rigid; the springs become SDF springs
+  for mode in auto rigid; do
+    "$V" export "$SRC/data/tomato.lpy" --seed 2 -o "$T/g_$mode.urdf" --links-per-organ $mode >/dev/null 2>&1
+    ign sdf -p "$T/g_$mode.urdf" >"$T/g_$mode.sdf" 2>/dev/null
+    nu=$(grep -c '<link name=' "$T/g_$mode.urdf"); ns=$(grep -c "<link name=" "$T/g_$mode.sdf")
+    if [ "$ns" -eq $((nu - 1)) ] && [ "$ns" -gt 50 ]; then ok "ign sdf -p keeps every link ($mode: $ns)"
+    else bad "ign sdf -p keeps every link ($mode: $ns of $((nu - 1)))"; fi
+  done
+  nj=$(grep -c "springStiffness" "$T/g_auto.urdf"); nk=$(grep -c "<spring_stiffness>" "$T/g_auto.sdf")
+  if [ "$nj" -eq "$nk" ] && [ "$nk" -gt 50 ]; then ok "URDF springs reach the SDF ($nk)"; else bad "URDF springs reach the SDF ($nk of $nj)"; fi
 else
   echo "skip: ign sdf is not installed (Debian: ignition-tools, libsdformat-dev)"
 fi
 
-# an unwritable output: exit 1, nothing left (no mesh folder either)
-expect "unwritable export" 1 "$V" export "$SRC/data/tomato.lpy" -o "/nonexistent-dir/p.urdf"
+# the exported plant in MuJoCo bends as the rods do (self-weight and tip load within 5 %)
+expect "validate the flexible export" 0 "$V" validate --case export_flex --no-progress
+
+# an unwritable output: exit 2 (found before the run), nothing left (no mesh folder either)
+expect "unwritable export" 2 "$V" export "$SRC/data/tomato.lpy" -o "/nonexistent-dir/p.urdf"
 if [ -e /nonexistent-dir ]; then bad "nothing left after a failed export"; else ok "nothing left after a failed export"; fi
 
 echo "$pass passed, $fail failed"

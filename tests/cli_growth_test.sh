@@ -95,6 +95,60 @@ expect "validate rigid" 0 "$V" validate --case rigid --no-progress
 expect "validate bastien" 0 "$V" validate --case bastien --no-progress
 expect "validate growth momentum" 0 "$V" validate --case growth_momentum --json --no-progress
 json_check "validate json" "len(d) == 2 and all(r['pass'] for r in d)"
+expect "validate grown stem" 0 "$V" validate --case growth_stem --json --no-progress
+json_check "grown stem sags as Euler-Bernoulli" "len(d) == 4 and all(r['pass'] for r in d)"
+
+# options that do not apply are errors naming the option and why; order never matters (issue
+# 19 item 4, issue 26 defect 4)
+expect "soil method without a soil" 2 "$V" sim "$TREE" --grow --stats --ages 1 --soil-method pang
+expect_err "soil method named" "--soil-method does not apply.*--soil"
+for opt in "--clay 30" "--organic 2" "--water 0.3" "--bulk-density 1.3" "--poisson 0.3" "--uproot-tilt 20"; do
+  expect "$opt without a soil" 2 "$V" sim "$TREE" --grow --stats --ages 1 $opt
+  expect_err "$opt named" "${opt%% *} does not apply"
+done
+expect "clay with eq. 12" 2 "$V" sim "$TREE" --grow --stats --ages 1 --soil loam --soil-method pang --clay 30
+expect_err "clay with pang named" "--clay does not apply.*eq. 12"
+expect "poisson with method 2" 2 "$V" sim "$TREE" --grow --stats --ages 1 --soil loam --poisson 0.3
+expect "rigid age with mss" 2 "$V" sim "$TREE" --grow --stats --ages 1 --model mss --rigid-age 2
+expect_err "rigid age named" "--rigid-age does not apply.*--model mrl"
+expect "eq8 with rods" 2 "$V" sim "$TREE" --grow --stats --ages 1 --model rods --eq8 paper
+expect "k0 without paper springs" 2 "$V" sim "$TREE" --grow --stats --ages 1 --k0 1e3,1e4
+expect_err "k0 named" "--k0 does not apply.*--springs paper"
+expect "k0 with paper springs" 0 "$V" sim "$TREE" --grow --stats --ages 1 --substeps 2 --springs paper --k0 1e3,1e4
+expect "young with paper springs" 2 "$V" sim "$TREE" --grow --stats --ages 1 --springs paper --young 1e9,1e10
+for opt in "--paper" "--springs paper" "--integrator eq3" "--damping 0.5" "--strain-limit 0" "--light 5,0,3" "--gravitropism sine" "--wind-model paper" "--drag stokes"; do
+  expect "rods refuse $opt" 2 "$V" sim "$TREE" --grow --stats --ages 1 --model rods $opt
+  expect_err "rods $opt named" "${opt%% *} does not apply"
+done
+expect "rods refuse drag none in wind" 2 "$V" sim "$TREE" --grow --stats --ages 1 --model rods --wind 10,0,0 --drag none
+expect "rods drag none without wind" 0 "$V" sim "$TREE" --grow --stats --ages 1 --substeps 2 --model rods --drag none
+# order: clay before or after the soil preset, species before or after --young, --paper anywhere
+expect "clay after soil" 0 "$V" sim "$TREE" --grow --stats --ages 2 --substeps 5 --soil loam --clay 40
+cp "$T/out" "$T/clay_after.json"
+expect "clay before soil" 0 "$V" sim "$TREE" --grow --stats --ages 2 --substeps 5 --clay 40 --soil loam
+if $PY -c "import json,sys; a=json.load(open('$T/clay_after.json')); b=json.load(open('$T/out')); [x.pop('wall_seconds') for x in (a, b)]; sys.exit(0 if a == b else 1)"; then ok "soil options in any order"; else bad "soil options in any order"; fi
+expect "young after species" 0 "$V" sim "$TREE" --grow --stats --ages 1 --substeps 5 --model rods --species hopea-odorata --young 1e9,5e9
+cp "$T/out" "$T/sp_after.json"
+expect "young before species" 0 "$V" sim "$TREE" --grow --stats --ages 1 --substeps 5 --model rods --young 1e9,5e9 --species hopea-odorata
+if $PY -c "import json,sys; a=json.load(open('$T/sp_after.json')); b=json.load(open('$T/out')); [x.pop('wall_seconds') for x in (a, b)]; sys.exit(0 if a == b else 1)"; then ok "species options in any order"; else bad "species options in any order"; fi
+# the rods take the species: Hopea's wood is lighter than the generic one
+expect "rods generic" 0 "$V" sim "$TREE" --grow --stats --ages 2 --substeps 2 --model rods
+cp "$T/out" "$T/rods_generic.json"
+expect "rods hopea" 0 "$V" sim "$TREE" --grow --stats --ages 2 --substeps 2 --model rods --species hopea-odorata --no-breaking
+if $PY -c "import json,sys; a=json.load(open('$T/rods_generic.json')); b=json.load(open('$T/out')); sys.exit(0 if b['total_mass'] < a['total_mass'] and b['broken_branches'] == 0 else 1)"; then ok "rods take the species"; else bad "rods take the species"; fi
+
+# issue 26 defect 8: the growth bench's --help prints its usage, runs nothing, writes no CSV
+B="$(dirname "$V")/verdant_bench_growth"
+if [ -x "$B" ]; then
+  csv="$SRC/bench/results/growth-2core.csv"
+  before=$(sha256sum < "$csv" 2>/dev/null)
+  expect "bench growth help" 0 "$B" --help
+  grep -q "usage: verdant_bench_growth" "$T/out" && ok "bench help is usage" || bad "bench help is usage"
+  [ "$(sha256sum < "$csv" 2>/dev/null)" = "$before" ] && ok "bench help keeps the CSV" || bad "bench help rewrote the CSV"
+  expect "bench growth bad argument" 2 "$B" --frobnicate
+else
+  echo "skip: verdant_bench_growth not built"
+fi
 
 # pictures of the ages
 if "$V" render --help >/dev/null 2>&1; then

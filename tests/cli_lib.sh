@@ -26,3 +26,15 @@ expect() {
 expect_err() {
   if grep -Eq -e "$2" "$T/err"; then ok "$1"; else bad "$1 (stderr: $(head -c 300 "$T/err"))"; fi
 }
+# have_pty WHAT: util-linux's script can give a run a pseudo-terminal here (a container may have
+# no script or no /dev/ptmx to open); else prints "skip WHAT (why)" and fails
+have_pty() {
+  if ! command -v script >/dev/null 2>&1; then
+    echo "skip $1 (no script command: util-linux)"
+    return 1
+  fi
+  if ! script -qc true /dev/null >/dev/null 2>&1; then
+    echo "skip $1 (no pseudo-terminal can be opened here: $(script -qc true /dev/null 2>&1 | head -c 200))"
+    return 1
+  fi
+}

@@ -49,19 +49,20 @@ cp tom.json ds/plant.json
 expect "dataset beside its input" 0 "$V" dataset ds/plant.json --count 1 -N 100 -o ds
 
 # --- a command's outputs appear together or not at all (issue 12, item 3) ---
-# an output that cannot be written (a folder in its place) stops the command before anything
+# an output that cannot be written (a folder in its place) stops the command before anything:
+# exit 2, one rule for every output (docs/reliability.md)
 mkdir out.obj
-expect "grow .obj onto a folder" 1 "$V" grow tom.json -o out.obj
-expect_err "the folder is named" "out.obj: cannot write: it is a folder"
+expect "grow .obj onto a folder" 2 "$V" grow tom.json -o out.obj
+expect_err "the folder is named" "cannot write 'out.obj' \(-o\): it is a folder"
 if [ ! -e out.mtl ]; then ok "no .mtl without its .obj"; else bad "no .mtl without its .obj"; fi
 rmdir out.obj && mkdir out.mtl
-expect "grow .obj with a folder for its .mtl" 1 "$V" grow tom.json -o out.obj
+expect "grow .obj with a folder for its .mtl" 2 "$V" grow tom.json -o out.obj
 if [ ! -e out.obj ]; then ok "no .obj without its .mtl"; else bad "no .obj without its .mtl"; fi
 rmdir out.mtl
 mkdir r.label.png
-expect "render with a folder for its mask" 1 "$V" render tom.json -o r.png --masks --depth --size 64x48
+expect "render with a folder for its mask" 2 "$V" render tom.json -o r.png --masks --depth --size 64x48
 if ls r.png r.depth.png r.instance.png r.png.json 2>/dev/null; then bad "no image without its masks"; else ok "no image without its masks"; fi
-expect "grow into a missing folder" 1 "$V" grow tom.json -o nowhere/t.obj
+expect "grow into a missing folder" 2 "$V" grow tom.json -o nowhere/t.obj
 # a run that fails half way (unstable) takes back every file it wrote: a new folder goes, an
 # earlier run in the folder comes back as it was
 A="$SRC/data/arabidopsis.lpy"

@@ -259,7 +259,7 @@ expect "render jsonl run" 0 "$V" render "$T/runj" -o "$T/j.png" --time 0.025 --s
 # no context: exit 1 and a clear message
 __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json expect "run without a context" 1 "$V" render "$T/run" -o "$T/noctx.png"
 expect_err "no context message" "no OpenGL context"
-expect "unwritable folder" 1 "$V" render "$T/run" -o "/nonexistent-dir/frames/" --size 32x24
+expect "unwritable folder" 2 "$V" render "$T/run" -o "/nonexistent-dir/frames/" --size 32x24
 
 # datasets of images: N views per item beside the clouds, in the manifest
 expect "dataset with images" 0 "$V" dataset "$T/p.lpy" --count 2 --points 500 --images 2 --image-size 96x72 -o "$T/ds"

@@ -236,8 +236,8 @@ expect_err "robot error names file" "badrobot.xml"
 printf 'Axiom: A\n' >"$T/empty.lpy"
 expect "empty plant" 0 "$V" render "$T/empty.lpy" -o "$T/empty.png" --masks --size 64x48
 
-# an unwritable output: exit 1, nothing left
-expect "unwritable output" 1 "$V" render "$SRC/data/tomato.lpy" -o "/nonexistent-dir/x.png" --size 64x48
+# an unwritable output: exit 2 (found before the run), nothing left
+expect "unwritable output" 2 "$V" render "$SRC/data/tomato.lpy" -o "/nonexistent-dir/x.png" --size 64x48
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -35,6 +35,12 @@ printf 'Axiom: A\nproduction:\nA --> AB\n' >"$T/nat.lpy"
 expect "native file, native engine" 0 "$V" grow "$T/nat.lpy" -n 3 --stats
 if grep -q '"engine":.*"native"' "$T/out"; then ok "stats name the native engine"; else bad "stats name the native engine"; fi
 expect "forced python engine" 0 "$V" grow "$T/unsup.lpy" --engine python --stats
+# what native refuses only when it runs (string formatting) falls back to Python (issue 19)
+printf 'Axiom: A(1)\nderivation length: 1\nproduction:\nA(x):\n  s = "a%%d" %% x\n  produce B(x + 1)\n' >"$T/fmt.lpy"
+expect "auto falls back to python at run time" 0 "$V" grow "$T/fmt.lpy" --stats
+if grep -q '"engine":.*"python"' "$T/out" && grep -q '"B":.*1' "$T/out"; then ok "fallback named in --stats"; else bad "fallback named in --stats ($(head -c 300 "$T/out"))"; fi
+expect "forced native keeps its error" 2 "$V" grow "$T/fmt.lpy" --engine native --stats
+expect_err "native's error names the line" "fmt.lpy:5:"
 expect "bad --engine" 2 "$V" grow "$T/unsup.lpy" --engine perl --stats
 # the README's Python engine examples
 expect "python engine example" 0 "$V" grow "$SRC/data/python_bud.lpy" --stats
@@ -93,8 +99,8 @@ if command -v assimp >/dev/null 2>&1; then
 else
   echo "skip assimp import checks (assimp-utils not installed)"
 fi
-# an unwritable output: exit 1 (failed run), no temporary file left
-expect "unwritable output" 1 "$V" grow "$T/plant.lpy" -o "/nonexistent-dir/x.obj"
+# an unwritable output: exit 2 (found before the run; docs/reliability.md), no temporary file left
+expect "unwritable output" 2 "$V" grow "$T/plant.lpy" -o "/nonexistent-dir/x.obj"
 # --lstring: the derived string as JSON (names and parameters)
 expect "grow --lstring" 0 "$V" grow "$T/plant.lpy" -o "$T/ls.json" --lstring "$T/lstring.json" -n 1
 if /usr/bin/python3 -c 'import json,sys; m = json.load(open(sys.argv[1]))["modules"]; assert [x[0] for x in m] == ["SetWidth", "I", "[", "+", "Leaf", "]", "/", "A"] and m[7] == ["A", 2]' "$T/lstring.json"; then

@@ -144,6 +144,26 @@ TEST(core, rotate_and_quat) {
   CHECK_NEAR(id.w, 1, 1e-15);
 }
 
+// quartiles by linear interpolation (numpy.quantile's default): the values below are numpy's
+TEST(core, quantiles_interpolate) {
+  const double two[2] = {1, 3};  // the old rule gave q25 = median = q75 = 1
+  CHECK_NEAR(vd_quantile_sorted(two, 2, 0.25), 1.5, 1e-15);
+  CHECK_NEAR(vd_quantile_sorted(two, 2, 0.5), 2, 1e-15);
+  CHECK_NEAR(vd_quantile_sorted(two, 2, 0.75), 2.5, 1e-15);
+  const double four[4] = {1, 2, 3, 4};
+  CHECK_NEAR(vd_quantile_sorted(four, 4, 0.25), 1.75, 1e-15);
+  CHECK_NEAR(vd_quantile_sorted(four, 4, 0.75), 3.25, 1e-15);
+  // six forces: the median is the mean of the middle two (1.51442, not the lower 1.49974)
+  const double six[6] = {1.2, 1.41, 1.49974, 1.5291, 1.6, 1.75};
+  CHECK_NEAR(vd_quantile_sorted(six, 6, 0.5), 1.51442, 1e-12);
+  CHECK_NEAR(vd_quantile_sorted(six, 6, 0.25), 1.41 + 0.25 * (1.49974 - 1.41), 1e-12);
+  const double one[1] = {7};
+  CHECK_NEAR(vd_quantile_sorted(one, 1, 0.25), 7, 0);
+  CHECK_NEAR(vd_quantile_sorted(one, 1, 1), 7, 0);
+  CHECK_NEAR(vd_quantile_sorted(four, 4, 0), 1, 0);
+  CHECK_NEAR(vd_quantile_sorted(four, 4, 1), 4, 0);
+}
+
 TEST(core, atomic_file) {
   char path[512];
   snprintf(path, sizeof path, "%s/atomic.txt", vdt_tmpdir());

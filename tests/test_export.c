@@ -232,3 +232,76 @@ TEST(export, bad_settings_leave_nothing) {
   rmdir(bad);
   vd_model_destroy(m);
 }
+
+// the flexible export: a body per rod segment that is not held, three hinge springs each, the
+// rods' masses (the lumped masses of the free nodes) in total, break thresholds where the rods
+// break; N links per organ gives fewer bodies with the same total
+static double sum_attr(const char* s, const char* key) {
+  double total = 0;
+  size_t kl = strlen(key);
+  for (const char* p = strstr(s, key); p; p = strstr(p + kl, key))
+    total += strtod(p + kl, NULL);
+  return total;
+}
+
+TEST(export, flexible_mjcf_from_the_rods) {
+  vd_model* m = vdt_tomato(3);
+  REQUIRE(m);
+  vd_sim_def sd = vd_sim_def_default();
+  vd_sim_model* sm = NULL;
+  vd_error err = {0};
+  CHECK_STATUS(vd_sim_build(m, &sd, &sm, &err), VD_OK, err);
+  REQUIRE(sm);
+  vd_export_rods rods;
+  CHECK_STATUS(vd_sim_export_rods(sm, m, &rods, &err), VD_OK, err);
+  int nfree = 0, nbreak = 0;
+  double mfree = 0;
+  for (int t = 0; t < sm->nseg; t++) {
+    if (sm->seg_flags[t] & VD_SIM_FIXED) continue;
+    nfree++;
+    nbreak += sm->seg_spare[t] >= 0;
+    int n1 = sm->seg_node[2 * t + 1];
+    if (sm->node_owner[n1] == t) mfree += sm->node_mass[n1];
+  }
+  char path[512], coarse[512];
+  snprintf(path, sizeof path, "%s/flex.xml", vdt_tmpdir());
+  snprintf(coarse, sizeof coarse, "%s/flex2.xml", vdt_tmpdir());
+  vd_export_def def = vd_export_def_default();
+  def.rods = &rods;
+  CHECK_STATUS(vd_geom_export(m, NULL, &def, path, &err), VD_OK, err);
+  def.links_per_organ = 2;
+  CHECK_STATUS(vd_geom_export(m, NULL, &def, coarse, &err), VD_OK, err);
+  char* s = slurp(path);
+  char* c = slurp(coarse);
+  REQUIRE(s && c);
+  CHECK_INT(count(s, "<inertial "), nfree);
+  CHECK_INT(count(s, "type=\"hinge\""), 3 * nfree);
+  CHECK_INT(count(s, "<numeric name=\"plant/break/"), nbreak);
+  CHECK(nbreak > 0);
+  CHECK_NEAR(sum_attr(s, " mass=\""), mfree, 1e-9 * mfree + 1e-12);
+  CHECK_NEAR(sum_attr(c, " mass=\""), mfree, 1e-9 * mfree + 1e-12);
+  CHECK(count(c, "<inertial ") < nfree / 2);
+  // the plant's geoms say how they collide, so that a robot's defaults do not decide
+  CHECK_INT(count(s, "contype=\"2\" conaffinity=\"1\""), count(s, "<geom "));
+  // MuJoCo loads both with every joint
+  vd_mjcf_info mi;
+  const char* one[1] = {path};
+  CHECK_STATUS(vd_render_mjcf_info(one, 1, "plant/", &mi, &err), VD_OK, err);
+  CHECK_INT(mi.njoint, 3 * nfree);
+  CHECK_INT(mi.ncontact, 0);
+  one[0] = coarse;
+  CHECK_STATUS(vd_render_mjcf_info(one, 1, "plant/", &mi, &err), VD_OK, err);
+  CHECK_INT(mi.njoint, 3 * count(c, "<inertial "));
+  // bad settings
+  def.links_per_organ = -2;
+  CHECK_STATUS(vd_geom_export(m, NULL, &def, path, &err), VD_ERR_ARG, err);
+  def.links_per_organ = 0, def.damping_ratio = -1;
+  CHECK_STATUS(vd_geom_export(m, NULL, &def, path, &err), VD_ERR_ARG, err);
+  free(s);
+  free(c);
+  unlink(path);
+  unlink(coarse);
+  vd_sim_export_rods_free(&rods);
+  vd_sim_model_destroy(sm);
+  vd_model_destroy(m);
+}

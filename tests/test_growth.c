@@ -209,15 +209,15 @@ TEST(growth, soil_strong_stands_weak_uproots) {
     if (m->node_flags[m->spring_node[2 * q + 1]] & VD_MSS_ROOT) root_stress = fmax(root_stress, d->spring_stress[q]);
   CHECK(root_stress < 1e6);  // Pa: the wind on the stem does not bend the roots
   vd_growth_destroy(g);
-  // the same loam by eq. 12 (millinewtons per node): the root plate gives way, the tree tips
-  // over onto the ground and is uprooted; it has collapsed against its drawn height
+  // the same loam by eq. 12 (millinewtons per node): the root plate gives way in the first
+  // substeps and the tree is uprooted; held by nothing (no friction on the ground), the sapling
+  // is blown downwind, and counts as collapsed
   g = grow_soil(ls, "loam", 1, VD_SOIL_PANG2023, &e);
   REQUIRE(g);
   vd_growth_get_stats(g, &s);
   CHECK(s.anchor_failed && s.anchor_load > 1 && s.uprooted);
   CHECK(has_event(g, VD_MSS_ANCHOR) && has_event(g, VD_MSS_UPROOT));
-  CHECK(s.collapsed && s.height < VD_GROWTH_COLLAPSE * s.drawn_height);
-  CHECK(!s.diverged && s.height >= 0);
+  CHECK(s.collapsed && isfinite(s.max_displacement) && s.height >= 0);
   vd_growth_destroy(g);
   vd_lsys_destroy(ls);
 }
@@ -226,24 +226,30 @@ TEST(growth, loam_and_clay_differ_at_capacity) {
   vd_lsystem* ls = load("data/tree.lpy");
   REQUIRE(ls);
   vd_error e = {0};
-  // both soils 1000 times weaker than their pedotransfer function (a loosened, soaked soil):
+  // both soils 2000 times weaker than their pedotransfer function (a loosened, soaked soil):
   // the sapling's wind moment uses about half of loam's anchorage and more than clay's
   // (SR 0.96 vs 0.25 MPa by da Silva & Kay 1997): loam stands, clay gives way
   vd_growth_stats s[2];
   const char* soil[2] = {"loam", "clay"};
   for (int k = 0; k < 2; k++) {
-    vd_growth* g = grow_soil(ls, soil[k], 1000, VD_SOIL_IMHOFF2016, &e);
+    vd_growth* g = grow_soil(ls, soil[k], 2000, VD_SOIL_IMHOFF2016, &e);
     REQUIRE(g);
     vd_growth_get_stats(g, &s[k]);
     vd_growth_destroy(g);
   }
   CHECK(s[0].anchor_load > 0.1 && s[0].anchor_load < 1 && !s[0].anchor_failed && !s[0].collapsed);
   CHECK(s[1].anchor_load > 1 && s[1].anchor_failed && s[1].uprooted && s[1].collapsed);
-  // the share used scales with 1 / SR: clay's is loam's times SR_loam / SR_clay
+  // the share used scales with 1 / SR: clay weakened by SR_loam / SR_clay less uses the share
+  // loam does
   vd_soil a, b;
   REQUIRE(vd_soil_preset("loam", &a) == VD_OK && vd_soil_preset("clay", &b) == VD_OK);
   double ratio = vd_soil_max_force(&a, 0.1, 0.01, 1) / vd_soil_max_force(&b, 0.1, 0.01, 1);
-  CHECK_NEAR(s[1].anchor_load / s[0].anchor_load, ratio, 0.05 * ratio);
+  vd_growth* g = grow_soil(ls, "clay", 2000 / ratio, VD_SOIL_IMHOFF2016, &e);
+  REQUIRE(g);
+  vd_growth_stats c;
+  vd_growth_get_stats(g, &c);
+  vd_growth_destroy(g);
+  CHECK_NEAR(c.anchor_load, s[0].anchor_load, 0.05 * s[0].anchor_load);
   vd_lsys_destroy(ls);
 }
 
@@ -261,11 +267,191 @@ TEST(growth, collapse_against_drawn_height) {
   vd_growth_destroy(g);
   // tipped over by a failed anchorage the rest shape leans with the tree (stress-free growth),
   // so height / rest height stays near 1; against the drawn height it has collapsed
-  g = grow_soil(ls, "loam", 1, VD_SOIL_PANG2023, &e);
+  g = grow_soil(ls, "clay", 2000, VD_SOIL_IMHOFF2016, &e);
   REQUIRE(g);
   vd_growth_get_stats(g, &s);
   CHECK(s.height0 < 0.6 * s.drawn_height);
   CHECK(s.collapsed);
   vd_growth_destroy(g);
+  vd_lsys_destroy(ls);
+}
+
+// runs the named growth validation cases; every check must pass; returns how many ran
+static int growth_cases_pass(const char* filter) {
+  vd_validate_def def;
+  memset(&def, 0, sizeof def);
+  def.filter = filter;
+  vd_validate_result* r = NULL;
+  int n = 0;
+  vd_error e = {0};
+  if (vd_growth_validate(&def, &r, &n, &e) != VD_OK) return -1;
+  for (int k = 0; k < n; k++)
+    if (!r[k].pass) vdt_fail(__FILE__, __LINE__, "%s: %s = %g, reference %g", r[k].name, r[k].quantity, r[k].measured, r[k].reference);
+  vd_free(r, sizeof *r * (size_t)n);
+  return n;
+}
+
+// issue 26 defect 1: each year's physics ran with last year's masses (new nodes 1e-4 kg, leaves
+// weightless): a straight stem grown sideways sagged 1.6 % of Euler-Bernoulli after age 1
+TEST(growth, defect1_current_masses_stem_sags_euler_bernoulli) {
+  CHECK_INT(growth_cases_pass("growth_stem"), 4);
+  // the tree carries its whole mass from the first substep: its stress under gravity with the
+  // seed's rule (last year's masses) is well below the current masses' one
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double stress[2], mass[2];
+  for (int paper = 0; paper < 2; paper++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_MSS;
+    def.substeps = 10;
+    def.opt.breaking = 0;
+    def.paper_masses = paper;
+    vd_growth* g = grow_def(ls, &def, 3, &e);
+    REQUIRE(g);
+    vd_growth_stats s;
+    vd_growth_get_stats(g, &s);
+    stress[paper] = s.max_stress, mass[paper] = s.total_mass;
+    const vd_mss_data* d = NULL;
+    const vd_mss_model* m = vd_growth_mss(g, &d);
+    REQUIRE(m && d);
+    // after the step both hold the model's masses (the seed's updated at the end)
+    double dm = 0;
+    for (int k = 0; k < m->nnode; k++) dm = fmax(dm, fabs(d->mass[k] - m->node_mass[k]));
+    CHECK(dm == 0);
+    CHECK(s.momentum_error < 1e-12);
+    vd_growth_destroy(g);
+  }
+  CHECK_NEAR(mass[0], mass[1], 1e-9 * mass[0]);
+  CHECK(stress[0] > 1.2 * stress[1]);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 8: the seed's wind load uses C_drag 1 (sec. 3.3), not the cylinder's 1.2
+TEST(growth, defect8_paper_drag_coefficient_is_one) {
+  vd_growth_def d = vd_growth_def_default();
+  CHECK_NEAR(d.opt.drag_cd, 1.2, 0);
+  vd_growth_def_paper(&d);
+  CHECK_NEAR(d.opt.drag_cd, 1.0, 0);
+  CHECK_INT(d.paper_masses, 1);
+}
+
+// largest stress of the root internodes of a mass-spring tree (Pa), and the root breaks
+static double root_stress(const vd_growth* g, int* root_breaks) {
+  const vd_mss_data* d = NULL;
+  const vd_mss_model* m = vd_growth_mss(g, &d);
+  double rs = 0;
+  for (int q = 0; m && q < m->ninter; q++)
+    if (m->node_flags[m->spring_node[2 * q + 1]] & VD_MSS_ROOT) rs = fmax(rs, d->spring_stress[q]);
+  int n, nb = 0;
+  const vd_growth_event* ev = vd_growth_events(g, &n);
+  for (int k = 0; k < n; k++) nb += ev[k].kind == VD_MSS_BREAK && !strcmp(ev[k].label, "root");
+  *root_breaks = nb;
+  return rs;
+}
+
+// issue 26 defect 3: the AC model bent the clamped roots' rest shape upward: 408 MPa and 7 roots
+// broken (1.7 MPa, none without it)
+TEST(growth, defect3_bastien_leaves_roots_as_they_grew) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double rs[2];
+  int nb[2];
+  for (int gr = 0; gr < 2; gr++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_MSS;
+    def.substeps = 10;
+    def.opt.gravitropism = gr ? VD_MSS_GRAVI_BASTIEN : VD_MSS_GRAVI_NONE;
+    vd_growth* g = grow_def(ls, &def, 6, &e);
+    REQUIRE(g);
+    rs[gr] = root_stress(g, &nb[gr]);
+    vd_growth_destroy(g);
+  }
+  CHECK_INT(nb[1], 0);
+  CHECK(rs[1] < 2e6 && rs[1] <= 1.01 * rs[0] + 1);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 5: MRL stressed clamped roots (1.7 MPa against 9e-6 Pa in mss): roots joined
+// the rigid body and carried their own weight as cantilevers
+TEST(growth, defect5_mrl_leaves_clamped_roots_unstressed) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  vd_growth_def def = vd_growth_def_default();
+  def.model = VD_GROWTH_MRL;
+  def.substeps = 10;
+  vd_growth* g = grow_def(ls, &def, 6, &e);
+  REQUIRE(g);
+  int nb;
+  CHECK(root_stress(g, &nb) < 1);  // Pa: the clamp holds every root node
+  CHECK_INT(nb, 0);
+  vd_growth_stats s;
+  vd_growth_get_stats(g, &s);
+  CHECK(s.nrigid > 0);
+  vd_growth_destroy(g);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 2: MRL's rigid body never moved (welded to its clamped or held members), and
+// eq. 8 as printed gave the corrected results; now it turns about the node it grows from (RK4,
+// quaternions), swaying in gusts
+TEST(growth, defect2_mrl_rigid_body_moves_and_eq8_matters) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double sway[2], ke[2];
+  for (int paper = 0; paper < 2; paper++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_MRL;
+    def.opt.wind = vd_v3(12, 0, 0);
+    def.opt.gust_amplitude = 0.5, def.opt.gust_period = 0.7;
+    def.opt.breaking = 0;
+    def.paper_eq8 = paper;
+    vd_growth* g = grow_def(ls, &def, 5, &e);
+    REQUIRE(g);
+    vd_growth_stats s;
+    vd_growth_get_stats(g, &s);
+    const vd_mss_data* d = NULL;
+    const vd_mss_model* m = vd_growth_mss(g, &d);
+    REQUIRE(m && d && d->rb.n > 0);
+    ke[paper] = vd_rigid_energy(&d->rb);
+    // the rigid members have left their rest positions
+    sway[paper] = 0;
+    for (int k = 0; k < m->nnode; k++)
+      if (d->rigid[k]) sway[paper] = fmax(sway[paper], vd_norm(vd_sub(d->pos[k], m->node_rest[k])));
+    CHECK(!s.collapsed && !s.diverged && s.unstable == 0);
+    vd_growth_destroy(g);
+  }
+  CHECK(ke[0] > 0 && ke[1] > 0);
+  CHECK(sway[0] > 1e-5);
+  CHECK(sway[0] != sway[1]);
+  vd_lsys_destroy(ls);
+}
+
+// issue 26 defect 4: the rods ignored the species, E, density, C_d and --no-breaking
+TEST(growth, defect4_rods_take_the_wood_and_breaking) {
+  vd_lsystem* ls = load("data/tree.lpy");
+  REQUIRE(ls);
+  vd_error e = {0};
+  double mass[2];
+  for (int k = 0; k < 2; k++) {
+    vd_growth_def def = vd_growth_def_default();
+    def.model = VD_GROWTH_RODS;
+    def.substeps = 5;
+    def.opt.wind = vd_v3(25, 0, 0);
+    def.mss.mor = def.mss.mor_green = 1e3;  // everything would break
+    def.opt.breaking = 0;
+    if (k) def.mss.density_wood = 2 * def.mss.density_wood, def.mss.density_green *= 2;
+    vd_growth* g = grow_def(ls, &def, 2, &e);
+    REQUIRE(g);
+    vd_growth_stats s;
+    vd_growth_get_stats(g, &s);
+    CHECK_INT(s.nbroken, 0);
+    mass[k] = s.total_mass;
+    vd_growth_destroy(g);
+  }
+  CHECK(mass[1] > 1.5 * mass[0]);
   vd_lsys_destroy(ls);
 }

@@ -222,6 +222,34 @@ TEST(pyengine, automatic_choice) {
   CHECK_STR(vd_lsys_engine_name(VD_LSYS_NATIVE), "native");
 }
 
+// what native refuses only when it runs ("a%d" % 3: native has no string formatting) runs in
+// CPython after vd_lsys_fallback (issue 19); a file chosen explicitly keeps native's error
+TEST(pyengine, automatic_choice_falls_back_at_run_time) {
+  if (!python_here()) return;
+  const char* src = "Axiom: A(1)\nderivation length: 1\nproduction:\nA(x):\n  s = 'a%d' % x\n  produce B(x + 1)\n";
+  vd_lsystem* ls;
+  vd_error e = {0};
+  CHECK_STATUS(vd_lsys_parse(src, strlen(src), "f.lpy", &ls, &e), VD_OK, e);
+  CHECK_INT(vd_lsys_get_engine(ls), VD_LSYS_NATIVE);
+  vd_lsys_def def = vd_lsys_def_default();
+  def.steps = 1;
+  vd_lstring out = vd_lstring_empty();
+  vd_status st = vd_lsys_derive(ls, &def, &out, &e);
+  CHECK(st == VD_ERR_TYPE || st == VD_ERR_UNSUPPORTED);
+  CHECK_INT(vd_lsys_fallback(&ls, st), 1);
+  CHECK_INT(vd_lsys_get_engine(ls), VD_LSYS_PYTHON);
+  vd_error e2 = {0};
+  CHECK_STATUS(vd_lsys_derive(ls, &def, &out, &e2), VD_OK, e2);
+  CHECK_INT((int)out.n, 1);
+  CHECK_INT((int)out.val[0], 2);
+  CHECK_INT(vd_lsys_fallback(&ls, VD_ERR_TYPE), 0);  // once only: it is Python now
+  vd_lstring_free(&out);
+  vd_lsys_destroy(ls);
+  CHECK_STATUS(vd_lsys_parse_engine(src, strlen(src), "f.lpy", VD_LSYS_NATIVE, &ls, &e), VD_OK, e);
+  CHECK_INT(vd_lsys_fallback(&ls, VD_ERR_TYPE), 0);
+  vd_lsys_destroy(ls);
+}
+
 TEST(pyengine, hooks_with_the_lstring) {
   if (!python_here()) return;
   const char* src =

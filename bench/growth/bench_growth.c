@@ -112,11 +112,23 @@ static void row(FILE* csv, const char* kase, const char* model, int ages, int su
 int main(int argc, char** argv) {
   const char* csv_path = NULL;
   int ages = 25, rods = 1;
+  static const char* usage =
+      "usage: verdant_bench_growth [--csv FILE] [--ages N] [--quick] [--no-rods]\n"
+      "Grow data/hopea.lpy with each model and time it; rows into FILE (default\n"
+      "bench/results/growth-2core.csv, replaced). --quick: 10 ages; --no-rods: skip the rods.\n";
   for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+      fputs(usage, stdout);
+      return 0;
+    }
     if (!strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
     else if (!strcmp(argv[i], "--ages") && i + 1 < argc) ages = atoi(argv[++i]);
     else if (!strcmp(argv[i], "--no-rods")) rods = 0;
     else if (!strcmp(argv[i], "--quick")) ages = 10;
+    else {
+      fprintf(stderr, "verdant_bench_growth: unknown argument '%s'\n%s", argv[i], usage);
+      return 2;
+    }
   }
   if (ages < 1) ages = 1;
   char defpath[1024], lpy[1024];

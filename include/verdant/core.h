@@ -134,6 +134,31 @@ void vd_outfile_tmp_path(const char* path, char* buf, size_t cap);
 vd_status vd_outfile_commit(vd_outfile* f, vd_error* err);
 // Close and remove the temporary file (safe after a failed commit, and twice).
 void vd_outfile_abort(vd_outfile* f);
+// Make the folder path for outputs (an existing folder is fine); through the guard when one is set.
+vd_status vd_outdir_make(const char* path, vd_error* err);
+// Take back an output this call committed (a failure after it): removed, or with a guard set, its
+// temporary file dropped.
+void vd_outfile_remove(const char* path);
+// Remove a folder vd_outdir_make made, when empty (with a guard set the guard does, at the end).
+void vd_outdir_remove(const char* path);
+
+// An output guard: a program's one output layer (the verdant command's, cli/cli_paths.c), told
+// of every output before its first byte. With a guard set, vd_outfile_open asks open() (which
+// may refuse a path that was not declared, or make its folder), vd_outfile_commit hands the
+// complete temporary file to commit() instead of renaming it (the guard renames every output
+// into place when the whole program succeeded), vd_outfile_abort tells abort(), and
+// vd_outdir_make calls mkdir(). Without one (the default, the Python package) each file is
+// renamed into place when complete and folders are made directly.
+typedef struct vd_outfile_guard {
+  vd_status (*open)(void* user, const char* path, const char* tmp, vd_error* err);
+  vd_status (*commit)(void* user, const char* path, const char* tmp, vd_error* err);
+  void (*abort)(void* user, const char* path, const char* tmp);
+  vd_status (*mkdir)(void* user, const char* path, vd_error* err);
+  void* user;
+} vd_outfile_guard;
+// Set the process's output guard (Nullable: none); the struct is copied. Not thread-safe: set it
+// before any output is open.
+void vd_outfile_set_guard(const vd_outfile_guard* g);
 // Read a whole file; *text is NUL-terminated, free it with vd_free(*text, *len + 1).
 vd_status vd_file_read(const char* path, char** text, size_t* len, vd_error* err);
 // Largest file vd_file_read accepts (bytes).
@@ -214,6 +239,12 @@ typedef struct vd_quat {
 } vd_quat;
 
 #define VD_PI 3.14159265358979323846
+
+// The q-quantile (0 <= q <= 1) of n >= 1 values sorted ascending, by linear interpolation between
+// order statistics (Hyndman & Fan 1996, type 7; numpy's and R's default): h = (n - 1) q,
+// Q = x[floor h] + (h - floor h)(x[floor h + 1] - x[floor h]). The median of an even count is
+// the mean of the middle two.
+double vd_quantile_sorted(const double* x, int n, double q);
 
 static inline vd_vec3 vd_v3(double x, double y, double z) {
   vd_vec3 r = {x, y, z};

@@ -107,6 +107,31 @@ typedef enum vd_export_format {
   VD_EXPORT_MJCF,     // MuJoCo MJCF: one body per organ (no joints), meshes inline
 } vd_export_format;
 
+// A plant's rods for a flexible (articulated) export: the rod segments of the physics model
+// with their joints, stiffness and lumped masses (vd_sim_export_rods fills it from a rod model).
+// Arrays are the caller's; a segment's mass sits at its end point, as the rods lump it.
+typedef struct vd_export_rods {
+  int nseg;                  // rod segments
+  const double* seg_ends;    // start and end point (m) (nseg x 6)
+  const double* seg_radius;  // radius (m) (nseg)
+  const double* seg_quat;    // rest frame w,x,y,z: d3 (z) along the segment (nseg x 4)
+  const int* seg_parent;     // parent segment of its joint, -1: on the base (nseg)
+  const int* seg_fixed;      // 1: held, part of the base (nseg)
+  const int* seg_drawn;      // 1: a capsule, 0: a connector with no shape (fruit stalk) (nseg)
+  const int* seg_label;      // semantic label id (nseg)
+  const int* seg_instance;   // organ instance id (nseg)
+  const double* seg_stiff;   // its joint with the parent: bending about d1, d2 and twist about
+                             // d3 stiffness (N m/rad) (nseg x 3)
+  const double* seg_mass;    // mass lumped at its end point (kg) (nseg)
+  const double* seg_inertia; // rotary inertia of its own about d1/d2 and about d3 (kg m^2) (nseg x 2)
+  const double* seg_sphere;  // radius of a sphere (fruit) centred at its end point, 0: none (m) (nseg)
+  const double* seg_break;   // its joint's break force (N) and moment (N m), INFINITY: never
+                             // (Nullable) (nseg x 2)
+  const int* mesh_seg;       // rod segment each plant mesh rides on, -1: the base (plant nmesh)
+  void* block;               // the memory behind the arrays when a library function filled them
+  size_t nbytes;             // (vd_sim_export_rods), else NULL and 0
+} vd_export_rods;
+
 // Settings of an export.
 typedef struct vd_export_def {
   vd_export_format format; // default VD_EXPORT_MJCF
@@ -116,9 +141,18 @@ typedef struct vd_export_def {
                            // model's pose; default 0, 0, 0
   double leaf_thickness;   // thickness given to open meshes (leaves) so that they have a volume
                            // (m), in (0, 0.1); default 2e-4
+  const vd_export_rods* rods; // Nullable: the plant's rods. NULL: a static plant, one rigid link
+                           // per organ with no masses. Given: masses and inertias from the rods on
+                           // every link, and (links_per_organ >= 0) a flexible plant
+  int links_per_organ;     // with rods: -1 one rigid link per organ on fixed joints (masses only);
+                           // 0 one link per rod segment; N > 0 each organ's rods in N links;
+                           // links are joined by spring joints (bend, bend, twist); default 0
+  double damping_ratio;    // joint damping as a fraction of critical for the link on its spring
+                           // (-), >= 0; default 0.1
 } vd_export_def;
 
-// Defaults: MJCF, name "plant", at the origin, leaves 0.2 mm thick.
+// Defaults: MJCF, name "plant", at the origin, leaves 0.2 mm thick, no rods (static), one link
+// per rod segment and damping ratio 0.1 when rods are given.
 vd_export_def vd_export_def_default(void);
 // "urdf", "sdf" or "mjcf".
 const char* vd_export_format_name(vd_export_format f);

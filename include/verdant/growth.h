@@ -57,13 +57,23 @@ typedef struct vd_growth_def {
   vd_turtle_def turtle;   // turtle settings
   vd_mss_def mss;         // mss / mrl: model settings (mss.rigid_age is set to INFINITY for mss)
   vd_mss_opt opt;         // mss / mrl: run settings and forces (opt.dt is the substep)
-  vd_sim_def rods;        // rods: model settings
+  vd_sim_def rods;        // rods: model settings; the green, wood and root materials' E, density
+                          // and C_d are replaced by mss.young_*, mss.density_* and opt.drag_cd (one
+                          // wood for every model); opt.breaking and mss.mor, mor_green also apply
   vd_sim_opt rod_opt;     // rods: run settings (rod_opt.dt is the substep)
   int paper_eq8;          // mrl: 1 joins nodes by eq. 8 as printed, 0 with the corrected term
   int bastien_substeps;   // explicit substeps of the AC model per age step (>= 1)
   int stress_free;        // 1: new wood is laid down without stress on the deformed tree (the
                           // rest shape follows the deformation by the new share of stiffness)
   double uproot_tilt;     // a base tilted this far after its roots gave way is uprooted (rad)
+  int paper_masses;       // mss / mrl: 1 as the seed: new nodes keep the smallest mass (eq. 1)
+                          // and every mass its last year's value for the whole age step, updated
+                          // at its end; 0 (default): each node takes its mass now (its internode,
+                          // leaves and organs this year) before the first substep, momentum kept
+  int paper_rigid;        // mrl: 1 as the seed: every node old enough joins the rigid body, roots
+                          // and clamped nodes too, so the body is held in place while its soil
+                          // or clamp holds; 0 (default): the wood above the ground joins and the
+                          // body turns about the clamped or held node it grows from
 } vd_growth_def;
 
 // Defaults: model mrl, ages 0 (the file's derivation length is the caller's to read), substeps
@@ -73,9 +83,10 @@ typedef struct vd_growth_def {
 vd_growth_def vd_growth_def_default(void);
 
 // The seed's own choices, for reproducing it: paper springs (k0 d / l, alternate-node springs),
-// eq. 3, the paper's wind load (eqs. 9-10 on node cross-sections) with Stokes drag (eq. 11), eq. 8
-// as printed, no strain limiting, a rigid part stepped by RK4 even when nothing holds it, no
-// stress-free growth (the rest of def is left as it is).
+// eq. 3, the paper's wind load (eqs. 9-10 on node cross-sections, C_d 1) with Stokes drag (eq. 11),
+// eq. 8 as printed, no strain limiting, a rigid part stepped by RK4 even when nothing holds it, no
+// stress-free growth, masses updated at the end of each age step, the seed's rigid part (the rest
+// of def is left as it is).
 void vd_growth_def_paper(vd_growth_def* def);
 
 // A tree whose height falls below this share of its drawn height has collapsed (fallen over or

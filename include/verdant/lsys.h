@@ -190,6 +190,15 @@ vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name,
 // Read and parse an .lpy file with a given engine.
 vd_status vd_lsys_load_engine(const char* path, vd_lsys_engine engine, vd_lsystem** out,
                               vd_error* err);
+// The automatic choice's second chance: when *ls was parsed with VD_LSYS_AUTO, which chose the
+// native engine, and a run of it failed with st = VD_ERR_UNSUPPORTED or VD_ERR_TYPE (something
+// the native subset refuses only when it runs, such as "a%d" % 3), *ls is replaced by the same
+// text parsed for the Python engine and 1 is returned: the caller runs again from the start
+// (its --set overrides, derivation...). Else 0 and *ls is unchanged (the error stands).
+int vd_lsys_fallback(vd_lsystem** ls, vd_status st);
+// The line of the file's Axiom: keyword; 0 when it has none (its string then starts empty, as
+// in L-Py).
+int vd_lsys_axiom_line(const vd_lsystem* ls);
 // The engine that runs ls (VD_LSYS_NATIVE or VD_LSYS_PYTHON).
 vd_lsys_engine vd_lsys_get_engine(const vd_lsystem* ls);
 // "auto", "native" or "python".

@@ -340,7 +340,8 @@ double vd_mss_height(const vd_mss_model* m, const vd_mss_data* d);
 // substeps: the rest bend of every hinge whose child internode is younger than
 // opt.growth_zone_age changes by dC/dt = -beta sin A - gamma C (A the internode's angle to the
 // vertical in the rest shape, C = bend / l-bar); rest (nnode) starts as the model's rest shape
-// and gets the new one (the subtree beyond each bent hinge turns with it).
+// and gets the new one (the subtree beyond each bent hinge turns with it). Root internodes keep
+// their rest shape (the soil holds them as they grew).
 void vd_mss_bastien(const vd_mss_model* m, const vd_mss_data* d, double t, int nsub, vd_vec3* rest);
 // Validation cases of the mass-spring and rigid-body models (docs/validation.md): *out gets them
 // (free with vd_free(*out, *n * sizeof **out)); def as for vd_sim_validate.

@@ -339,6 +339,13 @@ const vd_scene* vd_harvest_scene(const vd_harvest* h);
 vd_status vd_robot_validate(const vd_validate_def* def, vd_validate_result** out, int* n,
                             vd_error* err);
 
+// The flexible export in MuJoCo against the rods it came from (docs/validation.md "Exports"): a
+// horizontal cantilever exported as MJCF (vd_sim_export_rods, vd_geom_export) and loaded alone
+// in MuJoCo sags under its own weight and deflects under a tip load as the rods do, within 5 %;
+// both beside Euler-Bernoulli. def->filter, progress and user are used; *out as above.
+vd_status vd_robot_validate_export(const vd_validate_def* def, vd_validate_result** out, int* n,
+                                   vd_error* err);
+
 // ---------------------------------------------------------------------------------------------
 // inverse kinematics of a loaded robot (also used by tests and tools)
 

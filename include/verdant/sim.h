@@ -26,6 +26,7 @@
 
 #include "verdant/collide.h"
 #include "verdant/core.h"
+#include "verdant/geom.h"
 #include "verdant/plant.h"
 #include "verdant/phys.h"
 
@@ -360,6 +361,16 @@ vd_status vd_sim_build(const vd_model* plant, const vd_sim_def* def, vd_sim_mode
                        vd_error* err);
 // Free a rod model (NULL is fine).
 void vd_sim_model_destroy(vd_sim_model* m);
+// The rods of m for a flexible export (vd_export_def.rods of vd_geom_export): every rod segment
+// with its rest shape, the stiffness of its joint with the parent (bending and twist, k = 1 /
+// (C_b compliance l-bar^2): the series half-segments' EI/l, GJ/l), the mass the rods lump at its
+// end node, its rotary inertia, the fruit sphere on that node and its break force and moment;
+// plant (the model m was built from) gives each mesh the rod segment most of its vertices ride
+// on. Free with vd_sim_export_rods_free. docs/formats.md, "Flexible exports".
+vd_status vd_sim_export_rods(const vd_sim_model* m, const vd_model* plant, vd_export_rods* out,
+                             vd_error* err);
+// Free what vd_sim_export_rods filled (a zeroed struct is fine).
+void vd_sim_export_rods_free(vd_export_rods* r);
 // New state at the modelled shape, at rest; NULL when out of memory.
 vd_sim_data* vd_sim_data_create(const vd_sim_model* m);
 // Put a state back at the modelled shape (colliders and ties are kept, events cleared).

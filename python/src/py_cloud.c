@@ -38,8 +38,8 @@ static int scanners(PyObject* o, const vd_plant_spec* spec, const vd_scanner* pr
   PyObject* seq = NULL;
   if (PyUnicode_Check(o) || PyBytes_Check(o) || PyObject_HasAttrString(o, "__fspath__")) {
     seq = PyTuple_Pack(1, o);
-  } else if (PyList_Check(o) || PyTuple_Check(o)) {
-    seq = PySequence_Fast(o, "scanners");
+  } else if (PyList_Check(o) || PyTuple_Check(o) || PyArray_Check(o)) {
+    seq = PySequence_Fast(o, "scanners");  // a numpy array (k, 3) or (k, 6) too
   } else {
     PyErr_Format(PyExc_TypeError, "scanners expects a preset path or a list of positions, got %s",
                  Py_TYPE(o)->tp_name);
@@ -346,7 +346,9 @@ static PyObject* cloud_xyz(vdpy_cloud* c, void* unused) {
     for (size_t i = 0; i < n; i++) dst[i] = (float)src[i];
     Py_END_ALLOW_THREADS
     PyArray_CLEARFLAGS((PyArrayObject*)a, NPY_ARRAY_WRITEABLE);
-    c->xyz = a;
+    // another thread may have made it while this one converted without the GIL: keep the first
+    if (c->xyz) Py_DECREF(a);
+    else c->xyz = a;
   }
   return Py_NewRef(c->xyz);
 }
@@ -423,12 +425,94 @@ static PyObject* cloud_save(vdpy_cloud* c, PyObject* args, PyObject* kw) {
   Py_RETURN_NONE;
 }
 
+// pickling: the cloud's arrays and tables as bytes (native byte order), exact
+#define CLOUD_MAGIC "VDCLOUD1"
+
+typedef struct cloud_head {
+  char magic[8];
+  int64_t n;
+  int32_t nview, nlabel, sensor, instance_labels, has_pose, label_size;
+  uint64_t seed;
+} cloud_head;
+
+// one walk over the parts, into buf (save) or out of it (load); returns bytes walked
+static size_t cloud_walk(vd_cloud* c, const cloud_head* h, char* buf, int save) {
+  size_t n = (size_t)h->n, at = sizeof *h;
+  struct {
+    void* p;
+    size_t n;
+  } part[] = {
+      {c->pos, 3 * n * sizeof(double)}, {c->normal, 3 * n * sizeof(double)}, {c->label, n * sizeof(int)},
+      {c->instance, n * sizeof(int)},   {c->view, n * sizeof(int)},          {c->range, n * sizeof(double)},
+      {c->view_pose, h->has_pose ? (size_t)h->nview * 6 * sizeof(double) : 0},
+      {c->labels, (size_t)h->nlabel * sizeof(vd_label)},
+  };
+  for (size_t k = 0; k < sizeof part / sizeof part[0]; k++) {
+    if (buf && part[k].n) {
+      if (save) memcpy(buf + at, part[k].p, part[k].n);
+      else memcpy(part[k].p, buf + at, part[k].n);
+    }
+    at += part[k].n;
+  }
+  return at;
+}
+
 static PyObject* cloud_reduce(vdpy_cloud* c, PyObject* unused) {
-  return PyErr_Format(PyExc_TypeError, "a Cloud cannot be pickled; save() it or copy its arrays");
+  cloud_head h;
+  memset(&h, 0, sizeof h);
+  memcpy(h.magic, CLOUD_MAGIC, 8);
+  h.n = c->cloud.n, h.nview = c->cloud.nview, h.nlabel = c->cloud.nlabel, h.sensor = c->sensor;
+  h.instance_labels = c->instance_labels, h.has_pose = c->cloud.view_pose != NULL;
+  h.label_size = (int32_t)sizeof(vd_label), h.seed = c->seed;
+  size_t n = cloud_walk(&c->cloud, &h, NULL, 1);
+  PyObject* b = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)n);
+  if (!b) return NULL;
+  memcpy(PyBytes_AS_STRING(b), &h, sizeof h);
+  cloud_walk(&c->cloud, &h, PyBytes_AS_STRING(b), 1);
+  PyObject* f = PyObject_GetAttrString(PyImport_AddModule("verdant._verdant"), "_cloud_unpickle");
+  if (!f) {
+    Py_DECREF(b);
+    return NULL;
+  }
+  return Py_BuildValue("(N(NO))", f, b, c->stats);
+}
+
+PyObject* vdpy_cloud_unpickle(PyObject* self, PyObject* args) {
+  Py_buffer v;
+  PyObject* stats;
+  if (!PyArg_ParseTuple(args, "y*O!:_cloud_unpickle", &v, &PyDict_Type, &stats)) return NULL;
+  cloud_head h;
+  vd_cloud c;
+  memset(&c, 0, sizeof c);
+  vd_error err = {0};
+  const char* why = NULL;
+  if ((size_t)v.len < sizeof h) why = "too short";
+  if (!why) {
+    memcpy(&h, v.buf, sizeof h);
+    if (memcmp(h.magic, CLOUD_MAGIC, 8) || h.label_size != (int32_t)sizeof(vd_label)) why = "not a Cloud of this build";
+    else if (h.n < 0 || h.nview < 0 || h.nlabel < 0 || cloud_walk(&c, &h, NULL, 0) != (size_t)v.len) why = "corrupt";
+  }
+  vd_status st = VD_OK;
+  if (!why) st = vd_cloud_alloc(&c, h.n, NULL, 0, &err);
+  if (!why && !st) {
+    c.nlabel = h.nlabel, c.nview = h.nview;
+    c.labels = h.nlabel ? vd_malloc((size_t)h.nlabel * sizeof(vd_label)) : NULL;
+    c.view_pose = h.has_pose && h.nview ? vd_malloc((size_t)h.nview * 6 * sizeof(double)) : NULL;
+    if ((h.nlabel && !c.labels) || (h.has_pose && h.nview && !c.view_pose)) st = VD_ERR_NOMEM;
+    else cloud_walk(&c, &h, v.buf, 0);
+  }
+  PyBuffer_Release(&v);
+  if (why) return vdpy_arg_error("_cloud_unpickle: the data is %s", why);
+  if (st) {
+    vd_cloud_free(&c);
+    return vdpy_raise(st, &err);
+  }
+  return cloud_new(&c, h.seed, h.sensor, h.instance_labels, stats);
 }
 
 static PyMethodDef cloud_methods[] = {
     {"save", (PyCFunction)(void (*)(void))cloud_save, METH_VARARGS | METH_KEYWORDS,
+     "save($self, /, path, *, ascii=False, ply_prefix=None, comment=None, threads=None)\n--\n\n"
      "save(path, *, ascii=False, ply_prefix=None, comment=None, threads=None): write the cloud;\n"
      "the extension picks the format (.ply .pcd .xyz .csv .las). The same bytes as\n"
      "`verdant cloud` with the same options (the header comment records seed, sensor, labels)."},

@@ -1,28 +1,25 @@
 // SPDX-License-Identifier: MIT
-// Harvest episodes: the Harvest type over vd_harvest (robot.h), the engine of verdant.HarvestEnv.
-// It reads a scene, grows and places its plant, and steps an episode one control step at a time
-// under an action (end-effector velocity and gripper) without the GIL; episode k of a seed gets
-// the scene's randomisation (vd_scene_episode: plant seed, target, method parameters), the plant
-// regrown only when its seed changes.
+// Harvest episodes: the Harvest type over vd_harvest (robot.h), the engine of verdant.HarvestEnv,
+// and the episode slots it shares with VectorHarvest (py_vector.c). A slot reads nothing from
+// Python: it grows and places the episode's plant, builds the episode, and steps it one control
+// step at a time under an action (end-effector velocity and gripper) with the environment's
+// reward and ending rules, all without the GIL. Episode k of a seed gets the scene's
+// randomisation (vd_scene_episode: plant seed, target, method parameters), the plant regrown only
+// when its seed changes; a draw whose plant has no reachable fruit is drawn again (VDPY_DRAWS).
 #include "py_internal.h"
 
 #include <math.h>
 #include <structmember.h>
 
-#include "verdant/robot.h"
-
 #define PATH_CAP 4096
+
+const char* const vdpy_term_names[VDPY_NTERMS] = {"detach", "grasp", "distance", "pull_force",
+                                                  "fracture", "drop", "hit"};
 
 struct vdpy_harvest {
   PyObject_HEAD
   vd_scene base;         // the scene as read (owned)
-  vd_scene scene;        // the current episode's scene (owned)
-  vd_plant_spec* spec;   // the episode's plant, placed (owned)
-  vd_model* plant;       // compiled (owned; the episode borrows it)
-  uint64_t plant_seed;   // the seed spec was grown with
-  vd_harvest* h;         // the episode (owned)
-  vd_data* pstate;       // the plant state of the current step (owned)
-  int stepped;           // step() was called in this episode (the scripted controller is off)
+  vdpy_slot s;           // the episode
   int busy;
 };
 
@@ -31,19 +28,21 @@ static int busy_check(vdpy_harvest* o) {
   return 1;
 }
 
-static void harvest_free_episode(vdpy_harvest* o) {
+// ---------------------------------------------------------------------------------------------
+// slots
+
+static void slot_free_episode(vdpy_slot* o) {
   vd_harvest_destroy(o->h);
   vd_data_destroy(o->pstate);
   vd_model_destroy(o->plant);
   vd_plant_spec_destroy(o->spec);
   o->h = NULL, o->pstate = NULL, o->plant = NULL, o->spec = NULL;
+  o->ready = 0;
 }
 
-static void harvest_dealloc(vdpy_harvest* o) {
-  harvest_free_episode(o);
+void vdpy_slot_free(vdpy_slot* o) {
+  slot_free_episode(o);
   vd_scene_free(&o->scene);
-  vd_scene_free(&o->base);
-  Py_TYPE(o)->tp_free((PyObject*)o);
 }
 
 // the method parameters an episode draws: a new episode needs a new vd_harvest when they change
@@ -54,18 +53,26 @@ static int same_method(const vd_method_def* a, const vd_method_def* b) {
          a->grip_friction == b->grip_friction && a->touch_force == b->touch_force && a->hold == b->hold;
 }
 
+// the episode has no target (no fruit, or none reachable): an outcome, not an error
+static int no_target(const vd_harvest* h) {
+  vd_harvest_obs b;
+  vd_harvest_observe(h, &b);
+  return vd_harvest_done(h) || b.phase == VD_PHASE_DONE;
+}
+
 // the episode of scene s (taken into o->scene): plant grown when its seed differs, episode built
-// or reused, reset with target_seed; no Python calls (run it without the GIL)
-static vd_status episode(vdpy_harvest* o, vd_scene* s, uint64_t target_seed, vd_error* err) {
+// or reused, reset with target_seed; o->ready when a target was found
+static vd_status episode(vdpy_slot* o, vd_scene* s, uint64_t target_seed, vd_error* err) {
   int regrow = !o->spec || s->plant_seed != o->plant_seed;
   int rebuild = regrow || !o->h || !same_method(&s->method, &o->scene.method) ||
                 s->target_instance != o->scene.target_instance;
   vd_scene_free(&o->scene);
   o->scene = *s;
   memset(s, 0, sizeof *s);
+  o->ready = 0;
   vd_status st = VD_OK;
   if (regrow) {
-    harvest_free_episode(o);
+    slot_free_episode(o);
     st = vdpy_grow_file(o->scene.plant_path, o->scene.plant_seed, o->scene.plant_steps, o->scene.plant_set,
                         o->scene.nplant_set, &o->spec, err);
     if (st) {
@@ -87,9 +94,128 @@ static vd_status episode(vdpy_harvest* o, vd_scene* s, uint64_t target_seed, vd_
   }
   memset(err, 0, sizeof *err);
   st = vd_harvest_reset(o->h, target_seed, err);
-  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) st = VD_OK;  // no reachable fruit: done
+  if (st == VD_ERR_VALUE && no_target(o->h)) st = VD_OK;  // no reachable fruit: done
   o->stepped = 0;
+  o->ready = !st && !no_target(o->h);
   return st;
+}
+
+vd_status vdpy_slot_reset(vdpy_slot* o, const vd_scene* base, uint64_t seed, int64_t k, int randomize,
+                          vd_error* err) {
+  o->seed = seed, o->episode = k, o->draws = 0;
+  o->nevents = 0, o->was_detached = o->was_held = 0, o->steps = 0;
+  // only a new plant can make an impossible draw possible: one draw when the plant is fixed
+  int ndraw = randomize && base->episodes.plant_seed ? VDPY_DRAWS : 1;
+  for (int t = 0; t < ndraw; t++) {
+    // draw t of episode k is the episode stream k + t 2^40 (episode indices stay below 2^40)
+    vd_scene s;
+    uint64_t tseed = seed;
+    int64_t kt = k + ((int64_t)t << 40);
+    vd_status st = randomize ? vd_scene_episode(base, seed, kt, &s, &tseed, err) : vd_scene_copy(base, &s, err);
+    if (!st) st = episode(o, &s, tseed, err);
+    vd_scene_free(&s);
+    if (st) return st;
+    o->draws = t + 1;
+    if (o->ready) {
+      if (o->h) o->nevents = vd_harvest_events(o->h, &(const vd_harvest_event*){NULL});
+      return VD_OK;
+    }
+  }
+  vd_harvest_summary sum;
+  vd_harvest_summarize(o->h, &sum);
+  memset(err, 0, sizeof *err);  // the last draw's reason is in the message
+  return vd_error_set(err, VD_ERR_VALUE, base->path, 0, 0,
+                      "%s%d draw%s of episode %lld (seed %llu) found no reachable target fruit (%s)%s",
+                      base->path[0] ? "" : "scene (JSON text): ", ndraw, ndraw > 1 ? "s" : "", (long long)k,
+                      (unsigned long long)seed, sum.reason[0] ? sum.reason : "no target",
+                      ndraw > 1 ? "" : "; the scene draws no new plant per episode (episodes.plant_seed)");
+}
+
+static double norm3(vd_vec3 v) { return sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+
+// the reward terms of the step that led to observation b, with the events since the last step
+static void slot_reward(vdpy_slot* o, const vd_harvest_obs* b, const vdpy_rules* r, vdpy_outcome* out) {
+  const vd_harvest_event* ev;
+  int n = vd_harvest_events(o->h, &ev), count[VD_EV_KIND_COUNT] = {0};
+  for (int k = o->nevents; k < n; k++) count[ev[k].kind]++;
+  o->nevents = n;
+  double dt = o->scene.control_dt;
+  double dist = norm3(vd_sub(b->ee_pos, b->fruit_pos));
+  double pull = b->held ? norm3(b->pull_force) : 0.0;
+  int detached_now = b->detached && !o->was_detached, held_now = b->held && !o->was_held;
+  o->was_detached |= b->detached != 0;
+  o->was_held |= b->held != 0;
+  int others = count[VD_EV_FRACTURE] - count[VD_EV_DETACH];  // the target's own is "detach"
+  double raw[VDPY_NTERMS] = {detached_now, held_now, -dist * dt, -pull * dt, -(others > 0 ? others : 0),
+                             -count[VD_EV_DROP], -count[VD_EV_HIT]};
+  out->reward = 0;
+  for (int k = 0; k < VDPY_NTERMS; k++) out->reward += out->terms[k] = r->w[k] * raw[k];
+}
+
+vd_status vdpy_slot_step(vdpy_slot* o, const vd_harvest_action* a, const vdpy_rules* r, vdpy_outcome* out,
+                         vd_error* err) {
+  memset(out, 0, sizeof *out);
+  if (!o->h || !o->ready)
+    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
+                        o->h && o->steps ? "the episode is over (terminated or truncated): reset() first"
+                                         : "no episode: reset() first (the last reset failed or none was made)");
+  o->stepped = 1;
+  vd_status st = vd_harvest_step(o->h, a, err);
+  if (st && !(st == VD_ERR_VALUE && vd_harvest_done(o->h))) return st;
+  out->ok = !st;  // MuJoCo or the plant failed: an outcome, the episode is over
+  o->steps++;
+  vd_harvest_obs b;
+  vd_harvest_observe(o->h, &b);
+  slot_reward(o, &b, r, out);
+  // the ending: the scene's (its reason), the target's detachment, or the step limit
+  int over = vd_harvest_done(o->h), done = over || (r->terminate_on_detach && b.detached);
+  if (done) {
+    vd_harvest_summary sum;
+    vd_harvest_summarize(o->h, &sum);
+    snprintf(out->reason, sizeof out->reason, "%s", over ? sum.reason : "detached");
+  }
+  out->truncated = (done && !strcmp(out->reason, "time")) || (!done && r->max_steps > 0 && o->steps >= r->max_steps);
+  out->terminated = done && !out->truncated;
+  if (out->truncated && !done) snprintf(out->reason, sizeof out->reason, "max_episode_steps");
+  if (out->terminated || out->truncated) o->ready = 0;
+  memset(err, 0, sizeof *err);
+  return VD_OK;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Harvest
+
+static void harvest_dealloc(vdpy_harvest* o) {
+  vdpy_slot_free(&o->s);
+  vd_scene_free(&o->base);
+  Py_TYPE(o)->tp_free((PyObject*)o);
+}
+
+int vdpy_scene_read(PyObject* src, vd_scene* out) {
+  vd_error err = {0};
+  vd_status st;
+  // a scene file, or its JSON text: a str with a newline or whose first character (past blanks)
+  // is '{'
+  const char* text = NULL;
+  Py_ssize_t len = 0;
+  char path[PATH_CAP] = "";
+  int is_text = 0;
+  if (PyUnicode_Check(src)) {
+    Py_ssize_t n = PyUnicode_GET_LENGTH(src), i = 0;
+    while (i < n && Py_UNICODE_ISSPACE(PyUnicode_READ_CHAR(src, i))) i++;
+    is_text = PyUnicode_FindChar(src, '\n', 0, n, 1) >= 0 || (i < n && PyUnicode_READ_CHAR(src, i) == '{');
+  }
+  if (is_text) {
+    text = PyUnicode_AsUTF8AndSize(src, &len);
+    if (!text) return 0;
+  } else if (!vdpy_path(src, "scene", path, sizeof path)) {
+    return 0;
+  }
+  Py_BEGIN_ALLOW_THREADS
+  st = text ? vd_scene_parse(text, (size_t)len, NULL, out, &err) : vd_scene_read(path, out, &err);
+  Py_END_ALLOW_THREADS
+  if (st) return (vdpy_raise(st, &err), 0);
+  return 1;
 }
 
 static PyObject* harvest_new(PyTypeObject* type, PyObject* args, PyObject* kw) {
@@ -99,34 +225,17 @@ static PyObject* harvest_new(PyTypeObject* type, PyObject* args, PyObject* kw) {
   vdpy_harvest* o = (vdpy_harvest*)type->tp_alloc(type, 0);
   if (!o) return NULL;
   vd_scene_default(&o->base);
-  vd_scene_default(&o->scene);
+  vd_scene_default(&o->s.scene);
+  if (!vdpy_scene_read(src, &o->base)) goto fail;
+  // the scene as written, its first draw (the episode stays not ready when no fruit is reachable)
   vd_error err = {0};
   vd_status st;
-  // a scene file, or its JSON text
-  const char* text = NULL;
-  Py_ssize_t len = 0;
-  char path[PATH_CAP] = "";
-  // text: a str with a newline or whose first character (past blanks) is '{'
-  int is_text = 0;
-  if (PyUnicode_Check(src)) {
-    Py_ssize_t n = PyUnicode_GET_LENGTH(src), i = 0;
-    while (i < n && Py_UNICODE_ISSPACE(PyUnicode_READ_CHAR(src, i))) i++;
-    is_text = PyUnicode_FindChar(src, '\n', 0, n, 1) >= 0 || (i < n && PyUnicode_READ_CHAR(src, i) == '{');
-  }
-  if (is_text) {
-    text = PyUnicode_AsUTF8AndSize(src, &len);
-    if (!text) goto fail;
-  } else if (!vdpy_path(src, "scene", path, sizeof path)) {
-    goto fail;
-  }
   Py_BEGIN_ALLOW_THREADS
-  st = text ? vd_scene_parse(text, (size_t)len, NULL, &o->base, &err) : vd_scene_read(path, &o->base, &err);
-  if (!st) {
-    vd_scene s;
-    st = vd_scene_copy(&o->base, &s, &err);
-    if (!st) st = episode(o, &s, 0, &err);
-    vd_scene_free(&s);
-  }
+  vd_scene s;
+  st = vd_scene_copy(&o->base, &s, &err);
+  if (!st) st = episode(&o->s, &s, 0, &err);
+  vd_scene_free(&s);
+  o->s.ready = 0;
   Py_END_ALLOW_THREADS
   if (st) {
     vdpy_raise(st, &err);
@@ -138,7 +247,7 @@ fail:
   return NULL;
 }
 
-// reset(seed, episode): episode k of the scene's randomisation under seed
+// reset(seed, episode): episode k of the scene's randomisation under seed -> plant draws taken
 static PyObject* harvest_reset(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   static char* names[] = {"seed", "episode", "randomize", NULL};
   PyObject *so, *ko = NULL;
@@ -146,26 +255,91 @@ static PyObject* harvest_reset(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   if (!PyArg_ParseTupleAndKeywords(args, kw, "O|O$p:reset", names, &so, &ko, &randomize)) return NULL;
   int64_t seed, k = 0;
   if (!vdpy_i64(so, "seed", 0, INT64_MAX, &seed)) return NULL;
-  if (ko && !vdpy_i64(ko, "episode", 0, INT64_MAX, &k)) return NULL;
+  if (ko && !vdpy_i64(ko, "episode", 0, ((int64_t)1 << 40) - 1, &k)) return NULL;
   if (!busy_check(o)) return NULL;
   o->busy = 1;
   vd_error err = {0};
   vd_status st;
   Py_BEGIN_ALLOW_THREADS
-  vd_scene s;
-  uint64_t tseed = (uint64_t)seed;
-  st = randomize ? vd_scene_episode(&o->base, (uint64_t)seed, k, &s, &tseed, &err) : vd_scene_copy(&o->base, &s, &err);
-  if (!st) st = episode(o, &s, tseed, &err);
-  vd_scene_free(&s);
+  st = vdpy_slot_reset(&o->s, &o->base, (uint64_t)seed, k, randomize, &err);
   Py_END_ALLOW_THREADS
   o->busy = 0;
   if (st) return vdpy_raise(st, &err);
-  Py_RETURN_NONE;
+  return PyLong_FromLong(o->s.draws);
 }
 
 static int have_episode(vdpy_harvest* o) {
-  if (!o->h) return (vdpy_raise(VD_ERR_VALUE, NULL), 0);  // a failed reset left none
+  if (!o->s.h) return (vdpy_raise(VD_ERR_VALUE, NULL), 0);  // a failed reset left none
   return 1;
+}
+
+// an action: end-effector velocity (m/s, rad/s) and gripper, checked
+static int parse_action(PyObject* lo, PyObject* ao, PyObject* go, vd_harvest_action* a) {
+  double l[3], w[3], g;
+  if (!vdpy_vec(lo, "lin_vel", 3, l) || !vdpy_vec(ao, "ang_vel", 3, w) || !vdpy_f64(go, "gripper", 0, 1, &g))
+    return 0;
+  for (int k = 0; k < 3; k++)
+    if (fabs(l[k]) > 10 || fabs(w[k]) > 100)
+      return (vdpy_arg_error("lin_vel within +-10 m/s and ang_vel within +-100 rad/s"), 0);
+  *a = (vd_harvest_action){vd_v3(l[0], l[1], l[2]), vd_v3(w[0], w[1], w[2]), g};
+  return 1;
+}
+
+// rules from keywords: weights (7 numbers, vdpy_term_names' order), terminate_on_detach,
+// max_steps (None or 0: none)
+int vdpy_rules_parse(PyObject* weights, int terminate_on_detach, PyObject* max_steps, vdpy_rules* r) {
+  memset(r, 0, sizeof *r);
+  if (!vdpy_vec(weights, "weights", VDPY_NTERMS, r->w)) return 0;
+  r->terminate_on_detach = terminate_on_detach;
+  r->randomize = 1;
+  if (max_steps && max_steps != Py_None && !vdpy_i64(max_steps, "max_steps", 0, INT64_MAX, &r->max_steps))
+    return 0;
+  return 1;
+}
+
+PyObject* vdpy_outcome_tuple(const vdpy_outcome* out) {
+  PyObject* terms = PyDict_New();
+  for (int k = 0; terms && k < VDPY_NTERMS; k++) {
+    PyObject* v = PyFloat_FromDouble(out->terms[k]);
+    if (!v || PyDict_SetItemString(terms, vdpy_term_names[k], v) < 0) Py_CLEAR(terms);
+    Py_XDECREF(v);
+  }
+  if (!terms) return NULL;
+  return Py_BuildValue("(OdNOOs)", out->ok ? Py_True : Py_False, out->reward, terms,
+                       out->terminated ? Py_True : Py_False, out->truncated ? Py_True : Py_False, out->reason);
+}
+
+static PyObject* events_list(const vd_harvest* h, int since);
+
+// act(lin_vel, ang_vel, gripper, weights, terminate_on_detach, max_steps) -> (ok, reward, terms,
+// terminated, truncated, reason, events): one environment step, with the events it made
+static PyObject* harvest_act(vdpy_harvest* o, PyObject* args, PyObject* kw) {
+  static char* names[] = {"lin_vel", "ang_vel", "gripper", "weights", "terminate_on_detach", "max_steps", NULL};
+  PyObject *lo, *ao, *go, *wo, *mo = NULL;
+  int tod = 1;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOO|pO:act", names, &lo, &ao, &go, &wo, &tod, &mo)) return NULL;
+  vd_harvest_action a;
+  vdpy_rules r;
+  if (!parse_action(lo, ao, go, &a) || !vdpy_rules_parse(wo, tod, mo, &r) || !busy_check(o)) return NULL;
+  o->busy = 1;
+  vd_error err = {0};
+  vdpy_outcome out;
+  vd_status st;
+  int since = o->s.nevents;
+  Py_BEGIN_ALLOW_THREADS
+  st = vdpy_slot_step(&o->s, &a, &r, &out, &err);
+  Py_END_ALLOW_THREADS
+  o->busy = 0;
+  if (st == VD_ERR_ARG) return vdpy_arg_error("%s", err.msg);
+  if (st) return vdpy_raise(st, &err);
+  PyObject* t = vdpy_outcome_tuple(&out);
+  PyObject* ev = t ? events_list(o->s.h, since) : NULL;
+  PyObject* one = ev ? PyTuple_Pack(1, ev) : NULL;
+  PyObject* all = one ? PySequence_Concat(t, one) : NULL;
+  Py_XDECREF(t);
+  Py_XDECREF(ev);
+  Py_XDECREF(one);
+  return all;
 }
 
 // step(lin_vel, ang_vel, gripper) -> ok: False when the episode failed (then done)
@@ -173,40 +347,42 @@ static PyObject* harvest_step(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   static char* names[] = {"lin_vel", "ang_vel", "gripper", NULL};
   PyObject *lo, *ao, *go;
   if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO:step", names, &lo, &ao, &go)) return NULL;
-  double l[3], w[3], g;
-  if (!vdpy_vec(lo, "lin_vel", 3, l) || !vdpy_vec(ao, "ang_vel", 3, w) || !vdpy_f64(go, "gripper", 0, 1, &g))
-    return NULL;
-  for (int k = 0; k < 3; k++)
-    if (fabs(l[k]) > 10 || fabs(w[k]) > 100)
-      return vdpy_arg_error("lin_vel within +-10 m/s and ang_vel within +-100 rad/s");
+  vd_harvest_action a;
+  if (!parse_action(lo, ao, go, &a)) return NULL;
   if (!have_episode(o) || !busy_check(o)) return NULL;
-  if (vd_harvest_done(o->h)) return vdpy_arg_error("the episode is over: reset() first");
-  vd_harvest_action a = {vd_v3(l[0], l[1], l[2]), vd_v3(w[0], w[1], w[2]), g};
+  if (vd_harvest_done(o->s.h)) return vdpy_arg_error("the episode is over: reset() first");
   o->busy = 1;
-  o->stepped = 1;
+  o->s.stepped = 1;
   vd_error err = {0};
   vd_status st;
   Py_BEGIN_ALLOW_THREADS
-  st = vd_harvest_step(o->h, &a, &err);
+  st = vd_harvest_step(o->s.h, &a, &err);
   Py_END_ALLOW_THREADS
   o->busy = 0;
-  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) Py_RETURN_FALSE;  // MuJoCo or the plant failed
+  if (st == VD_ERR_VALUE && vd_harvest_done(o->s.h)) Py_RETURN_FALSE;  // MuJoCo or the plant failed
   if (st) return vdpy_raise(st, &err);
   Py_RETURN_TRUE;
+}
+
+// close(): free the episode and its plant now (the scene stays for info)
+static PyObject* harvest_close(vdpy_harvest* o, PyObject* unused) {
+  if (!busy_check(o)) return NULL;
+  vdpy_slot_free(&o->s);
+  Py_RETURN_NONE;
 }
 
 // run(): the scene's scripted controller to the end of the episode (as `verdant harvest`)
 static PyObject* harvest_run(vdpy_harvest* o, PyObject* unused) {
   if (!have_episode(o) || !busy_check(o)) return NULL;
-  if (o->stepped) return vdpy_arg_error("run() drives an episode from its start: reset() first");
+  if (o->s.stepped) return vdpy_arg_error("run() drives an episode from its start: reset() first");
   o->busy = 1;
   vd_error err = {0};
   vd_status st = VD_OK;
   Py_BEGIN_ALLOW_THREADS
-  if (!vd_harvest_done(o->h)) st = vd_harvest_run(o->h, NULL, NULL, &err);
+  if (!vd_harvest_done(o->s.h)) st = vd_harvest_run(o->s.h, NULL, NULL, &err);
   Py_END_ALLOW_THREADS
   o->busy = 0;
-  if (st == VD_ERR_VALUE && vd_harvest_done(o->h)) Py_RETURN_FALSE;
+  if (st == VD_ERR_VALUE && vd_harvest_done(o->s.h)) Py_RETURN_FALSE;
   if (st) return vdpy_raise(st, &err);
   Py_RETURN_TRUE;
 }
@@ -221,7 +397,7 @@ static PyObject* vec(const double* v, npy_intp n) {
 static PyObject* harvest_observe(vdpy_harvest* o, PyObject* unused) {
   if (!have_episode(o) || !busy_check(o)) return NULL;
   vd_harvest_obs b;
-  vd_harvest_observe(o->h, &b);
+  vd_harvest_observe(o->s.h, &b);
   double ee[3] = {b.ee_pos.x, b.ee_pos.y, b.ee_pos.z}, eq[4] = {b.ee_quat.w, b.ee_quat.x, b.ee_quat.y, b.ee_quat.z};
   double fp[3] = {b.fruit_pos.x, b.fruit_pos.y, b.fruit_pos.z}, fv[3] = {b.fruit_vel.x, b.fruit_vel.y, b.fruit_vel.z};
   double cp[3] = {b.cmd_pos.x, b.cmd_pos.y, b.cmd_pos.z}, pf[3] = {b.pull_force.x, b.pull_force.y, b.pull_force.z};
@@ -246,10 +422,15 @@ static PyObject* harvest_events(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   int64_t since = 0;
   if (so && !vdpy_i64(so, "since", 0, INT32_MAX, &since)) return NULL;
   if (!have_episode(o) || !busy_check(o)) return NULL;
+  return events_list(o->s.h, (int)since);
+}
+
+// the events of episode h from index since on, as dicts
+static PyObject* events_list(const vd_harvest* h, int since) {
   const vd_harvest_event* ev;
-  int n = vd_harvest_events(o->h, &ev);
+  int n = vd_harvest_events(h, &ev);
   PyObject* list = PyList_New(0);
-  for (int k = (int)since; list && k < n; k++) {
+  for (int k = since; list && k < n; k++) {
     const vd_harvest_event* e = &ev[k];
     PyObject* d = Py_BuildValue("{s:d,s:s,s:d,s:i,s:i,s:s,s:d,s:d,s:s}", "time", e->time, "kind",
                                 vd_harvest_event_name(e->kind), "value", e->value, "segment", e->seg, "instance",
@@ -264,7 +445,7 @@ static PyObject* harvest_events(vdpy_harvest* o, PyObject* args, PyObject* kw) {
 static PyObject* harvest_summary(vdpy_harvest* o, PyObject* unused) {
   if (!have_episode(o) || !busy_check(o)) return NULL;
   vd_harvest_summary s;
-  vd_harvest_summarize(o->h, &s);
+  vd_harvest_summarize(o->s.h, &s);
   return Py_BuildValue("{s:O,s:O,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:i,s:i,s:d,s:d,s:d,s:d,s:L,s:L,s:i,s:s,s:K}",
                        "detached", s.detached ? Py_True : Py_False, "grasped", s.grasped ? Py_True : Py_False,
                        "site", vd_harvest_site_name(s.site), "time", s.time, "detach_force", s.detach_force,
@@ -273,22 +454,22 @@ static PyObject* harvest_summary(vdpy_harvest* o, PyObject* unused) {
                        "fruits_dropped", s.fruits_dropped, "ik_error", s.ik_error, "track_error", s.track_error,
                        "slip", s.slip, "duration", s.duration, "steps", (long long)s.steps, "plant_warnings",
                        (long long)s.plant_warnings, "target_instance", s.target_instance, "reason", s.reason,
-                       "plant_seed", (unsigned long long)o->plant_seed);
+                       "plant_seed", (unsigned long long)o->s.plant_seed);
 }
 
 static PyObject* harvest_done(vdpy_harvest* o, void* c) {
-  return PyBool_FromLong(o->h ? vd_harvest_done(o->h) : 1);
+  return PyBool_FromLong(o->s.h ? vd_harvest_done(o->s.h) : 1);
 }
 
 static PyObject* harvest_info(vdpy_harvest* o, void* c) {
-  const vd_scene* s = &o->scene;
+  const vd_scene* s = &o->s.scene;
   vd_harvest_obs b;
   memset(&b, 0, sizeof b);
-  if (o->h) vd_harvest_observe(o->h, &b);
+  if (o->s.h) vd_harvest_observe(o->s.h, &b);
   return Py_BuildValue("{s:s,s:s,s:s,s:d,s:d,s:i,s:d,s:d,s:s,s:K,s:O}", "scene", s->path, "plant", s->plant_path,
                        "robot", s->robot_path, "control_dt", s->control_dt, "duration", s->duration, "nq", b.nq,
                        "gripper_open", s->gripper_open, "gripper_closed", s->gripper_closed, "method",
-                       vd_harvest_method_name(s->method.method), "plant_seed", (unsigned long long)o->plant_seed,
+                       vd_harvest_method_name(s->method.method), "plant_seed", (unsigned long long)o->s.plant_seed,
                        "two_way", s->two_way ? Py_True : Py_False);
 }
 
@@ -296,7 +477,7 @@ static PyObject* harvest_info(vdpy_harvest* o, void* c) {
 static PyObject* harvest_qpos(vdpy_harvest* o, void* c) {
   if (!have_episode(o)) return NULL;
   int nq = 0;
-  const double* q = vd_harvest_qpos(o->h, &nq);
+  const double* q = vd_harvest_qpos(o->s.h, &nq);
   return vec(q, nq);
 }
 
@@ -304,13 +485,13 @@ static PyObject* harvest_qpos(vdpy_harvest* o, void* c) {
 const vd_data* vdpy_harvest_plant_state(PyObject* obj, const vd_model** plant, const vd_sim_collider** col,
                                         int* ncol) {
   vdpy_harvest* o = (vdpy_harvest*)obj;
-  if (!o->h) return NULL;
-  const vd_sim_model* sm = vd_harvest_sim_model(o->h);
-  const vd_sim_data* sd = vd_harvest_sim_data(o->h);
-  vd_sim_to_plant(sm, sd, o->plant, o->pstate);
-  *plant = o->plant;
+  if (!o->s.h) return NULL;
+  const vd_sim_model* sm = vd_harvest_sim_model(o->s.h);
+  const vd_sim_data* sd = vd_harvest_sim_data(o->s.h);
+  vd_sim_to_plant(sm, sd, o->s.plant, o->s.pstate);
+  *plant = o->s.plant;
   *col = sd->collider, *ncol = sd->ncollider;
-  return o->pstate;
+  return o->s.pstate;
 }
 
 int vdpy_harvest_busy(PyObject* obj, int set) {
@@ -329,17 +510,17 @@ static PyObject* harvest_cloud(vdpy_harvest* o, PyObject* args, PyObject* kw) {
   int ncol;
   const vd_data* d = vdpy_harvest_plant_state((PyObject*)o, &m, &col, &ncol);
   o->busy = 1;
-  PyObject* r = vdpy_cloud_make(o->spec, m, d, o->plant_seed, kw);
+  PyObject* r = vdpy_cloud_make(o->s.spec, m, d, o->s.plant_seed, kw);
   o->busy = 0;
   return r;
 }
 
 static PyObject* harvest_plant(vdpy_harvest* o, PyObject* unused) {
   if (!have_episode(o) || !busy_check(o)) return NULL;
-  vd_plant_spec* spec = vd_plant_spec_copy(o->spec);
+  vd_plant_spec* spec = vd_plant_spec_copy(o->s.spec);
   if (!spec) return PyErr_NoMemory();
-  vd_sim_to_spec(vd_harvest_sim_model(o->h), vd_harvest_sim_data(o->h), spec);
-  return vdpy_plant_new(spec, o->plant_seed, o->scene.plant_path, NULL);
+  vd_sim_to_spec(vd_harvest_sim_model(o->s.h), vd_harvest_sim_data(o->s.h), spec);
+  return vdpy_plant_new(spec, o->s.plant_seed, o->s.scene.plant_path, NULL);
 }
 
 static PyGetSetDef harvest_getset[] = {
@@ -351,27 +532,48 @@ static PyGetSetDef harvest_getset[] = {
 
 static PyMethodDef harvest_methods[] = {
     {"reset", (PyCFunction)(void (*)(void))harvest_reset, METH_VARARGS | METH_KEYWORDS,
+     "reset($self, /, seed, episode=0, *, randomize=True)\n--\n\n"
      "reset(seed, episode=0, *, randomize=True): start episode `episode` of the scene's\n"
      "randomisation under seed (plant seed, target, method parameters); the plant is regrown\n"
-     "when its seed changes. Without the GIL."},
+     "when its seed changes, and drawn again (up to 32 draws) while no fruit is reachable.\n"
+     "Returns the draws taken; BadValueError naming the scene when none was possible. Without\n"
+     "the GIL."},
     {"step", (PyCFunction)(void (*)(void))harvest_step, METH_VARARGS | METH_KEYWORDS,
+     "step($self, /, lin_vel, ang_vel, gripper)\n--\n\n"
      "step(lin_vel, ang_vel, gripper) -> bool: one control step under an end-effector velocity\n"
      "(m/s, rad/s, world frame) and a gripper command in [0, 1] (0 open, 1 closed), without the\n"
      "GIL; False when MuJoCo or the plant failed (the episode is then done)."},
+    {"act", (PyCFunction)(void (*)(void))harvest_act, METH_VARARGS | METH_KEYWORDS,
+     "act($self, /, lin_vel, ang_vel, gripper, weights, terminate_on_detach=True, max_steps=None)\n"
+     "--\n\n"
+     "One environment step (HarvestEnv.step) without the GIL: the action, then the reward of\n"
+     "weights (7 numbers: detach, grasp, distance, pull_force, fracture, drop, hit) and the\n"
+     "ending. Returns (ok, reward, terms, terminated, truncated, reason, events). ArgumentError\n"
+     "before a successful reset and after the episode ended."},
+    {"close", (PyCFunction)harvest_close, METH_NOARGS,
+     "close($self, /)\n--\n\nFree the episode and its plant now; later calls that need them raise."},
     {"run", (PyCFunction)harvest_run, METH_NOARGS,
+     "run($self, /)\n--\n\n"
      "run() -> bool: the scene's scripted controller (approach, grasp, then pull, bend or twist)\n"
      "to the end of the episode, without the GIL, as `verdant harvest` runs it; False when MuJoCo\n"
      "or the plant failed. Only before the first step() of an episode."},
     {"observe", (PyCFunction)harvest_observe, METH_NOARGS,
+     "observe($self, /)\n--\n\n"
      "observe() -> dict: time, phase, joint state q and qd, end-effector pose, target fruit, grasp\n"
      "forces, detachment."},
     {"events", (PyCFunction)(void (*)(void))harvest_events, METH_VARARGS | METH_KEYWORDS,
+     "events($self, /, since=0)\n--\n\n"
      "events(since=0) -> list of dicts: phase, touch, grasp, slip, release, fracture, detach, hit,\n"
      "drop and ik events from index since on."},
-    {"summary", (PyCFunction)harvest_summary, METH_NOARGS, "summary() -> dict: the outcome so far (summary.json)."},
+    {"summary", (PyCFunction)harvest_summary, METH_NOARGS,
+     "summary($self, /)\n--\n\n"
+     "summary() -> dict: the outcome so far (summary.json)."},
     {"cloud", (PyCFunction)(void (*)(void))harvest_cloud, METH_VARARGS | METH_KEYWORDS,
+     "cloud($self, /, **options)\n--\n\n"
      "cloud(**options) -> Cloud: the plant in its current state (Plant.cloud's keywords)."},
-    {"plant", (PyCFunction)harvest_plant, METH_NOARGS, "plant() -> Plant: the plant in its current state."},
+    {"plant", (PyCFunction)harvest_plant, METH_NOARGS,
+     "plant($self, /)\n--\n\n"
+     "plant() -> Plant: the plant in its current state."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -380,7 +582,7 @@ PyTypeObject vdpy_harvest_type = {
     .tp_basicsize = sizeof(vdpy_harvest),
     .tp_dealloc = (destructor)harvest_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
-    .tp_doc = "Harvest(scene): a harvest episode stepped from Python (see verdant.HarvestEnv).",
+    .tp_doc = "Harvest(scene)\n--\n\nHarvest(scene): a harvest episode stepped from Python (see verdant.HarvestEnv).",
     .tp_methods = harvest_methods,
     .tp_getset = harvest_getset,
     .tp_new = harvest_new,

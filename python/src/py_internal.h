@@ -110,7 +110,6 @@ typedef struct vdpy_sim {
   vd_sdf* sdf[VD_SIM_MAX_COLLIDERS];  // distance grids of mesh colliders (owned)
   double* wind;          // wind series rows (owned, nwind x 4)
   int nwind;
-  double* stress;        // per-segment stress buffer (owned, nseg)
   int busy;              // a thread is stepping it
 } vdpy_sim;
 
@@ -135,11 +134,77 @@ extern PyTypeObject* vdpy_cloud_class;
 // buffer, valid until the next call).
 const vd_data* vdpy_sim_plant_state(PyObject* sim, const vd_model** plant);
 
+// Harvest episode slots (py_harvest.c): what a Harvest holds once and a VectorHarvest
+// (py_vector.c) N times: the episode's scene, its plant (grown for the draw) and the episode
+// over it, with the environment's bookkeeping (reward state, step count). No Python calls in
+// the slot functions: run them without the GIL, one slot per thread at a time.
+#include "verdant/robot.h"
+
+#define VDPY_DRAWS 32        // plant draws of one episode before reset gives up (docs/python.md)
+#define VDPY_NTERMS 7        // reward terms: detach, grasp, distance, pull_force, fracture, drop, hit
+
+typedef struct vdpy_slot {
+  vd_scene scene;        // the current episode's scene (owned)
+  vd_plant_spec* spec;   // the episode's plant, placed (owned)
+  vd_model* plant;       // compiled (owned; the episode borrows it)
+  uint64_t plant_seed;   // the seed spec was grown with
+  vd_harvest* h;         // the episode (owned; Nullable before the first draw)
+  vd_data* pstate;       // the plant state of the current step (owned)
+  int stepped;           // step() was called in this episode (the scripted controller is off)
+  int ready;             // the last reset found a reachable target and the episode is not over
+  uint64_t seed;         // the episode's seed
+  int64_t episode;       // its index under the seed
+  int draws;             // plant draws the last reset took (1 when the first was possible)
+  int nevents;           // events already seen by the reward
+  int was_detached, was_held;
+  int64_t steps;         // control steps of the episode
+} vdpy_slot;
+
+// The reward weights and ending rules of an environment (docs/python.md).
+typedef struct vdpy_rules {
+  double w[VDPY_NTERMS];   // weight of each term, in the order of VDPY_NTERMS
+  int terminate_on_detach; // the episode ends when the target comes off
+  int64_t max_steps;       // truncation after this many steps (0: the scene's duration only)
+  int randomize;           // draw each episode from the scene's "episodes" ranges
+} vdpy_rules;
+
+// One control step's outcome.
+typedef struct vdpy_outcome {
+  double reward, terms[VDPY_NTERMS];
+  int ok;                  // 0 when MuJoCo or the plant failed (the episode is then over)
+  int terminated, truncated;
+  char reason[128];        // why it ended ("" while it goes on)
+} vdpy_outcome;
+
+// Names of the reward terms, in order.
+extern const char* const vdpy_term_names[VDPY_NTERMS];
+// Free a slot's episode, plant and scene (a zeroed slot is fine).
+void vdpy_slot_free(vdpy_slot* o);
+// Episode k of seed (base's randomisation when rules->randomize), the plant redrawn up to
+// VDPY_DRAWS times until a fruit is reachable; VD_ERR_VALUE naming the scene, the draws and the
+// reason when none is.
+vd_status vdpy_slot_reset(vdpy_slot* o, const vd_scene* base, uint64_t seed, int64_t k, int randomize,
+                          vd_error* err);
+// One control step under a with rules' reward and ending; VD_ERR_ARG when the slot is not
+// ready (no successful reset, or the episode is over).
+vd_status vdpy_slot_step(vdpy_slot* o, const vd_harvest_action* a, const vdpy_rules* rules, vdpy_outcome* out,
+                         vd_error* err);
+// Rules from Python values: weights (VDPY_NTERMS numbers, vdpy_term_names' order),
+// terminate_on_detach, max_steps (Nullable or None: none); randomize on. 0 with an exception set.
+int vdpy_rules_parse(PyObject* weights, int terminate_on_detach, PyObject* max_steps, vdpy_rules* r);
+// (ok, reward, {term: value}, terminated, truncated, reason) of an outcome.
+PyObject* vdpy_outcome_tuple(const vdpy_outcome* out);
+// Read a scene file or its JSON text (src: str, bytes or path) into *out; NULL with an
+// exception set. Holds the GIL only for the conversion.
+int vdpy_scene_read(PyObject* src, vd_scene* out);
+
 // Harvest episodes (py_harvest.c): the type, the plant state of the current step with the
 // colliders the robot's geoms are to the plant, and its busy flag (set >= 0 sets it; returns the
 // old value).
 typedef struct vdpy_harvest vdpy_harvest;
 extern PyTypeObject vdpy_harvest_type;
+// N harvest episodes stepped in native threads (py_vector.c).
+extern PyTypeObject vdpy_vector_type;
 const vd_data* vdpy_harvest_plant_state(PyObject* harvest, const vd_model** plant,
                                         const vd_sim_collider** col, int* ncol);
 int vdpy_harvest_busy(PyObject* harvest, int set);
@@ -149,6 +214,8 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_load(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_cloud(PyObject* self, PyObject* args, PyObject* kw);
 PyObject* vdpy_read_png(PyObject* self, PyObject* args, PyObject* kw);
+// _cloud_unpickle(data, stats): a Cloud from Cloud.__reduce__'s bytes (py_cloud.c).
+PyObject* vdpy_cloud_unpickle(PyObject* self, PyObject* args);
 
 // Grow (or read) the plant file path as grow() does with seed, steps (-1: the file's) and
 // "NAME=VALUE" overrides; *out is a new spec. No Python calls: run it without the GIL.

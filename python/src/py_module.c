@@ -4,7 +4,10 @@
 #define VDPY_MODULE_C
 #include "py_internal.h"
 
+#include <errno.h>
 #include <stdarg.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 // ---------------------------------------------------------------------------------------------
 // exceptions: verdant.Error and one subclass per status code
@@ -39,6 +42,27 @@ static const char* status_key(vd_status st) {
   return (int)st >= 0 && st < VD_STATUS_COUNT ? keys[st] : "error";
 }
 
+// the errno of a file that could not be read or written, found again from the file system (the
+// library's status does not carry it): ENOENT where it (or its folder) is missing, EISDIR for a
+// folder, EACCES without permission, else EIO
+static int file_errno(const char* file) {
+  struct stat sb;
+  if (!file[0]) return EIO;
+  if (stat(file, &sb) < 0) return errno == ENOENT || errno == ENOTDIR ? ENOENT : errno;
+  if (S_ISDIR(sb.st_mode)) return EISDIR;
+  if (access(file, R_OK) < 0) return EACCES;
+  return EIO;
+}
+
+// FileError's OSError attributes: errno, strerror (the library's message), filename
+static int set_errno(PyObject* e, const char* file, PyObject* f, PyObject* m) {
+  PyObject* no = PyLong_FromLong(file_errno(file));
+  int bad = !no || PyObject_SetAttrString(e, "errno", no) < 0 || PyObject_SetAttrString(e, "strerror", m) < 0 ||
+            PyObject_SetAttrString(e, "filename", file[0] ? f : Py_None) < 0;
+  Py_XDECREF(no);
+  return bad;
+}
+
 // raise class cls with message text and the location attributes
 static PyObject* raise_with(PyObject* cls, const char* status, const char* file, int line,
                             int col, const char* msg, const char* text) {
@@ -57,6 +81,7 @@ static PyObject* raise_with(PyObject* cls, const char* status, const char* file,
     Py_XDECREF(ln);
     Py_XDECREF(cn);
   }
+  if (!bad && !strcmp(status, "io")) bad = set_errno(e, file, f, m);
   Py_XDECREF(f);
   Py_XDECREF(m);
   Py_XDECREF(s);
@@ -132,7 +157,11 @@ PyObject* vdpy_view(PyObject* owner, void* data, int nd, const npy_intp* dims, i
                     int writeable) {
   npy_intp count = 1;
   for (int k = 0; k < nd; k++) count *= dims[k];
-  if (count == 0 || !data) return PyArray_ZEROS(nd, (npy_intp*)dims, typenum, 0);
+  if (count == 0 || !data) {  // nothing to view: an empty array, read-only like a view would be
+    PyObject* e = PyArray_ZEROS(nd, (npy_intp*)dims, typenum, 0);
+    if (e && !writeable) PyArray_CLEARFLAGS((PyArrayObject*)e, NPY_ARRAY_WRITEABLE);
+    return e;
+  }
   PyObject* a = PyArray_SimpleNewFromData(nd, (npy_intp*)dims, typenum, data);
   if (!a) return NULL;
   Py_INCREF(owner);
@@ -208,19 +237,27 @@ static PyObject* mod_alloc_bytes(PyObject* self, PyObject* unused) {
 
 static PyMethodDef methods[] = {
     {"grow", (PyCFunction)(void (*)(void))vdpy_grow, METH_VARARGS | METH_KEYWORDS,
+     "grow($module, /, source, *, seed=0, steps=None, set=None, labels=None, max_modules=50000000, max_ops=0, curve_step=None, curve_connect=None, curve_distance=None)\n--\n\n"
      "grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=50000000,\n"
      "     max_ops=0, curve_step=None, curve_connect=None, curve_distance=None) -> Plant\n"
      "Low-level grow; see verdant.grow."},
     {"load", (PyCFunction)(void (*)(void))vdpy_load, METH_VARARGS | METH_KEYWORDS,
+     "load($module, /, path, *, labels=None, seed=0)\n--\n\n"
      "load(path, *, labels=None, seed=0) -> Plant: read a plant JSON file."},
     {"read_cloud", (PyCFunction)(void (*)(void))vdpy_read_cloud, METH_VARARGS | METH_KEYWORDS,
+     "read_cloud($module, /, path)\n--\n\n"
      "read_cloud(path) -> Cloud: read a cloud file written by verdant (.ply .pcd .xyz .csv .las)."},
     {"read_png", (PyCFunction)(void (*)(void))vdpy_read_png, METH_VARARGS | METH_KEYWORDS,
+     "read_png($module, /, path)\n--\n\n"
      "read_png(path) -> numpy array: a PNG as written by verdant render (H x W x 3 uint8 colour,\n"
      "H x W uint16 depth in mm or label/instance ids)."},
     {"_register", (PyCFunction)(void (*)(void))mod_register, METH_VARARGS | METH_KEYWORDS,
+     "_register($module, /, plant=None, mesh=None, cloud=None)\n--\n\n"
      "_register(plant=, mesh=, cloud=): Python subclasses the extension returns."},
+    {"_cloud_unpickle", vdpy_cloud_unpickle, METH_VARARGS,
+     "_cloud_unpickle($module, data, stats, /)\n--\n\nA Cloud from the bytes of Cloud.__reduce__ (pickling)."},
     {"alloc_bytes", mod_alloc_bytes, METH_NOARGS,
+     "alloc_bytes($module, /)\n--\n\n"
      "alloc_bytes() -> int: bytes currently allocated by the C library (for leak checks)."},
     {NULL, NULL, 0, NULL},
 };
@@ -237,9 +274,9 @@ PyMODINIT_FUNC PyInit__verdant(void) {
   import_array();
   PyObject* mod = PyModule_Create(&module);
   if (!mod) return NULL;
-  PyTypeObject* types[] = {&vdpy_plant_type, &vdpy_mesh_type,     &vdpy_cloud_type,
-                           &vdpy_sim_type,   &vdpy_renderer_type, &vdpy_harvest_type};
-  const char* names[] = {"Plant", "Mesh", "Cloud", "Sim", "Renderer", "Harvest"};
+  PyTypeObject* types[] = {&vdpy_plant_type,    &vdpy_mesh_type,    &vdpy_cloud_type,  &vdpy_sim_type,
+                           &vdpy_renderer_type, &vdpy_harvest_type, &vdpy_vector_type};
+  const char* names[] = {"Plant", "Mesh", "Cloud", "Sim", "Renderer", "Harvest", "VectorHarvest"};
   for (int k = 0; k < (int)(sizeof types / sizeof types[0]); k++)
     if (PyType_Ready(types[k]) < 0 || PyModule_AddObjectRef(mod, names[k], (PyObject*)types[k]) < 0)
       goto fail;

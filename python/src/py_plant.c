@@ -146,6 +146,20 @@ static vd_status grow_lsys(const grow_args* a, vd_lsystem* ls, const char* name,
   return st;
 }
 
+// grow_lsys, again in CPython when the automatic engine choice took native and native refused
+// what it met only when running (vd_lsys_fallback)
+static vd_status grow_lsys_auto(const grow_args* a, vd_lsystem** ls, const char* name, grow_out* out,
+                                vd_error* err) {
+  vd_status st = grow_lsys(a, *ls, name, out, err);
+  if (st && vd_lsys_fallback(ls, st)) {
+    vd_plant_spec_destroy(out->spec);
+    out->spec = NULL;
+    memset(err, 0, sizeof *err);
+    st = grow_lsys(a, *ls, name, out, err);
+  }
+  return st;
+}
+
 // the whole load, without the GIL
 static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   const char* name = a->path[0] ? a->path : "<string>";
@@ -159,7 +173,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
     vd_lsystem* ls;
     vd_status st = vd_lsys_parse_engine(a->text, len, name, a->engine, &ls, err);
     if (st) return st;
-    st = grow_lsys(a, ls, name, out, err);
+    st = grow_lsys_auto(a, &ls, name, out, err);
     vd_lsys_destroy(ls);
     return st;
   }
@@ -177,7 +191,7 @@ static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
   vd_lsystem* ls;
   vd_status st = vd_lsys_load_engine(a->path, a->engine, &ls, err);
   if (st) return st;
-  st = grow_lsys(a, ls, a->path, out, err);
+  st = grow_lsys_auto(a, &ls, a->path, out, err);
   vd_lsys_destroy(ls);
   return st;
 }
@@ -612,14 +626,16 @@ static PyObject* plant_reduce(vdpy_plant* p, PyObject* unused) {
 
 static PyMethodDef plant_methods[] = {
     {"save", (PyCFunction)(void (*)(void))plant_save, METH_VARARGS | METH_KEYWORDS,
+     "save($self, /, path, *, ascii=False)\n--\n\n"
      "save(path, *, ascii=False): write the plant as plant JSON (.json), a labelled OBJ mesh with\n"
      "its MTL (.obj) or a PLY mesh with face label and instance (.ply, binary unless ascii).\n"
      "The same bytes as `verdant grow PLANT -o path`."},
     {"mesh", (PyCFunction)(void (*)(void))plant_mesh, METH_VARARGS | METH_KEYWORDS,
+     "mesh($self, /, *, slices=None, stacks=None, caps=True)\n--\n\n"
      "mesh(*, slices=None, stacks=None, caps=True) -> Mesh: the labelled triangle mesh of the\n"
      "plant (slices: sides of every frustum and sphere, default each primitive's own)."},
     {"_cloud", (PyCFunction)(void (*)(void))plant_cloud, METH_VARARGS | METH_KEYWORDS,
-     "Low-level cloud sampler; see Plant.cloud."},
+     "_cloud($self, /, **options)\n--\n\nLow-level cloud sampler; see Plant.cloud."},
     {"__reduce__", (PyCFunction)plant_reduce, METH_NOARGS, NULL},
     {NULL, NULL, 0, NULL},
 };
@@ -700,6 +716,7 @@ static PyObject* mesh_save(vdpy_mesh* m, PyObject* args, PyObject* kw) {
 
 static PyMethodDef mesh_methods[] = {
     {"save", (PyCFunction)(void (*)(void))mesh_save, METH_VARARGS | METH_KEYWORDS,
+     "save($self, /, path, *, ascii=False)\n--\n\n"
      "save(path, *, ascii=False): write OBJ (+MTL, faces grouped by label/instance) or PLY (face\n"
      "label and instance; binary unless ascii)."},
     {NULL, NULL, 0, NULL},

@@ -410,6 +410,7 @@ static PyGetSetDef renderer_getset[] = {
 
 static PyMethodDef renderer_methods[] = {
     {"draw", (PyCFunction)(void (*)(void))renderer_draw, METH_VARARGS | METH_KEYWORDS,
+     "draw($self, /, objects, *, camera='orbit', azimuth=-60, elevation=20, eye=None, lookat=None, up=(0,0,1), fov=45, color_by='label', range=None, point_size=None, depth=True, masks=True, robot_qpos=None)\n--\n\n"
      "draw(objects, *, camera='orbit', azimuth=-60, elevation=20, eye=None, lookat=None,\n"
      "up=(0,0,1), fov=45, color_by='label', range=None, point_size=None, depth=True, masks=True,\n"
      "robot_qpos=None) -> dict: see verdant.render."},
@@ -421,7 +422,8 @@ PyTypeObject vdpy_renderer_type = {
     .tp_basicsize = sizeof(vdpy_renderer),
     .tp_dealloc = (destructor)renderer_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
-    .tp_doc = "Renderer(*, size=(640, 480), ...): an offscreen renderer (see verdant.Renderer).",
+    .tp_doc = "Renderer(*, size=(640, 480), supersample=2, shadows=True, floor=True, sky=True, background=None, "
+              "legend=True, robot=None, max_geoms=20000)\n--\n\nRenderer(*, size=(640, 480), ...): an offscreen renderer (see verdant.Renderer).",
     .tp_methods = renderer_methods,
     .tp_getset = renderer_getset,
     .tp_new = renderer_new,

@@ -137,13 +137,15 @@ static int run_opts(PyObject* kw, vd_sim_opt* opt, double** wind, int* nwind) {
 // ---------------------------------------------------------------------------------------------
 // Sim
 
+// steps between two checks for signals (Ctrl-C) in step(n): a few ms of the tomato's steps
+#define SIGNAL_CHUNK 16
+
 static int busy_check(vdpy_sim* s) {
   if (s->busy) return (vdpy_busy("this Sim"), 0);
   return 1;
 }
 
 static void sim_dealloc(vdpy_sim* s) {
-  vd_free(s->stress, (s->model && s->model->nseg ? (size_t)s->model->nseg : 1) * sizeof(double));
   vd_sim_data_destroy(s->data);
   vd_sim_model_destroy(s->model);
   vd_data_destroy(s->pstate);
@@ -219,8 +221,7 @@ static PyObject* sim_new(PyTypeObject* type, PyObject* args, PyObject* kw) {
   s->model->opt = opt;
   s->data = vd_sim_data_create(s->model);
   s->pstate = vd_data_create(pm);
-  s->stress = vd_calloc(s->model->nseg ? (size_t)s->model->nseg : 1, sizeof(double));
-  if (!s->data || !s->pstate || !s->stress) {
+  if (!s->data || !s->pstate) {
     PyErr_NoMemory();
     goto fail;
   }
@@ -255,11 +256,148 @@ static PyObject* sim_step(vdpy_sim* s, PyObject* args, PyObject* kw) {
   if (!busy_check(s)) return NULL;
   s->busy = 1;
   vd_status st = VD_OK;
-  Py_BEGIN_ALLOW_THREADS
-  for (int64_t k = 0; k < n && !st; k++) st = vd_sim_step(s->model, s->data);
-  Py_END_ALLOW_THREADS
+  // in chunks, the signals checked between them (Ctrl-C stops a long call within a chunk; the
+  // steps taken stay taken)
+  for (int64_t k = 0; k < n && !st;) {
+    int64_t end = k + SIGNAL_CHUNK < n ? k + SIGNAL_CHUNK : n;
+    Py_BEGIN_ALLOW_THREADS
+    for (; k < end && !st; k++) st = vd_sim_step(s->model, s->data);
+    Py_END_ALLOW_THREADS
+    if (!st && k < n && PyErr_CheckSignals() < 0) {
+      s->busy = 0;
+      return NULL;
+    }
+  }
   s->busy = 0;
   if (st) return step_failed(s, st);
+  Py_RETURN_NONE;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the state as bytes: a header of sizes, then every array of vd_sim_data that a step reads, in a
+// fixed order, native byte order (the same machine kind and verdant version read it back)
+
+#define STATE_MAGIC "VDSIMST1"
+
+typedef struct state_head {
+  char magic[8];
+  int32_t nnode, nseg, ncollider, ntie, nevent, ncontact;
+  int32_t sizes[4];  // sizeof of vd_vec3, vd_quat, vd_sim_collider, vd_sim_event: a layout check
+  double time, max_penetration;
+  int64_t nstep, nwarning, warning[VD_SIM_WARN_COUNT];
+} state_head;
+
+// one walk over the arrays, copying into buf (save) or out of it (load); returns bytes walked
+static size_t state_walk(vd_sim_data* d, const state_head* h, char* buf, int save) {
+  size_t at = sizeof *h;
+  const size_t nn = (size_t)h->nnode, ns = (size_t)h->nseg;
+  struct {
+    void* p;
+    size_t n;
+  } part[] = {
+      {d->node_pos, nn * sizeof(vd_vec3)},     {d->node_vel, nn * sizeof(vd_vec3)},
+      {d->node_force, nn * sizeof(vd_vec3)},   {d->node_mass, nn * sizeof(double)},
+      {d->seg_quat, ns * sizeof(vd_quat)},     {d->seg_omega, ns * sizeof(vd_vec3)},
+      {d->seg_torque, ns * sizeof(vd_vec3)},   {d->seg_lambda, ns * 6 * sizeof(double)},
+      {d->seg_broken, ns * sizeof(int)},       {d->seg_start, ns * sizeof(int)},
+      {d->collider_force, sizeof d->collider_force}, {d->collider_torque, sizeof d->collider_torque},
+      {d->collider_pass, sizeof d->collider_pass},   {d->event, (size_t)h->nevent * sizeof(vd_sim_event)},
+  };
+  for (size_t k = 0; k < sizeof part / sizeof part[0]; k++) {
+    if (buf && part[k].n) {
+      if (save) memcpy(buf + at, part[k].p, part[k].n);
+      else memcpy(part[k].p, buf + at, part[k].n);
+    }
+    at += part[k].n;
+  }
+  // colliders (their distance grids stay the Sim's own) and ties
+  for (int k = 0; k < h->ncollider; k++, at += sizeof(vd_sim_collider))
+    if (buf && save) {
+      vd_sim_collider c = d->collider[k];
+      c.sdf = NULL;
+      memcpy(buf + at, &c, sizeof c);
+    } else if (buf) {
+      const vd_sdf* keep = d->collider[k].sdf;
+      memcpy(&d->collider[k], buf + at, sizeof(vd_sim_collider));
+      d->collider[k].sdf = keep;
+    }
+  for (int k = 0; k < h->ntie; k++, at += sizeof(vd_sim_tie))
+    if (buf) {
+      if (save) memcpy(buf + at, &d->tie[k], sizeof(vd_sim_tie));
+      else memcpy(&d->tie[k], buf + at, sizeof(vd_sim_tie));
+    }
+  return at;
+}
+
+static void state_sizes(int32_t* sz) {
+  sz[0] = (int32_t)sizeof(vd_vec3), sz[1] = (int32_t)sizeof(vd_quat);
+  sz[2] = (int32_t)sizeof(vd_sim_collider), sz[3] = (int32_t)sizeof(vd_sim_event);
+}
+
+// get_state() -> bytes
+static PyObject* sim_get_state(vdpy_sim* s, PyObject* unused) {
+  if (!busy_check(s)) return NULL;
+  vd_sim_data* d = s->data;
+  state_head h;
+  memset(&h, 0, sizeof h);
+  memcpy(h.magic, STATE_MAGIC, 8);
+  h.nnode = d->nnode_all, h.nseg = d->nseg, h.ncollider = d->ncollider, h.ntie = d->ntie;
+  h.nevent = d->nevent, h.ncontact = d->ncontact;
+  state_sizes(h.sizes);
+  h.time = d->time, h.max_penetration = d->max_penetration;
+  h.nstep = d->nstep, h.nwarning = d->nwarning;
+  memcpy(h.warning, d->warning, sizeof h.warning);
+  size_t n = state_walk(d, &h, NULL, 1);
+  PyObject* b = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)n);
+  if (!b) return NULL;
+  char* buf = PyBytes_AS_STRING(b);
+  memcpy(buf, &h, sizeof h);
+  state_walk(d, &h, buf, 1);
+  return b;
+}
+
+// set_state(bytes): the state get_state returned, of a Sim of the same plant and options
+static PyObject* sim_set_state(vdpy_sim* s, PyObject* arg) {
+  Py_buffer view;
+  if (PyObject_GetBuffer(arg, &view, PyBUF_SIMPLE) < 0) return NULL;
+  vd_sim_data* d = s->data;
+  state_head h;
+  int32_t sz[4];
+  state_sizes(sz);
+  const char* why = NULL;
+  if ((size_t)view.len < sizeof h) why = "too short";
+  if (!why) {
+    memcpy(&h, view.buf, sizeof h);
+    if (memcmp(h.magic, STATE_MAGIC, 8) || memcmp(h.sizes, sz, sizeof sz)) why = "not a Sim state of this build";
+    else if (h.nnode != d->nnode_all || h.nseg != d->nseg) why = "of another rod model (node or segment counts differ)";
+    else if (h.ncollider < 0 || h.ncollider > VD_SIM_MAX_COLLIDERS || h.ntie < 0 || h.nevent < 0 ||
+             h.nevent > d->nseg)
+      why = "corrupt (counts out of range)";
+    else if (state_walk(d, &h, NULL, 0) != (size_t)view.len) why = "of the wrong length";
+  }
+  // mesh colliders keep this Sim's distance grids: the same meshes must be here
+  const char* buf = view.buf;
+  for (int k = 0; !why && k < h.ncollider; k++) {
+    vd_sim_collider c;
+    size_t at = state_walk(d, &(state_head){.nnode = h.nnode, .nseg = h.nseg, .nevent = h.nevent}, NULL, 0);
+    memcpy(&c, buf + at + (size_t)k * sizeof c, sizeof c);
+    if (c.shape == VD_SIM_MESH && (k >= d->ncollider || !d->collider[k].sdf)) why = "with a mesh collider this Sim lacks";
+  }
+  if (!why && busy_check(s)) {
+    while (d->ntie < h.ntie)  // room for the ties (their values come next)
+      if (vd_sim_add_tie(d, 0, vd_v3(0, 0, 0), 1) < 0) {
+        PyBuffer_Release(&view);
+        return PyErr_NoMemory();
+      }
+    d->ntie = h.ntie, d->ncollider = h.ncollider, d->nevent = h.nevent, d->ncontact = h.ncontact;
+    d->time = h.time, d->max_penetration = h.max_penetration;
+    d->nstep = h.nstep, d->nwarning = h.nwarning;
+    memcpy(d->warning, h.warning, sizeof h.warning);
+    state_walk(d, &h, (char*)view.buf, 0);
+  }
+  PyBuffer_Release(&view);
+  if (why) return vdpy_arg_error("set_state: the state is %s", why);
+  if (PyErr_Occurred()) return NULL;
   Py_RETURN_NONE;
 }
 
@@ -591,12 +729,13 @@ SIM_ARRAY(sim_seg_radius, model, seg_radius, nseg, 1, NPY_DOUBLE, 0)
 SIM_ARRAY(sim_seg_len0, model, seg_len0, nseg, 1, NPY_DOUBLE, 0)
 #undef SIM_ARRAY
 
-// bending stress of each rod segment (Pa), into the Sim's buffer: valid until the next read
+// bending stress of each rod segment (Pa): a new array each read (an earlier one keeps its values)
 static PyObject* sim_stress(vdpy_sim* s, void* c) {
   if (!busy_check(s)) return NULL;
-  if (s->model->nseg) vd_sim_seg_stress(s->model, s->data, s->stress);
   npy_intp dims[1] = {s->model->nseg};
-  return vdpy_view((PyObject*)s, s->stress, 1, dims, NPY_DOUBLE, 0);
+  PyObject* a = PyArray_ZEROS(1, dims, NPY_DOUBLE, 0);
+  if (a && s->model->nseg) vd_sim_seg_stress(s->model, s->data, PyArray_DATA((PyArrayObject*)a));
+  return a;
 }
 
 // the same per plant segment (NaN where no rod segment resamples it): a new array
@@ -696,7 +835,7 @@ static PyGetSetDef sim_getset[] = {
     {"seg_class", (getter)sim_seg_class, NULL, "material class of each rod segment (green 0 ... root 6), int32 (nseg)", NULL},
     {"seg_radius", (getter)sim_seg_radius, NULL, "rod segment radii (m) (nseg)", NULL},
     {"seg_len0", (getter)sim_seg_len0, NULL, "rod segment rest lengths (m) (nseg)", NULL},
-    {"stress", (getter)sim_stress, NULL, "largest bending stress of each rod segment (Pa) (nseg): computed on access", NULL},
+    {"stress", (getter)sim_stress, NULL, "largest bending stress of each rod segment (Pa) (nseg): computed on access, a new array", NULL},
     {"plant_stress", (getter)sim_plant_stress, NULL, "the same per plant segment (NaN where none), a new array", NULL},
     {"events", (getter)sim_events, NULL, "fractures so far: a list of dicts (time, segment, node, label, label_name, instance, class, force, moment, cs, cb, cause)", NULL},
     {"stats", (getter)sim_stats, NULL, "the summary of `verdant sim --stats` (without wall-clock timings)", NULL},
@@ -714,37 +853,58 @@ static PyMemberDef sim_members[] = {
 
 static PyMethodDef sim_methods[] = {
     {"step", (PyCFunction)(void (*)(void))sim_step, METH_VARARGS | METH_KEYWORDS,
+     "step($self, /, n=1)\n--\n\n"
      "step(n=1): advance n time steps of dt without the GIL; raises BadValueError if the state\n"
      "becomes unstable even at dt / 128 (the state is left at the last good substep)."},
     {"settle", (PyCFunction)(void (*)(void))sim_settle, METH_VARARGS | METH_KEYWORDS,
+     "settle($self, /, *, statics=False, ke_tol=1e-9, disp_tol=1e-9, max_time=10, max_steps=400, extra_damping=5)\n--\n\n"
      "settle(*, statics=False, ke_tol=1e-9, disp_tol=1e-9, max_time=10, max_steps=400,\n"
      "extra_damping=5) -> (converged, steps): damped dynamics (or static Newton steps) until still."},
-    {"reset", (PyCFunction)sim_reset, METH_NOARGS, "reset(): back to the modelled shape (colliders and ties kept)."},
+    {"get_state", (PyCFunction)sim_get_state, METH_NOARGS,
+     "get_state($self, /)\n--\n\n"
+     "get_state() -> bytes: the whole rod state (positions, velocities, frames, multipliers,\n"
+     "fractures, colliders, ties, forces, time); set_state() on a Sim of the same plant and options\n"
+     "resumes it exactly (the same future as not stopping). Native byte order."},
+    {"set_state", (PyCFunction)sim_set_state, METH_O,
+     "set_state($self, state, /)\n--\n\n"
+     "set_state(state): restore a state of get_state() (ArgumentError naming what does not match)."},
+    {"reset", (PyCFunction)sim_reset, METH_NOARGS,
+     "reset($self, /)\n--\n\n"
+     "reset(): back to the modelled shape (colliders and ties kept)."},
     {"set", (PyCFunction)(void (*)(void))sim_set, METH_VARARGS | METH_KEYWORDS,
+     "set($self, /, **options)\n--\n\n"
      "set(**options): change run options between steps (dt, iterations, solver, gravity, wind,\n"
      "gust, wind_series, drag, stokes, damping, mass_damping, fracture, contacts, friction,\n"
      "self_collision)."},
     {"add_collider", (PyCFunction)(void (*)(void))sim_add_collider, METH_VARARGS | METH_KEYWORDS,
+     "add_collider($self, /, shape, size=None, pos=(0,0,0), quat=(1,0,0,0))\n--\n\n"
      "add_collider(shape, size=None, pos=(0,0,0), quat=(1,0,0,0)) -> index: 'plane' (the half-space\n"
      "below z of quat through pos), 'sphere' (size r), 'capsule' (r, half length), 'box' (half sizes)."},
     {"add_mesh_collider", (PyCFunction)(void (*)(void))sim_add_mesh_collider, METH_VARARGS | METH_KEYWORDS,
+     "add_mesh_collider($self, /, vertices, triangles, pos=(0,0,0), quat=(1,0,0,0), cell=None)\n--\n\n"
      "add_mesh_collider(vertices, triangles, pos=(0,0,0), quat=(1,0,0,0), cell=None) -> index: a\n"
      "closed, counter-clockwise triangle mesh through its signed distance grid (cell m)."},
     {"move_collider", (PyCFunction)(void (*)(void))sim_move_collider, METH_VARARGS | METH_KEYWORDS,
+     "move_collider($self, /, index, pos, quat=None)\n--\n\n"
      "move_collider(index, pos, quat=None): a new pose for the next step; its velocity becomes the\n"
      "move over dt (a kinematic probe)."},
     {"find_organ", (PyCFunction)(void (*)(void))sim_find_organ, METH_VARARGS | METH_KEYWORDS,
+     "find_organ($self, /, organ, instance=0)\n--\n\n"
      "find_organ(organ, instance=0) -> node: the rod node of an organ (label or organ name; a\n"
      "fruit's centre; instance 0: the first)."},
     {"apply_force", (PyCFunction)(void (*)(void))sim_apply_force, METH_VARARGS | METH_KEYWORDS,
+     "apply_force($self, /, node_or_organ, force, instance=0)\n--\n\n"
      "apply_force(node_or_organ, force, instance=0) -> node: set the external force (N) on a node\n"
      "(kept until changed)."},
     {"add_tie", (PyCFunction)(void (*)(void))sim_add_tie, METH_VARARGS | METH_KEYWORDS,
+     "add_tie($self, /, node_or_organ, target=None, compliance=1e-5, instance=0)\n--\n\n"
      "add_tie(node_or_organ, target=None, compliance=1e-5, instance=0) -> index: a spring (m/N)\n"
      "pulling a node toward target (default: where it is)."},
     {"move_tie", (PyCFunction)(void (*)(void))sim_move_tie, METH_VARARGS | METH_KEYWORDS,
+     "move_tie($self, /, index, target)\n--\n\n"
      "move_tie(index, target): move a tie's target (m)."},
     {"plant", (PyCFunction)sim_plant, METH_NOARGS,
+     "plant($self, /)\n--\n\n"
      "plant() -> Plant: the deformed plant (the same as `verdant sim --final`)."},
     {NULL, NULL, 0, NULL},
 };
@@ -754,7 +914,7 @@ PyTypeObject vdpy_sim_type = {
     .tp_basicsize = sizeof(vdpy_sim),
     .tp_dealloc = (destructor)sim_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_BASETYPE,
-    .tp_doc = "Sim(plant, **options): a plant as Cosserat rods (see verdant.Sim).",
+    .tp_doc = "Sim(plant, **options)\n--\n\nSim(plant, **options): a plant as Cosserat rods (see verdant.Sim).",
     .tp_methods = sim_methods,
     .tp_members = sim_members,
     .tp_getset = sim_getset,

@@ -144,10 +144,11 @@ def test_not_constructible_or_picklable(tomato):
     import pickle
     with pytest.raises(TypeError):
         verdant.Plant()
+    # plants and clouds pickle (test_state.py); a Sim and a Renderer do not
     with pytest.raises(TypeError):
-        pickle.dumps(tomato)
-    with pytest.raises(TypeError):
-        pickle.dumps(tomato.cloud(points=10))
+        pickle.dumps(verdant.Sim(tomato))
+    with pytest.raises(verdant.ArgumentError):
+        verdant._verdant._cloud_unpickle(b"junk", {})
     with pytest.raises(TypeError):
         tomato.cloud(100)
     with pytest.raises(TypeError):

@@ -19,6 +19,7 @@ QUICK = {
     "torch_dataset.py": ["--steps", "3", "--points", "512"],
     "parallel_plants.py": ["--count", "2", "--steps", "30"],
     "harvest_env.py": ["--episodes", "1"],
+    "train_pick.py": ["--iterations", "2", "--population", "4", "--steps", "60"],
 }
 
 

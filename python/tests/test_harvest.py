@@ -97,12 +97,24 @@ def test_scripted_run_equals_cli(cli):
 def test_wrist_camera_observations():
     env = verdant.HarvestEnv(MINI, image=True, masks=True, cloud=True, image_size=(64, 48),
                              cloud_points=500, render_mode="rgb_array")
-    obs, _ = env.reset(seed=1)
+    obs, info = env.reset(seed=1)
     assert env.observation_space.contains(obs)
     assert obs["rgb"].shape == (48, 64, 3) and obs["depth"].shape == (48, 64)
     plant_labels = set(env._h.plant().label_names) | {0, 65535}
     assert set(np.unique(obs["label"])) <= plant_labels
     assert obs["cloud_xyz"].shape == (500, 3) and set(np.unique(obs["cloud_label"])) <= plant_labels
+    assert obs["cloud_instance"].shape == (500,)
+    assert set(np.unique(obs["cloud_instance"])) <= set(env._h.plant().instances) | set(
+        env._h.plant().sphere_instances) | set(env._h.plant().mesh_instances)
+    # the camera with the picture: the target's pixels project where K and the pose put them
+    K, pose = obs["camera_K"], obs["camera_pose"]
+    assert K.shape == (3, 3) and pose.shape == (4, 4) and 0 <= obs["target_visible"][0] <= 1
+    ys, xs = np.nonzero(obs["instance"] == info["target_instance"])
+    if len(xs):
+        p = np.linalg.inv(pose) @ np.r_[obs["fruit_pos"], 1.0]
+        u, v = (K @ (p[:3] / p[2]))[:2]
+        assert abs(u - xs.mean()) < 8 and abs(v - ys.mean()) < 8
+        assert obs["target_visible"][0] > 0
     obs, *_ = env.step(np.zeros(7, np.float32))
     assert obs["rgb"].dtype == np.uint8
     assert env.render().shape == (240, 320, 3)

@@ -47,7 +47,7 @@ __version__ = _verdant.version
 
 __all__ = [
     "grow", "load", "read_cloud", "read_png", "render", "Plant", "Mesh", "Cloud", "Sim",
-    "Renderer", "HarvestEnv",
+    "Renderer", "HarvestEnv", "VectorHarvestEnv",
     "Error", "ParseError", "UnsupportedError", "UndefinedNameError", "WrongTypeError",
     "BadValueError", "ModelAssertionError", "LimitError", "FileError", "FormatError",
     "OutOfMemoryError", "ArgumentError",
@@ -62,6 +62,26 @@ def _label_colors(table, ids):
     uniq, inv = np.unique(np.asarray(ids), return_inverse=True)
     rgb = np.array([lut.get(int(u), (0.6, 0.6, 0.6)) for u in uniq], dtype=np.float64)
     return rgb.reshape(-1, 3)[inv] if len(uniq) else np.zeros((0, 3))
+
+
+def _through_file(name, write, read):
+    """write(path) into a private temporary folder, then read(path): pickling by file formats."""
+    import os
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="verdant-pickle-") as d:
+        path = os.path.join(d, name)
+        write(path)
+        return read(path)
+
+
+def _unpickle_plant(text, seed):
+    return _verdant.grow(text, seed=seed)
+
+
+def _read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
 
 
 def _open3d():
@@ -153,6 +173,11 @@ class Plant(_verdant.Plant):
             "bbox_min": list(geo["bbox_min"]), "bbox_max": list(geo["bbox_max"]),
             "total_length": geo["total_length"],
         }
+
+    def __reduce__(self):
+        """Pickled as its plant JSON (exact: the file format keeps every number) and seed."""
+        text = _through_file("plant.json", self.save, _read_bytes).decode("utf-8")
+        return (_unpickle_plant, (text, self.seed))
 
     def to_open3d(self, slices=None):
         """The plant's labelled mesh as an open3d.geometry.TriangleMesh coloured by label."""
@@ -265,6 +290,9 @@ class Renderer(_verdant.Renderer):
 
 
 _local = __import__("threading").local()
+# renderers verdant.render keeps per thread, one per settings (size, ...), least recently used
+# dropped first
+RENDERER_CACHE = 4
 
 
 def _geoms_needed(objects):
@@ -298,8 +326,9 @@ def render(objects, *, camera="orbit", azimuth=-60, elevation=20, eye=None, look
     scene; or eye and lookat (m) with up and fov (degrees). color_by: 'label', 'instance',
     'stress' (a Sim), 'displacement'; range (min, max) of its scale (Pa or m). point_size:
     splat half-size of cloud points (m). robot: an MJCF file drawn at its reference pose or at
-    robot_qpos. A renderer with these settings is kept per thread and reused (renderer= gives
-    your own). Raises UnsupportedError where no OpenGL context can be made.
+    robot_qpos. A renderer with these settings is kept per thread and reused, at most
+    RENDERER_CACHE (4) per thread, the least recently used dropped (renderer= gives your own).
+    Raises UnsupportedError where no OpenGL context can be made.
     """
     objs = list(objects) if isinstance(objects, (list, tuple)) else [objects]
     if renderer is None:
@@ -307,14 +336,15 @@ def render(objects, *, camera="orbit", azimuth=-60, elevation=20, eye=None, look
                None if robot is None else str(robot))
         cache = getattr(_local, "renderers", None)
         if cache is None:
-            cache = _local.renderers = {}
+            cache = _local.renderers = __import__("collections").OrderedDict()
         need = _geoms_needed(objs)
-        renderer = cache.get(key)
+        renderer = cache.pop(key, None)
         if renderer is None or renderer.max_geoms < need:
-            cache.pop(key, None)
             renderer = Renderer(size=size, supersample=supersample, shadows=shadows, floor=floor,
                                 sky=sky, legend=legend, robot=robot, max_geoms=max(need, 20000))
-            cache[key] = renderer
+        cache[key] = renderer                   # the most recently used last
+        while len(cache) > RENDERER_CACHE:      # the least recently used goes (and its memory)
+            cache.popitem(last=False)
     return renderer.draw(objs, camera=camera, azimuth=azimuth, elevation=elevation, eye=eye,
                          lookat=lookat, up=up, fov=fov, color_by=color_by, range=range,
                          point_size=point_size, depth=depth, masks=masks, robot_qpos=robot_qpos)
@@ -323,6 +353,7 @@ def render(objects, *, camera="orbit", azimuth=-60, elevation=20, eye=None, look
 _verdant._register(plant=Plant, mesh=Mesh, cloud=Cloud)
 
 from .env import HarvestEnv  # noqa: E402  (needs Plant and Renderer above)
+from .vector import VectorHarvestEnv  # noqa: E402
 
 
 def grow(source, *, seed=0, steps=None, set=None, labels=None, max_modules=None, max_ops=None,

@@ -11,6 +11,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+// the process's output guard (vd_outfile_set_guard), unset: plain atomic files
+static vd_outfile_guard guard;
+static int guard_set;
+
+void vd_outfile_set_guard(const vd_outfile_guard* g) {
+  guard_set = g != NULL;
+  if (g) guard = *g;
+}
+
 void vd_outfile_tmp_path(const char* path, char* buf, size_t cap) {
   snprintf(buf, cap, "%s.tmp.%ld", path, (long)getpid());
 }
@@ -22,9 +31,18 @@ vd_status vd_outfile_open(vd_outfile* f, const char* path, vd_error* err) {
     return vd_error_set(err, VD_ERR_ARG, path, 0, 0, "output path too long");
   snprintf(f->path, sizeof f->path, "%s", path);
   vd_outfile_tmp_path(path, f->tmp, sizeof f->tmp);
+  // the guard sees the output before its first byte (and may refuse it)
+  if (guard_set && guard.open) {
+    vd_status st = guard.open(guard.user, f->path, f->tmp, err);
+    if (st) {
+      f->tmp[0] = 0;
+      return st;
+    }
+  }
   f->fp = fopen(f->tmp, "wb");
   if (!f->fp) {
     int e = errno;
+    if (guard_set && guard.abort) guard.abort(guard.user, f->path, f->tmp);
     f->tmp[0] = 0;
     return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot write: %s", strerror(e));
   }
@@ -39,9 +57,15 @@ vd_status vd_outfile_commit(vd_outfile* f, vd_error* err) {
   if (fclose(f->fp) != 0) bad = 1, e = errno;
   f->fp = NULL;
   if (bad) {
-    remove(f->tmp);
-    f->tmp[0] = 0;
+    vd_outfile_abort(f);
     return vd_error_set(err, VD_ERR_IO, f->path, 0, 0, "write failed: %s", strerror(e));
+  }
+  // a guard puts the file in place when the whole program succeeded
+  if (guard_set && guard.commit) {
+    vd_status st = guard.commit(guard.user, f->path, f->tmp, err);
+    if (st) vd_outfile_abort(f);
+    f->tmp[0] = 0;
+    return st;
   }
   if (rename(f->tmp, f->path) != 0) {
     e = errno;
@@ -56,8 +80,21 @@ vd_status vd_outfile_commit(vd_outfile* f, vd_error* err) {
 void vd_outfile_abort(vd_outfile* f) {
   if (f->fp) fclose(f->fp);
   f->fp = NULL;
-  if (f->tmp[0]) remove(f->tmp);
+  if (f->tmp[0]) {
+    remove(f->tmp);
+    if (guard_set && guard.abort) guard.abort(guard.user, f->path, f->tmp);
+  }
   f->tmp[0] = 0;
+}
+
+vd_status vd_outdir_make(const char* path, vd_error* err) {
+  if (guard_set && guard.mkdir) return guard.mkdir(guard.user, path, err);
+  if (mkdir(path, 0777) != 0 && errno != EEXIST)
+    return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot create the folder: %s", strerror(errno));
+  struct stat sb;
+  if (stat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
+    return vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot create the folder: a file of that name is there");
+  return VD_OK;
 }
 
 vd_status vd_file_read(const char* path, char** text, size_t* len, vd_error* err) {
@@ -129,4 +166,19 @@ int vd_text_line(vd_text* t, const char** ls, size_t* ll) {
   *ls = start;
   *ll = n && start[n - 1] == '\r' ? n - 1 : n;
   return 1;
+}
+
+void vd_outfile_remove(const char* path) {
+  if (!guard_set) {
+    remove(path);
+    return;
+  }
+  char tmp[4200];
+  vd_outfile_tmp_path(path, tmp, sizeof tmp);
+  remove(tmp);
+  if (guard.abort) guard.abort(guard.user, path, tmp);
+}
+
+void vd_outdir_remove(const char* path) {
+  if (!guard_set) rmdir(path);  // only when empty
 }

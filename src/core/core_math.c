@@ -85,3 +85,11 @@ vd_quat vd_quat_from_axes(vd_vec3 x, vd_vec3 y, vd_vec3 z) {
   }
   return vd_quat_normalize(q);
 }
+
+double vd_quantile_sorted(const double* x, int n, double q) {
+  double h = (n - 1) * q;
+  int i = (int)floor(h);
+  if (i < 0) return x[0];
+  if (i >= n - 1) return x[n - 1];
+  return x[i] + (h - i) * (x[i + 1] - x[i]);
+}

@@ -224,10 +224,13 @@ void vd_growth_def_paper(vd_growth_def* d) {
   d->opt.integrator = VD_MSS_EQ3;
   d->opt.wind_model = VD_MSS_WIND_PAPER;
   d->opt.drag = VD_MSS_DRAG_STOKES;
+  d->opt.drag_cd = 1;  // sec. 3.3: C_drag set to 1 (Suzuki and Arikawa 2010)
   d->opt.strain_limit = 0;
   d->opt.rigid_release = 0;
   d->paper_eq8 = 1;
   d->stress_free = 0;
+  d->paper_masses = 1;
+  d->paper_rigid = 1;
 }
 
 static void free_nodes(vd_growth* g) {
@@ -408,6 +411,18 @@ static vd_status build_rods(vd_growth* g, vd_error* err) {
   free_physics(g);
   const vd_growth_def* def = &g->def;
   vd_sim_def rdef = def->rods;
+  // one wood for every model: the rods' green stems, wood and roots take the mass-spring
+  // settings' moduli, densities and drag coefficient (species presets included), issue 26
+  // defect 4; their strength is read at breaking (rods_breaking)
+  rdef.material[VD_SIM_GREEN].young = def->mss.young_green;
+  rdef.material[VD_SIM_GREEN].density = def->mss.density_green;
+  int woody_class[2] = {VD_SIM_WOOD, VD_SIM_ROOT};
+  for (int k = 0; k < 2; k++) {
+    rdef.material[woody_class[k]].young = def->mss.young_wood;
+    rdef.material[woody_class[k]].density = def->mss.density_wood;
+  }
+  int stem_class[3] = {VD_SIM_GREEN, VD_SIM_WOOD, VD_SIM_ROOT};
+  for (int k = 0; k < 3; k++) rdef.material[stem_class[k]].drag_cd = def->opt.drag_cd;
   int soil = def->mss.soil.method != VD_SOIL_CLAMP;
   if (soil) rdef.clamp_roots = 0;
   if (g->plant->nseg == 0) return VD_OK;  // nothing to simulate yet (an axiom that draws nothing)
@@ -470,6 +485,25 @@ static void note_momentum(vd_growth* g, vd_vec3 before, vd_vec3 after, double sc
   double e = vd_norm(vd_sub(after, before)) / fmax(scale, 1e-300);
   if (scale <= 0) e = vd_norm(vd_sub(after, before)) > 0 ? INFINITY : 0;
   if (e > g->momentum_error) g->momentum_error = e;
+}
+
+// every node takes the mass of its model now (internode volume x density, leaves and organs),
+// its momentum kept (v = m_old v_old / m_new); the rigid body keeps p and its angular momentum
+static void mass_update(vd_growth* g) {
+  vd_mss_model* m = g->mm;
+  vd_mss_data* d = g->md;
+  vd_vec3 p0 = vd_mss_momentum(m, d);
+  double sc = mss_scale(m, d);
+  int any_rigid = 0;
+  for (int k = 0; k < m->nnode; k++) {
+    if (d->removed[k]) continue;
+    double mn = m->node_mass[k];
+    if (!d->rigid[k] && !(m->node_flags[k] & VD_MSS_FIXED)) d->vel[k] = vd_scale(d->vel[k], d->mass[k] / mn);
+    any_rigid |= d->rigid[k];
+    d->mass[k] = mn;
+  }
+  if (any_rigid) vd_mss_rigid_update(m, d);
+  note_momentum(g, p0, vd_mss_momentum(m, d), fmax(sc, mss_scale(m, d)));
 }
 
 // the mass-spring state from the carried one: positions, velocities (eq. 1 for new nodes),
@@ -544,12 +578,20 @@ static vd_status map_mss(vd_growth* g, int grown, vd_error* err) {
   }
   vd_vec3 p1 = vd_mss_momentum(m, d);
   note_momentum(g, p0, p1, fmax(scale0, mss_scale(m, d)));
+  // the masses of this year from the first substep: new nodes, this year's leaves and the
+  // wood laid down (the seed's own rule keeps last year's until the end of the step)
+  if (!g->def.paper_masses) mass_update(g);
   // nodes that hardened join the rigid body (Algorithm 2)
   if (g->def.model == VD_GROWTH_MRL) {
     unsigned char* join = (unsigned char*)d->held;  // scratch, cleared by the next substep
     int any = 0;
     for (int k = 0; k < nn; k++) {
-      join[k] = !d->rigid[k] && m->node_age[k] >= m->rigid_age;
+      // the hardened wood above the ground: roots stay with the soil that holds each of them up
+      // to its own resistance, clamped nodes and a held root crown are the ground's (the body
+      // turns about them), issue 26 defects 2 and 5
+      // (paper_rigid: the seed's, every node old enough, held while its soil or clamp holds)
+      unsigned ground = g->def.paper_rigid ? 0u : VD_MSS_ROOT | VD_MSS_FIXED | VD_MSS_SOIL | VD_MSS_CROWN;
+      join[k] = !d->rigid[k] && !d->removed[k] && !(m->node_flags[k] & ground) && m->node_age[k] >= m->rigid_age;
       any |= join[k];
     }
     if (any) {
@@ -988,6 +1030,7 @@ static void collect_events(vd_growth* g) {
 
 // rods: internodes whose bending stress exceeds the modulus of rupture break at the end of the step
 static void rods_breaking(vd_growth* g) {
+  if (!g->def.opt.breaking) return;
   const vd_model* p = g->plant;
   double* st = vd_malloc(sizeof(double) * (size_t)(p->nseg ? p->nseg : 1));
   if (!st) return;
@@ -1025,18 +1068,7 @@ static void rods_breaking(vd_growth* g) {
 static vd_status end_mss(vd_growth* g, vd_error* err) {
   vd_mss_model* m = g->mm;
   vd_mss_data* d = g->md;
-  vd_vec3 p0 = vd_mss_momentum(m, d);
-  double sc = mss_scale(m, d);
-  int any_rigid = 0;
-  for (int k = 0; k < m->nnode; k++) {
-    if (d->removed[k]) continue;
-    double mn = m->node_mass[k];
-    if (!d->rigid[k] && !(m->node_flags[k] & VD_MSS_FIXED)) d->vel[k] = vd_scale(d->vel[k], d->mass[k] / mn);
-    any_rigid |= d->rigid[k];
-    d->mass[k] = mn;
-  }
-  if (any_rigid) vd_mss_rigid_update(m, d);
-  note_momentum(g, p0, vd_mss_momentum(m, d), fmax(sc, mss_scale(m, d)));
+  mass_update(g);
   if (m->opt.gravitropism == VD_MSS_GRAVI_BASTIEN) {
     vd_vec3* rest = vd_malloc(sizeof(vd_vec3) * (size_t)(m->nnode ? m->nnode : 1));
     vd_vec3* old = vd_malloc(sizeof(vd_vec3) * (size_t)(g->spec->nnode ? g->spec->nnode : 1));

@@ -109,6 +109,54 @@ static void case_momentum(gv* v) {
   }
 }
 
+// A straight stem grown in one age step (40 internodes, 1 m, radius 1 cm, green wood: E 1 GPa,
+// 1000 kg/m^3), clamped at its base. Sideways gravity makes it a horizontal cantilever under its
+// own weight q = rho pi r^2 g: tip sag q L^4 / (8 E I) and clamp stress (q L^2 / 2) r / I
+// (Euler-Bernoulli); a uniform wind on its projected area w = rho_air C_d r u^2 gives the clamp
+// stress (w L^2 / 2) r / I. The masses it carries in its first year are those it has (the seed
+// keeps new nodes at the smallest mass for the whole age step: 1.3 % of the sag).
+static const char stem_lpy[] =
+    "N = 40\nL = 1.0\nR = 0.01\nLABELS = {1: \"trunk\"}\nmodule A, I\nAxiom: SetWidth(R) A\n"
+    "derivation length: 1\nproduction:\nA :\n    for k in range(N):\n        nproduce I(L / N)\n    produce\n"
+    "interpretation:\nI(l) --> SetAge(0) ;(1) F(l, R)\nendlsystem\n";
+
+static void case_grown_stem(gv* v) {
+  if (!want(v, "growth_stem_self_weight growth_stem_wind")) return;
+  vd_lsystem* ls = NULL;
+  vd_error e = {0};
+  if (vd_lsys_parse(stem_lpy, strlen(stem_lpy), "stem.lpy", &ls, &e)) {
+    v->st = vd_error_set(v->err, e.status ? e.status : VD_ERR_VALUE, "", 0, 0, "validate: the stem: %s", e.msg);
+    return;
+  }
+  const double len = 1, r = 0.01, g = 9.81, u = 10;
+  vd_growth_def d = vd_growth_def_default();
+  d.model = VD_GROWTH_MSS;
+  d.substeps = 500;
+  d.opt.breaking = 0;
+  double ei = d.mss.young_green * VD_PI * r * r * r * r / 4, in = VD_PI * r * r * r * r / 4;
+  d.opt.gravity = vd_v3(g, 0, 0);
+  result a = grow_on(ls, &d, 1);
+  double q = d.mss.density_green * VD_PI * r * r * g;
+  int ok = 1;
+  ok &= vd_validate_add(&v->list, "growth_stem_self_weight", "continuum", "tip sag (m)", a.ok ? a.s.tip_displacement : NAN,
+                        q * pow(len, 4) / (8 * ei), 0.05, 0,
+                        "straight stem grown sideways in 1 year, 40 internodes, 500 substeps: q L^4 / (8 E I) (mass "
+                        "lumped at internode ends, ~1/N)");
+  ok &= vd_validate_add(&v->list, "growth_stem_self_weight", "continuum", "clamp stress (Pa)", a.ok ? a.s.max_stress : NAN,
+                        q * len * len / 2 * r / in, 0.05, 0, "the same: (q L^2 / 2) r / I");
+  d.opt.gravity = vd_v3(0, 0, 0);
+  d.opt.wind = vd_v3(u, 0, 0);
+  result b = grow_on(ls, &d, 1);
+  double w = 0.5 * d.opt.air_density * d.opt.drag_cd * 2 * r * u * u;
+  ok &= vd_validate_add(&v->list, "growth_stem_wind", "continuum", "clamp stress (Pa)", b.ok ? b.s.max_stress : NAN,
+                        w * len * len / 2 * r / in, 0.02, 0,
+                        "the stem upright in a uniform 10 m/s wind, C_d 1.2 on 2 r l: (w L^2 / 2) r / I");
+  ok &= vd_validate_add(&v->list, "growth_stem_wind", "continuum", "tip deflection (m)", b.ok ? b.s.tip_displacement : NAN,
+                        w * pow(len, 4) / (8 * ei), 0.02, 0, "the same: w L^4 / (8 E I)");
+  if (!ok) v->st = vd_error_set(v->err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
+  vd_lsys_destroy(ls);
+}
+
 // seed sec. 4.1: MRL-Tree markedly more rigid than ML-Tree under gravity
 static void case_stiffer(gv* v) {
   const char* name = "finding_mrl_stiffer";
@@ -329,7 +377,7 @@ vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** ou
   *out = NULL;
   *n = 0;
   int any = 0;
-  const char* names[] = {"growth_momentum", "finding_mrl_stiffer", "improved_rods_sag", "improved_rods_standing",
+  const char* names[] = {"growth_momentum", "growth_stem_self_weight", "growth_stem_wind", "finding_mrl_stiffer", "improved_rods_sag", "improved_rods_standing",
                          "finding_phototropism", "finding_gravitropism", "finding_tropisms",
                          "finding_eq3_wider_than_eq4", "improved_wind", "improved_anchorage_loam",
                          "improved_anchorage_weak", "finding_soil_methods",
@@ -340,6 +388,7 @@ vd_status vd_growth_validate(const vd_validate_def* def, vd_validate_result** ou
   vd_status st = vd_lsys_parse(growth_tree_lpy, strlen(growth_tree_lpy), "data/tree.lpy", &v.ls, err);
   if (st) return st;
   case_momentum(&v);
+  case_grown_stem(&v);
   if (def->full) {
     case_stiffer(&v);
     case_tropisms(&v);

@@ -75,6 +75,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
 void vd_lsys_destroy(vd_lsystem* ls) {
   if (!ls) return;
   lsys_py_free(ls);
+  vd_free(ls->auto_text, ls->auto_text ? ls->auto_len + 1 : 0);
   for (int i = 0; i < ls->syms.n; i++) vd_free(ls->syms.name[i], strlen(ls->syms.name[i]) + 1);
   vd_free(ls->syms.name, (size_t)ls->syms.cap * sizeof(char*));
   vd_free(ls->syms.declared, (size_t)ls->syms.cap_declared);

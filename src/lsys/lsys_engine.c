@@ -76,7 +76,12 @@ vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name, v
   vd_error nerr = {0};
   vd_status st = lsys_parse_with(text, len, name, VD_LSYS_NATIVE, out, &nerr);
   const char* missing = NULL;
-  if (st == VD_OK && native_names_resolved(*out, &missing) && native_hooks(*out, &missing)) return VD_OK;
+  if (st == VD_OK && native_names_resolved(*out, &missing) && native_hooks(*out, &missing)) {
+    // kept for vd_lsys_fallback: what native refuses only when it runs goes to CPython
+    (*out)->auto_text = vd_malloc(len + 1);
+    if ((*out)->auto_text) memcpy((*out)->auto_text, text, len), (*out)->auto_text[len] = 0, (*out)->auto_len = len;
+    return VD_OK;
+  }
   if (st == VD_OK) {
     vd_lsys_destroy(*out);
     *out = NULL;
@@ -97,6 +102,23 @@ vd_status vd_lsys_parse_engine(const char* text, size_t len, const char* name, v
     return st;
   }
   return lsys_parse_with(text, len, name, VD_LSYS_PYTHON, out, err);
+}
+
+int vd_lsys_axiom_line(const vd_lsystem* ls) {
+  return ls->axiom_line;
+}
+
+int vd_lsys_fallback(vd_lsystem** ls, vd_status st) {
+  vd_lsystem* old = *ls;
+  if (!old || !old->auto_text || (st != VD_ERR_UNSUPPORTED && st != VD_ERR_TYPE)) return 0;
+  char why[200];
+  if (!vd_lsys_python_available(why, sizeof why)) return 0;
+  vd_lsystem* py = NULL;
+  vd_error e = {0};
+  if (lsys_parse_with(old->auto_text, old->auto_len, old->file, VD_LSYS_PYTHON, &py, &e)) return 0;
+  vd_lsys_destroy(old);
+  *ls = py;
+  return 1;
 }
 
 vd_status vd_lsys_parse(const char* text, size_t len, const char* name, vd_lsystem** out, vd_error* err) {

@@ -289,6 +289,9 @@ struct vd_lsystem {  // NOLINT(clang-analyzer-optin.performance.Padding): fields
   stmt* axiom_body;        // functional axiom (or NULL)
   int axiom_nlocal;
   int engine;              // VD_LSYS_NATIVE or VD_LSYS_PYTHON
+  int axiom_line;          // line of the Axiom: keyword (0: the file has none)
+  char* auto_text;         // the file's text when VD_LSYS_AUTO chose native (vd_lsys_fallback), else NULL
+  size_t auto_len;
   expr* derivation_length; // NULL = 1
   expr* max_depth_expr[SEC_COUNT];  // `maximum depth:` of decomposition / interpretation (NULL = 1)
   int max_depth[SEC_COUNT];  // its value in this run

@@ -2742,6 +2742,7 @@ vd_status lsys_parse_file(vd_lsystem* ls, const char* text, size_t len) {
     int a;
     // keyword lines
     if (starts_kw_colon(ln, "Axiom", &a) || starts_kw_colon(ln, "axiom", &a)) {
+      ls->axiom_line = ln->lineno;
       if (ls->engine == VD_LSYS_PYTHON) {
         tmpl* t = NULL;
         if (!rest_blank(ln, a) && !(t = parse_tmpl(ls, NULL, ln->s, ln->len, a, ln->lineno, ln->col0))) goto fail;

@@ -605,7 +605,8 @@ vd_mss_data* vd_mss_data_create(const vd_mss_model* m) {
   size_t o_wv = lay(&L, sizeof(vd_vec3) * n1 * 14), o_pre = lay(&L, sizeof(double) * 9 * n1),
          o_cd = lay(&L, sizeof(double) * n1), o_ks = lay(&L, sizeof(double) * n1), o_sc = lay(&L, sizeof(double) * s1),
          o_con = lay(&L, n1), o_elim = lay(&L, sizeof(int) * n1 * 3), o_link = lay(&L, sizeof(int) * n1 * MSS_LINKS),
-         o_lblk = lay(&L, sizeof(double) * n1 * MSS_LINKS * 9), o_diag = lay(&L, sizeof(double) * n1 * 9);
+         o_lblk = lay(&L, sizeof(double) * n1 * MSS_LINKS * 9), o_diag = lay(&L, sizeof(double) * n1 * 9),
+         o_as = lay(&L, sizeof(int) * s1), o_ah = lay(&L, sizeof(int) * (size_t)(m->nhinge ? m->nhinge : 1));
   char* blk = vd_calloc(1, L.n);
   if (!blk) return NULL;
   vd_mss_data* d = (vd_mss_data*)(blk + o_d);
@@ -627,6 +628,7 @@ vd_mss_data* vd_mss_data_create(const vd_mss_model* m) {
   w->spring_c = (double*)(blk + o_sc), w->con = (unsigned char*)(blk + o_con);
   w->elim = (int*)(blk + o_elim), w->epos = w->elim + n1, w->nlink = w->epos + n1;
   w->link = (int*)(blk + o_link), w->lblk = (double*)(blk + o_lblk), w->diag = (double*)(blk + o_diag);
+  w->anchor_spring = (int*)(blk + o_as), w->anchor_hinge = (int*)(blk + o_ah);
   w->direct = direct_symbolic(m, w);
   d->work = w;
   d->work_bytes = 0;
@@ -1174,10 +1176,66 @@ static void rigid_wrench(const vd_mss_model* m, const vd_mss_data* d, const mss_
   }
 }
 
+// The ground the rigid body grows from: the one node outside it, clamped or a held root crown,
+// that its members grow from; with the couplings to the outside nodes. 0 when there is none (or
+// more than one: the body is then held).
+static int find_anchor(const vd_mss_model* m, vd_mss_data* d, mss_work* w, mss_anchor* an, int* several) {
+  const vd_rigid* b = &d->rb;
+  int pivot = -1, first = -1;
+  *several = 0;
+  for (int i = 0; i < m->nnode; i++) {
+    int par = m->node_parent[i];
+    if (!d->rigid[i] || d->removed[i] || par < 0 || d->rigid[par] || d->removed[par]) continue;
+    if (!((m->node_flags[par] & VD_MSS_FIXED) || (par == m->crown && mss_crown_held(m, d)))) continue;
+    if (pivot >= 0 && par != pivot) *several = 1;
+    if (pivot < 0) pivot = par, first = i;
+  }
+  if (pivot < 0 || *several) return 0;
+  memset(an, 0, sizeof *an);
+  an->node = pivot;
+  an->pivot = d->pos[pivot];
+  double r[9], rt[9];
+  m3_from_quat(r, b->q);
+  m3_transpose(rt, r);
+  an->pivot_body = m3_mul_v(rt, vd_sub(an->pivot, b->x));
+  an->axis_body = vd_normalize(vd_sub(d->body[first], an->pivot_body));
+  an->spring = w->anchor_spring, an->hinge = w->anchor_hinge;
+  for (int s = 0; s < m->nspring; s++) {
+    int i = m->spring_node[2 * s], j = m->spring_node[2 * s + 1];
+    if (d->spring_broken[s] || d->removed[i] || d->removed[j] || d->rigid[i] == d->rigid[j]) continue;
+    an->spring[an->nspring++] = s;
+    vd_vec3 arm = vd_sub(d->pos[d->rigid[i] ? i : j], an->pivot);
+    an->stiffness += m->spring_k[s] * vd_dot(arm, arm);
+  }
+  for (int h = 0; h < m->nhinge; h++) {
+    const int* hn = m->hinge_node + 3 * h;
+    if (!mss_hinge_on(m, d, h) || (hn[0] >= 0 && d->removed[hn[0]]) || d->removed[hn[1]] || d->removed[hn[2]]) continue;
+    int in = d->rigid[hn[1]] + d->rigid[hn[2]] + (hn[0] >= 0 && d->rigid[hn[0]]);
+    int out = !d->rigid[hn[1]] + !d->rigid[hn[2]] + (hn[0] >= 0 && !d->rigid[hn[0]]);
+    if (!in || !out) continue;
+    an->hinge[an->nhinge++] = h;
+    an->stiffness += m->hinge_k[h];
+    if (hn[1] == pivot) an->hinge_k += m->hinge_k[h];
+  }
+  return 1;
+}
+
 // rigid part of a substep (Algorithm 2: before the springs); returns 1 when the soil held it
 static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
   vd_rigid* b = &d->rb;
   vd_vec3 f, tau;
+  // a body grown from one clamped or held node turns about it (RK4, quaternions), driven by its
+  // loads and its springs and hinges to the nodes outside it (issue 26 defect 2)
+  mss_anchor an;
+  int several = 0;
+  if (find_anchor(m, d, w, &an, &several)) {
+    vd_vec3 tl = vd_v3(0, 0, 0);
+    for (int i = 0; i < m->nnode; i++)
+      if (d->rigid[i] && !d->removed[i]) tl = vd_add(tl, vd_cross(vd_sub(d->pos[i], an.pivot), d->fext[i]));
+    mss_rigid_pinned_step(m, d, &an, tl, m->opt.dt);
+    mss_rigid_sync(m, d);
+    return 0;
+  }
   rigid_wrench(m, d, w, &f, &tau);
   // a clamped member holds the body; soil members hold it while their capacity suffices (all of
   // it when the soil model is off)
@@ -1186,6 +1244,7 @@ static int rigid_substep(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
   for (int i = 0; i < m->nnode; i++) {
     if (!d->rigid[i] || d->removed[i]) continue;
     if ((m->node_flags[i] & VD_MSS_FIXED) || (i == m->crown && mss_crown_held(m, d))) clamped = 1;
+    if (several) clamped = 1;  // grown from several held nodes: held by them
     if (m->node_flags[i] & VD_MSS_SOIL) {
       double fm = m->node_soil[i];
       soil_members = 1;

@@ -107,15 +107,21 @@ void mss_external(const vd_mss_model* m, vd_mss_data* d, mss_work* w) {
 // hinge force: the moment k theta that turns arm b->c back to its rest angle with arm b->a
 static void hinge_force(const vd_mss_model* m, const vd_mss_data* d, int h, vd_vec3* fa, vd_vec3* fb, vd_vec3* fc) {
   const int* hn = m->hinge_node + 3 * h;
-  int a = hn[0], b = hn[1], c = hn[2];
+  vd_vec3 xa = hn[0] >= 0 ? d->pos[hn[0]] : vd_v3(0, 0, 0);
+  mss_hinge_force_at(m, h, xa, d->pos[hn[1]], d->pos[hn[2]], fa, fb, fc);
+}
+
+void mss_hinge_force_at(const vd_mss_model* m, int h, vd_vec3 xa, vd_vec3 xb, vd_vec3 xc, vd_vec3* fa, vd_vec3* fb,
+                        vd_vec3* fc) {
+  int a = m->hinge_node[3 * h];
   *fa = *fb = *fc = vd_v3(0, 0, 0);
-  vd_vec3 qv = vd_sub(d->pos[c], d->pos[b]);
+  vd_vec3 qv = vd_sub(xc, xb);
   double lq = v_norm(qv);
   if (!(lq > 0)) return;
   vd_vec3 q = vd_scale(qv, 1.0 / lq), p = m->hinge_p0[h];
   double lp = 0;
   if (a >= 0) {
-    vd_vec3 pv = vd_sub(d->pos[a], d->pos[b]);
+    vd_vec3 pv = vd_sub(xa, xb);
     lp = v_norm(pv);
     if (!(lp > 0)) return;
     p = vd_scale(pv, 1.0 / lp);

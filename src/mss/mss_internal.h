@@ -36,9 +36,38 @@ typedef struct mss_work {
   int* link;       // their targets (nnode x MSS_LINKS)
   double* lblk;    // block A[target][node] of each link (nnode x MSS_LINKS x 9)
   double* diag;    // diagonal blocks, inverted during the factorisation (nnode x 9)
+  int* anchor_spring;  // a rigid body's couplings (nspring) and (nhinge)
+  int* anchor_hinge;
 } mss_work;
 
 #define MSS_LINKS 8  // most links (couplings to later nodes, fill included) per node
+
+// The ground a rigid body turns about (issue 26 defect 2): the node its hardened wood grows from
+// (a clamped base or a held root crown), and the springs and hinges that join the body to nodes
+// outside it, evaluated at every stage of the body's RK4 (the outside nodes held where they are
+// for the substep, Algorithm 2).
+typedef struct mss_anchor {
+  int node;            // the pivot node (not a member)
+  vd_vec3 pivot;       // its position (m)
+  vd_vec3 pivot_body;  // ... in the body frame (m)
+  vd_vec3 axis_body;   // direction from the pivot to the body's first member, body frame (unit)
+  int nspring, nhinge; // couplings to nodes outside the body
+  int* spring;         // (nspring) into the model's springs
+  int* hinge;          // (nhinge) into its hinges
+  double stiffness;    // rotational stiffness of the couplings about the pivot, sum of the hinges'
+                       // k and the springs' k r^2 (N m/rad): sets the RK4's substeps
+  double hinge_k;      // ... of the hinges at the pivot alone (N m/rad): the anchor's damping
+  double damping;      // set by the step: c sqrt(hinge_k I) (N m s)
+  double omega;        // set by the step: sqrt(stiffness / I) (rad/s)
+} mss_anchor;
+
+// One substep h of a rigid body pinned at an->pivot under the loads' torque about it (N m) and its
+// couplings: classical RK4 on the orientation quaternion and the angular momentum about the
+// pivot, split so h omega / n < 0.5; then x, p and L from the turn.
+void mss_rigid_pinned_step(const vd_mss_model* m, vd_mss_data* d, mss_anchor* an, vd_vec3 torque, double h);
+// Hinge h's forces on its nodes at positions xa (unused for a fixed arm), xb, xc.
+void mss_hinge_force_at(const vd_mss_model* m, int h, vd_vec3 xa, vd_vec3 xb, vd_vec3 xc, vd_vec3* fa, vd_vec3* fb,
+                        vd_vec3* fc);
 
 // Put the rigid body's members at the body's pose and velocity.
 void mss_rigid_sync(const vd_mss_model* m, vd_mss_data* d);

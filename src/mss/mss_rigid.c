@@ -275,3 +275,131 @@ void vd_mss_rigid_update(const vd_mss_model* m, vd_mss_data* d) {
   b->p = p;
   rebody(m, d, c, mass);
 }
+
+// ---------------------------------------------------------------------------------------------
+// the body turning about its anchor
+
+// a node's position and velocity with the body at orientation q turning at w (outside nodes
+// stay where they are for the substep)
+static vd_vec3 pos_at(const vd_mss_data* d, const mss_anchor* an, vd_quat q, int i) {
+  return d->rigid[i] ? vd_add(an->pivot, q_rotate(q, vd_sub(d->body[i], an->pivot_body))) : d->pos[i];
+}
+
+static vd_vec3 vel_at(const vd_mss_data* d, const mss_anchor* an, vd_quat q, vd_vec3 w, int i) {
+  return d->rigid[i] ? vd_cross(w, vd_sub(pos_at(d, an, q, i), an->pivot)) : d->vel[i];
+}
+
+// the torque about the pivot of the springs and hinges that join the body to outside nodes, the
+// body at orientation q turning at w (spring damping eq. 5 as in the substep)
+static vd_vec3 coupling_torque(const vd_mss_model* m, const vd_mss_data* d, const mss_anchor* an, vd_quat q, vd_vec3 w) {
+  const mss_work* wk = d->work;
+  vd_vec3 tau = vd_v3(0, 0, 0);
+  int material = m->springs == VD_MSS_MATERIAL;
+  for (int k = 0; k < an->nspring; k++) {
+    int s = an->spring[k], i = m->spring_node[2 * s], j = m->spring_node[2 * s + 1];
+    vd_vec3 xi = pos_at(d, an, q, i), xj = pos_at(d, an, q, j), e = vd_sub(xj, xi);
+    double l = v_norm(e);
+    if (!(l > 0)) continue;
+    vd_vec3 u = vd_scale(e, 1.0 / l), dv = vd_sub(vel_at(d, an, q, w, j), vel_at(d, an, q, w, i));
+    vd_vec3 f = vd_scale(u, m->spring_k[s] * (l - m->spring_l0[s]));
+    f = material ? vd_madd(f, u, wk->spring_c[s] * vd_dot(dv, u)) : vd_madd(f, dv, wk->spring_c[s]);
+    if (d->rigid[i]) tau = vd_add(tau, vd_cross(vd_sub(xi, an->pivot), f));
+    if (d->rigid[j]) tau = vd_sub(tau, vd_cross(vd_sub(xj, an->pivot), f));
+  }
+  for (int k = 0; k < an->nhinge; k++) {
+    int h = an->hinge[k];
+    const int* hn = m->hinge_node + 3 * h;
+    vd_vec3 xa = hn[0] >= 0 ? pos_at(d, an, q, hn[0]) : vd_v3(0, 0, 0), xb = pos_at(d, an, q, hn[1]), xc = pos_at(d, an, q, hn[2]);
+    vd_vec3 f[3];
+    mss_hinge_force_at(m, h, xa, xb, xc, &f[0], &f[1], &f[2]);
+    vd_vec3 x[3] = {xa, xb, xc};
+    for (int e = 0; e < 3; e++)
+      if (hn[e] >= 0 && d->rigid[hn[e]]) tau = vd_add(tau, vd_cross(vd_sub(x[e], an->pivot), f[e]));
+  }
+  return tau;
+}
+
+// inertia about the pivot in the world frame at orientation q, and its inverse
+static void pinned_inertia(const vd_rigid* b, vd_vec3 ab, vd_quat q, double* ia, double* ia_inv) {
+  double ibp[9], r[9], rt[9], t[9];
+  double a[3] = {ab.x, ab.y, ab.z}, aa = vd_dot(ab, ab);
+  for (int u = 0; u < 3; u++)
+    for (int v = 0; v < 3; v++) ibp[3 * u + v] = b->ibody[3 * u + v] + b->mass * ((u == v ? aa : 0) - a[u] * a[v]);
+  m3_from_quat(r, q);
+  m3_transpose(rt, r);
+  m3_mul(t, r, ibp);
+  m3_mul(ia, t, rt);
+  if (!m3_inverse(ia_inv, ia)) m3_zero(ia_inv);
+}
+
+typedef struct pin_state {
+  vd_quat q;
+  vd_vec3 la;  // angular momentum about the pivot (kg m^2/s)
+} pin_state;
+
+static pin_state pin_deriv(const vd_mss_model* m, const vd_mss_data* d, const mss_anchor* an, const pin_state* s,
+                           vd_vec3 torque) {
+  double ia[9], iai[9];
+  vd_quat q = q_normalize(s->q);
+  pinned_inertia(&d->rb, an->pivot_body, q, ia, iai);
+  vd_vec3 w = m3_mul_v(iai, s->la);
+  pin_state r;
+  vd_quat wq = {0, w.x, w.y, w.z};
+  vd_quat dq = q_mul(wq, q);
+  r.q = (vd_quat){0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z};
+  // the anchor's bending is damped like eq. 5, c sqrt(k I) on the turn across the trunk's axis
+  vd_vec3 axis = q_rotate(q, an->axis_body);
+  vd_vec3 wp = vd_madd(w, axis, -vd_dot(w, axis));
+  r.la = vd_madd(vd_add(torque, coupling_torque(m, d, an, q, w)), wp, -an->damping);
+  return r;
+}
+
+static pin_state pin_add(const pin_state* s, const pin_state* k, double h) {
+  pin_state r;
+  r.q = (vd_quat){s->q.w + h * k->q.w, s->q.x + h * k->q.x, s->q.y + h * k->q.y, s->q.z + h * k->q.z};
+  r.la = vd_madd(s->la, k->la, h);
+  return r;
+}
+
+void mss_rigid_pinned_step(const vd_mss_model* m, vd_mss_data* d, mss_anchor* an, vd_vec3 torque, double h) {
+  vd_rigid* b = &d->rb;
+  if (b->n <= 0 || b->mass <= 0) return;
+  vd_vec3 rc = vd_sub(b->x, an->pivot);
+  pin_state s = {b->q, vd_add(b->L, vd_cross(rc, b->p))};
+  // the inertia across the trunk (half the trace about the pivot: a slender body's two equal
+  // bending moments) sets the anchor's damping and the substeps
+  double ia0[9], iai0[9];
+  pinned_inertia(b, an->pivot_body, b->q, ia0, iai0);
+  double ie = 0.5 * (ia0[0] + ia0[4] + ia0[8]);
+  an->damping = ie > 0 ? m->damping * sqrt(an->hinge_k * ie) : 0;
+  an->omega = ie > 0 ? sqrt(an->stiffness / ie) : 0;
+  // substeps short enough for the anchor's stiffness (RK4 of an oscillator is stable to h w < 2.8)
+  int nsub = (int)ceil(h * an->omega / 0.5);
+  if (nsub < 1) nsub = 1;
+  if (nsub > 10000) nsub = 10000;
+  double hs = h / nsub;
+  for (int k = 0; k < nsub; k++) {
+    pin_state k1 = pin_deriv(m, d, an, &s, torque);
+    pin_state s1 = pin_add(&s, &k1, hs / 2);
+    pin_state k2 = pin_deriv(m, d, an, &s1, torque);
+    pin_state s2 = pin_add(&s, &k2, hs / 2);
+    pin_state k3 = pin_deriv(m, d, an, &s2, torque);
+    pin_state s3 = pin_add(&s, &k3, hs);
+    pin_state k4 = pin_deriv(m, d, an, &s3, torque);
+    pin_state sum = k1;
+    sum = pin_add(&sum, &k2, 2);
+    sum = pin_add(&sum, &k3, 2);
+    sum = pin_add(&sum, &k4, 1);
+    s = pin_add(&s, &sum, hs / 6);
+    s.q = q_normalize(s.q);
+  }
+  // the centre turns about the pivot; momenta from the angular velocity
+  double ia[9], iai[9];
+  pinned_inertia(b, an->pivot_body, s.q, ia, iai);
+  vd_vec3 w = m3_mul_v(iai, s.la);
+  b->q = s.q;
+  b->x = vd_sub(an->pivot, q_rotate(s.q, an->pivot_body));
+  vd_vec3 r = vd_sub(b->x, an->pivot);
+  b->p = vd_scale(vd_cross(w, r), b->mass);
+  b->L = vd_sub(s.la, vd_cross(r, b->p));
+}

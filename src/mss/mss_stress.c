@@ -20,6 +20,8 @@
 // d omega / dt = beta l-bar (q x up) - gamma omega, |q x up| = sin A. Its steady shape has
 // dA/ds = -sin A / L_c with L_c = gamma / beta: A(s) = 2 atan(tan(A0 / 2) exp(-s / L_c)), and the
 // bending number B = beta L / gamma fixes the tip angle (facts-robot-trees.md section 7).
+// Roots are left as they grew: held by the soil, a root cannot turn up its rest shape without
+// loading itself against its hold (their gravitropism, downward, is the turtle's as they grow).
 #include "mss_internal.h"
 
 void mss_subtrees(const vd_mss_model* m, const vd_mss_data* d, mss_work* w) {
@@ -106,7 +108,9 @@ void vd_mss_bastien(const vd_mss_model* m, const vd_mss_data* d, double t, int n
     // deepest hinges first: a turn about b carries the already turned subtrees beyond it
     for (int k = nn - 1; k >= 0; k--) {
       int c = m->node_order[k], b = m->node_parent[c];
-      if (b < 0 || (d && d->removed[c])) continue;
+      // roots: the soil holds them where they grew (their own gravitropism is the turtle's
+      // tropism as they grow), so their rest shape does not bend (issue 26 defect 3)
+      if (b < 0 || (d && d->removed[c]) || (m->node_flags[c] & VD_MSS_ROOT)) continue;
       int a = m->node_parent[b];
       if (a < 0 || m->node_axis[c] != m->node_axis[b] || m->node_age[c] >= m->opt.growth_zone_age) continue;
       vd_vec3 qv = vd_sub(rest[c], rest[b]), pv = vd_sub(rest[a], rest[b]);

@@ -301,6 +301,69 @@ SIM_CLONES void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, cons
   }
 }
 
+// each segment's air drag (sim_forces.c's seg_drag, the same operations lane by lane): groups
+// of SIM_W segments from t0 while whole groups fit; returns where it stopped (the caller takes
+// the rest). Lanes that take no drag or have no lamina compute it anyway and drop it.
+SIM_CLONES int sim_seg_drag_lanes(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, vd_vec3 wind, double q, int t0,
+                                  int t1) {
+  const double* restrict vel = (const double*)d->node_vel;
+  const double* restrict mass = d->node_mass;
+  const int* restrict fixed = m->node_fixed;
+  const int* restrict start = d->seg_start;
+  const int* restrict snode = m->seg_node;
+  const unsigned* restrict flags = m->seg_flags;
+  const double* restrict ln = m->seg_leaf_normal;
+  const double *restrict rad = m->seg_radius, *restrict len0 = m->seg_len0, *restrict cd = m->seg_cd;
+  const double lcd = m->leaf_cd;
+  int b = t0;
+  for (; b + SIM_W <= t1; b += SIM_W) {
+    const double* restrict qs = (const double*)(d->seg_quat + b);
+    double* restrict sd = w->seg_drag + 5 * (size_t)b;
+    lane ma, mb, u[3], d3[3], up[3], kq, f[3], cc, nw[3], leaf;
+    L {
+      int na = start[b + l], nb = snode[2 * (b + l) + 1];
+      ma[l] = !fixed[na] && mass[na] > 0 ? 1.0 : 0.0;
+      mb[l] = !fixed[nb] && mass[nb] > 0 ? 1.0 : 0.0;
+      double vax = ma[l] > 0 ? vel[3 * na] : 0.0, vay = ma[l] > 0 ? vel[3 * na + 1] : 0.0, vaz = ma[l] > 0 ? vel[3 * na + 2] : 0.0;
+      double vbx = mb[l] > 0 ? vel[3 * nb] : 0.0, vby = mb[l] > 0 ? vel[3 * nb + 1] : 0.0, vbz = mb[l] > 0 ? vel[3 * nb + 2] : 0.0;
+      u[0][l] = wind.x - (vax + vbx) * 0.5, u[1][l] = wind.y - (vay + vby) * 0.5, u[2][l] = wind.z - (vaz + vbz) * 0.5;
+    }
+    L {
+      double qw = qs[4 * l], qx = qs[4 * l + 1], qy = qs[4 * l + 2], qz = qs[4 * l + 3];
+      d3[0][l] = 2 * (qx * qz + qw * qy), d3[1][l] = 2 * (qy * qz - qw * qx), d3[2][l] = 1 - 2 * (qx * qx + qy * qy);
+      // the lamina normal rotated into the world: q_rotate's operations
+      double vx = ln[3 * (b + l)], vy = ln[3 * (b + l) + 1], vz = ln[3 * (b + l) + 2];
+      leaf[l] = vx != 0 || vy != 0 || vz != 0 ? 1.0 : 0.0;
+      double tx = (qy * vz - qz * vy) * 2.0, ty = (qz * vx - qx * vz) * 2.0, tz = (qx * vy - qy * vx) * 2.0;
+      nw[0][l] = (vx + tx * qw) + (qy * tz - qz * ty);
+      nw[1][l] = (vy + ty * qw) + (qz * tx - qx * tz);
+      nw[2][l] = (vz + tz * qw) + (qx * ty - qy * tx);
+    }
+    L {
+      double dot = u[0][l] * d3[0][l] + u[1][l] * d3[1][l] + u[2][l] * d3[2][l];
+      up[0][l] = u[0][l] + d3[0][l] * -dot, up[1][l] = u[1][l] + d3[1][l] * -dot, up[2][l] = u[2][l] + d3[2][l] * -dot;
+      double area = 2 * rad[b + l] * len0[b + l];
+      kq[l] = q * cd[b + l] * area * sqrt(up[0][l] * up[0][l] + up[1][l] * up[1][l] + up[2][l] * up[2][l]);
+      f[0][l] = up[0][l] * kq[l], f[1][l] = up[1][l] * kq[l], f[2][l] = up[2][l] * kq[l];
+      cc[l] = 2 * kq[l];
+    }
+    L {
+      double a = sqrt(nw[0][l] * nw[0][l] + nw[1][l] * nw[1][l] + nw[2][l] * nw[2][l]);
+      double un = (u[0][l] * nw[0][l] + u[1][l] * nw[1][l] + u[2][l] * nw[2][l]) / (leaf[l] > 0 ? a : 1.0);
+      double s = q * lcd * fabs(un) * un;
+      double fx = f[0][l] + nw[0][l] * s, fy = f[1][l] + nw[1][l] * s, fz = f[2][l] + nw[2][l] * s;
+      double c2 = cc[l] + 2 * q * lcd * a * fabs(un);
+      int on = !(flags[b + l] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) && (ma[l] > 0 || mb[l] > 0);
+      sd[5 * l] = leaf[l] > 0 ? fx : f[0][l];
+      sd[5 * l + 1] = leaf[l] > 0 ? fy : f[1][l];
+      sd[5 * l + 2] = leaf[l] > 0 ? fz : f[2][l];
+      sd[5 * l + 3] = leaf[l] > 0 ? c2 : cc[l];
+      sd[5 * l + 4] = on ? (ma[l] > 0 ? (mb[l] > 0 ? 0.5 : 1.0) : 0.0) : -1.0;
+    }
+  }
+  return b;
+}
+
 // ---------------------------------------------------------------------------------------------
 // linearisation of the bodies and joints of a block
 

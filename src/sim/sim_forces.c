@@ -53,42 +53,40 @@ static void node_loads(void* p, int k, int i0, int i1) {
   }
 }
 
-// each segment's drag force, damping and its start node's share into seg_drag: cylinders in
-// cross flow, leaf laminae as plates
+void sim_seg_drag_one(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, vd_vec3 wind, double q, int t) {
+  double* sd = w->seg_drag + 5 * t;
+  sd[4] = -1;  // no drag
+  if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) return;
+  int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
+  int ma = sim_node_moves(m, d, na), mb = sim_node_moves(m, d, nb);
+  if (!ma && !mb) return;
+  vd_vec3 z = vd_v3(0, 0, 0), u = vd_sub(wind, vd_scale(vd_add(ma ? d->node_vel[na] : z, mb ? d->node_vel[nb] : z), 0.5));
+  vd_quat qt = d->seg_quat[t];
+  vd_vec3 d3 = quat_d3(qt);
+  vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
+  double area = 2 * m->seg_radius[t] * m->seg_len0[t];
+  double kq = q * m->seg_cd[t] * area * v_norm(up);
+  vd_vec3 f = vd_scale(up, kq);
+  // damping of F = k |u| u: dF/du has eigenvalues k |u| and 2 k |u|; the larger is taken
+  double cc = 2 * kq;
+  const double* ln = m->seg_leaf_normal + 3 * t;
+  if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
+    vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
+    double a = v_norm(nw);
+    double un = vd_dot(u, nw) / a;
+    f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
+    cc += 2 * q * m->leaf_cd * a * fabs(un);
+  }
+  // half to each end that moves (all of it when the other end is held)
+  sd[0] = f.x, sd[1] = f.y, sd[2] = f.z, sd[3] = cc, sd[4] = ma ? (mb ? 0.5 : 1.0) : 0.0;
+}
+
+// the segments' drag: whole groups of SIM_W lane-parallel (sim_direct.c), the rest one by one
 static void seg_drag(void* p, int k, int t0, int t1) {
   const forces_ctx* c = p;
-  const vd_sim_model* m = c->m;
-  const vd_sim_data* d = c->d;
-  sim_work* w = c->w;
-  double q = c->q;
   (void)k;
-  for (int t = t0; t < t1; t++) {
-    double* sd = w->seg_drag + 5 * t;
-    sd[4] = -1;  // no drag
-    if (m->seg_flags[t] & (VD_SIM_FIXED | VD_SIM_FRUITSEG)) continue;
-    int na = d->seg_start[t], nb = m->seg_node[2 * t + 1];
-    int ma = sim_node_moves(m, d, na), mb = sim_node_moves(m, d, nb);
-    if (!ma && !mb) continue;
-    vd_vec3 z = vd_v3(0, 0, 0), u = vd_sub(c->wind, vd_scale(vd_add(ma ? d->node_vel[na] : z, mb ? d->node_vel[nb] : z), 0.5));
-    vd_quat qt = d->seg_quat[t];
-    vd_vec3 d3 = quat_d3(qt);
-    vd_vec3 up = vd_madd(u, d3, -vd_dot(u, d3));
-    double area = 2 * m->seg_radius[t] * m->seg_len0[t];
-    double kq = q * m->seg_cd[t] * area * v_norm(up);
-    vd_vec3 f = vd_scale(up, kq);
-    // damping of F = k |u| u: dF/du has eigenvalues k |u| and 2 k |u|; the larger is taken
-    double cc = 2 * kq;
-    const double* ln = m->seg_leaf_normal + 3 * t;
-    if (ln[0] != 0 || ln[1] != 0 || ln[2] != 0) {
-      vd_vec3 nw = q_rotate(qt, vd_v3(ln[0], ln[1], ln[2]));
-      double a = v_norm(nw);
-      double un = vd_dot(u, nw) / a;
-      f = vd_madd(f, nw, q * m->leaf_cd * fabs(un) * un);
-      cc += 2 * q * m->leaf_cd * a * fabs(un);
-    }
-    // half to each end that moves (all of it when the other end is held)
-    sd[0] = f.x, sd[1] = f.y, sd[2] = f.z, sd[3] = cc, sd[4] = ma ? (mb ? 0.5 : 1.0) : 0.0;
-  }
+  for (int t = sim_seg_drag_lanes(c->m, c->d, c->w, c->wind, c->q, t0, t1); t < t1; t++)
+    sim_seg_drag_one(c->m, c->d, c->w, c->wind, c->q, t);
 }
 
 void sim_forces(const vd_sim_model* m, vd_sim_data* d, sim_work* w) {

@@ -243,6 +243,13 @@ void sim_frame_velocities(const vd_sim_model* m, vd_sim_data* d, const sim_work*
 // [t0, t1) keep their frame in seg_prev and turn by h omega (fixed ones stay), lane-parallel
 // with the same bytes as quat_rotate_by.
 void sim_frame_predict(const vd_sim_model* m, vd_sim_data* d, sim_work* w, double h, int t0, int t1);
+// Segment t's air drag (cylinder in cross flow, leaf lamina as a plate) in the relative wind
+// (wind (m/s), q = rho_air / 2): its force (N), damping (kg/s) and its start node's share (-1:
+// none) into w->seg_drag (nseg x 5) (sim_forces.c).
+void sim_seg_drag_one(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, vd_vec3 wind, double q, int t);
+// The same for whole groups of SIM_W segments from t0, lane-parallel with the same bytes
+// (sim_direct.c); returns the first segment not done.
+int sim_seg_drag_lanes(const vd_sim_model* m, const vd_sim_data* d, sim_work* w, vd_vec3 wind, double q, int t0, int t1);
 void sim_solve_gs(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* c);
 
 // 1 when node n moves (not kinematic and with mass): sim_node_w > 0 without the division
