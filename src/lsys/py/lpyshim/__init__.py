@@ -7,4 +7,4 @@ last) builds what the engine uses. The PlantGL geometry modules are plain Python
 and tested on their own (src/lsys/py/tests); `lpy` and `engine` call back into the engine's C
 module `_vd`, which only exists inside it.
 """
-__all__ = ["pgl_math", "pgl_appearance", "pgl_geometry", "pgl_curves", "pgl_surfaces", "pgl_algo", "lpy", "engine"]
+__all__ = ["errors", "pgl_math", "pgl_appearance", "pgl_geometry", "pgl_curves", "pgl_surfaces", "pgl_algo", "lpy", "engine"]

@@ -11,9 +11,10 @@ import sys as _sys
 import types as _types
 
 from . import _vd
+from .errors import NotInVerdant, NotProvided, _NoWindow, _display_only, missing_attr, unsupported
 from .lpy import *  # noqa: F401,F403 - the L-Py names
 from .lpy import _future_module, _tableparam_module, _vd_items, _vd_lstring, _vd_make_vec3, _vd_mk
-from .lpy import _vd_init_context, _vd_turtle_settings
+from .lpy import _predefined_class, _vd_init_context, _vd_turtle_settings
 from .pgl_algo import *  # noqa: F401,F403
 from .pgl_appearance import *  # noqa: F401,F403
 from .pgl_curves import *  # noqa: F401,F403
@@ -121,14 +122,16 @@ def _vd_import(name, globals=None, locals=None, fromlist=(), level=0):
             raise ModuleNotFoundError(
                 "No module named '%s' (verdant provides openalea.plantgl and openalea.lpy only)" % name)
         return mod if fromlist else OPENALEA["openalea"]
-    try:
-        mod = _real_import(name, globals, locals, fromlist, level)
-    except ModuleNotFoundError:
-        mod = _import_beside(name, globals, fromlist, level)
-        if mod is None and level == 0 and name in ("pylab", "matplotlib", "matplotlib.pyplot"):
-            mod = _plot_module(name, fromlist)
-        if mod is None:
-            raise
+    # the model's folder first, as on L-Py's sys.path; then the installed modules
+    mod = _import_beside(name, globals, fromlist, level)
+    if mod is None:
+        try:
+            mod = _real_import(name, globals, locals, fromlist, level)
+        except ModuleNotFoundError:
+            if level == 0 and name in ("pylab", "matplotlib", "matplotlib.pyplot"):
+                mod = _plot_module(name, fromlist)
+            if mod is None:
+                raise
     if getattr(mod, "__name__", None) in ("importlib", "imp"):
         mod = _reload_proxy(mod)
     if not _run["np_seeded"] and name.split(".")[0] == "numpy":
@@ -164,6 +167,22 @@ _PLOT_CALLS = ["plot", "show", "draw", "close", "figure", "clf", "cla", "subplot
                "contourf", "pcolor", "pcolormesh", "quiver", "boxplot", "pie", "step", "stem", "suptitle"]
 
 
+class _NoPlot:
+    """A figure or axes of the stand-in pyplot: drawing methods do nothing; queries (get_*) and
+    files (savefig) raise, naming them."""
+
+    def __init__(self, what):
+        self._what = what
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        path = "matplotlib %s.%s" % (self._what, name)
+        if name.startswith("get") or name == "savefig":
+            raise NotInVerdant("%s (matplotlib is not installed: plots are not drawn)" % path)
+        return _display_only(path)
+
+
 def _plot_module(name, fromlist):
     """pylab / matplotlib.pyplot where matplotlib is not installed: plotting draws nothing (as
     PlantGL's Viewer here: a command-line run has no window), pylab's numpy names are numpy's;
@@ -176,37 +195,82 @@ def _plot_module(name, fromlist):
         except ImportError:
             pass
     for n in _PLOT_CALLS:
-        setattr(m, n, _NoDisplay())
-    m.subplots = lambda *a, **k: (_NoDisplay(), _NoDisplay())
-    m.savefig = _unsupported("savefig (matplotlib is not installed)")
+        setattr(m, n, _display_only("%s.%s" % (m.__name__, n)))
+    m.subplots = lambda *a, **k: (_NoPlot("figure"), _NoPlot("axes"))
+    m.savefig = unsupported("savefig (matplotlib is not installed)")
     m.__vd_shim__ = True
     if name == "pylab":
         return m
     pkg = _types.ModuleType("matplotlib")
     pkg.pyplot = m
-    pkg.use = _NoDisplay()
+    pkg.use = _display_only("matplotlib.use")
     pkg.__vd_shim__ = True
     return m if fromlist and name == "matplotlib.pyplot" else pkg
 
 
 def _import_beside(name, globals, fromlist, level):
-    """A module file next to the .lpy file (L-Py runs files from their folder)."""
-    if level != 0 or not globals or not globals.get("__file__"):
+    """A module or package in the .lpy file's folder (L-Py puts that folder on sys.path): `mod.py`
+    or `pkg/__init__.py` there, a package's submodules, relative imports inside a package. None
+    when the name is not there. The modules are kept here, not in sys.modules (a host process's
+    modules stay its own), and import openalea from this shim."""
+    if not globals:
         return None
-    top = name.split(".")[0]
-    path = _os.path.join(_os.path.dirname(_os.path.abspath(globals["__file__"])), top + ".py")
-    if not _os.path.isfile(path):
+    root = globals.get("__vd_root__")
+    if root is None:
+        if not globals.get("__file__"):
+            return None
+        root = _os.path.dirname(_os.path.abspath(globals["__file__"]))
+    if level:
+        pkg = globals.get("__package__") or ""
+        parts = pkg.split(".") if pkg else []
+        if not parts or level - 1 > len(parts) - 1:
+            return None
+        base = ".".join(parts[: len(parts) - (level - 1)])
+        name = base + "." + name if name else base
+    parts = name.split(".")
+    mod, top = None, None
+    for k in range(len(parts)):
+        mod = _load_beside(root, ".".join(parts[: k + 1]), mod)
+        if mod is None:
+            return None
+        top = top or mod
+    for f in fromlist or ():
+        # `from pkg import sub`: a submodule the package has not imported itself
+        if f != "*" and not hasattr(mod, f) and getattr(mod, "__path__", None):
+            _load_beside(root, name + "." + f, mod)
+    return mod if fromlist else top
+
+
+def _load_beside(root, qualname, parent):
+    """The module qualname (its parent package already loaded) from root, run once."""
+    leaf = qualname.rsplit(".", 1)[-1]
+    folder = parent.__path__[0] if parent is not None else root
+    if parent is not None and not getattr(parent, "__path__", None):
+        return None
+    path, pkgdir = _os.path.join(folder, leaf + ".py"), None
+    if _os.path.isfile(_os.path.join(folder, leaf, "__init__.py")):
+        pkgdir = _os.path.join(folder, leaf)
+        path = _os.path.join(pkgdir, "__init__.py")
+    elif not _os.path.isfile(path):
         return None
     mod = _local_modules.get(path)
     if mod is None:
         import importlib.util as iu
-        spec = iu.spec_from_file_location(top, path)
+        spec = iu.spec_from_file_location(qualname, path, submodule_search_locations=[pkgdir] if pkgdir else None)
         mod = iu.module_from_spec(spec)
-        # its own imports are answered as the file's are (openalea from this shim)
+        # its own imports are answered as the file's are (openalea from this shim, the model's
+        # folder first)
         mod.__builtins__ = _BUILTINS
         mod.__vd_local__ = True
-        spec.loader.exec_module(mod)
+        mod.__vd_root__ = root
         _local_modules[path] = mod
+        try:
+            spec.loader.exec_module(mod)
+        except BaseException:
+            del _local_modules[path]
+            raise
+    if parent is not None:
+        setattr(parent, leaf, mod)
     return mod
 
 
@@ -215,35 +279,13 @@ def _import_beside(name, globals, fromlist, level):
 # batch runs); tools it does not provide fail when called, not when imported
 
 
-class _NoDisplay:
-    """PlantGL's Viewer without a window: attributes and calls accepted, nothing shown."""
-
-    def __getattr__(self, name):
-        if name.startswith("__"):
-            raise AttributeError(name)
-        return _NoDisplay()
-
-    def __setattr__(self, name, value):
-        pass
-
-    def __call__(self, *a, **k):
-        return None
-
-
-Viewer = _NoDisplay()
+Viewer = _NoWindow("Viewer")
 eStatic, eAnimatedPrimitives, eAnimatedScene = 0, 1, 2
 
 
 def pgl_support_extension(name):
     """PlantGL's optional extensions (CGAL, ...): none here."""
     return False
-
-
-def _unsupported(what):
-    def f(*a, **k):
-        raise NotImplementedError("%s is not available in verdant's PlantGL" % what)
-    f.__name__ = what
-    return f
 
 
 def _vd_lazy_scene(_=None):
@@ -402,12 +444,12 @@ _SCENEGRAPH = ["Point2Array", "Point3Array", "Point4Array", "RealArray", "Index3
                "Disc", "Box", "Mesh", "TriangleSet", "FaceSet", "QuadSet", "Translated", "Scaled", "AxisRotated", "NurbsPatch",
                "BezierPatch", "Paraboloid", "NurbsPatch3D", "Point2Grid", "Point3Grid", "Discretizer",
                "PointSet", "pointset_directions", "pointset_mean_direction", "findClosestFromSubset",
-               "EulerRotated", "Oriented", "Group", "Shape", "Scene"]
+               "EulerRotated", "Oriented", "Group", "Shape", "Scene", "Revolution", "Swung", "Extrusion"]
 _LPY = ["Lstring", "AxialTree", "PatternString", "Module", "ParamModule", "useGroup", "getGroup",
         "getIterationNb", "isFirstIteration", "Stop", "forward", "backward", "isForward", "frameDisplay",
         "nsproduce", "extern", "context", "execContext", "isAnimationEnabled", "ParameterSet", "isFrameDisplayed",
         "PatternModule", "inLeftContext", "inRightContext", "InLeftContext", "InRightContext", "ModuleClass",
-        "Lsystem"]
+        "Lsystem", "newmodule"]
 
 _DISPLAY = ["Viewer", "eStatic", "eAnimatedPrimitives", "eAnimatedScene", "pgl_support_extension"]
 _pgl_math = _module("openalea.plantgl.math", _MATH)
@@ -415,9 +457,11 @@ _pgl_sg = _module("openalea.plantgl.scenegraph", _SCENEGRAPH)
 _pgl_all = _module("openalea.plantgl.all", _MATH + _SCENEGRAPH + _DISPLAY)
 _pgl_nd = _module("openalea.plantgl.scenegraph.nurbspatch_nd", ["NurbsPatch3D"])
 _pgl_sg.nurbspatch_nd = _pgl_nd
+_pgl_cspline = _module("openalea.plantgl.scenegraph.cspline", ["CSpline", "cspline"])
+_pgl_sg.cspline = _pgl_cspline
 _pgl_light = _types.ModuleType("openalea.plantgl.light.light")
-_pgl_light.diffuseInterception = _unsupported("diffuseInterception")
-_pgl_light.directionalInterception = _unsupported("directionalInterception")
+_pgl_light.diffuseInterception = unsupported("diffuseInterception")
+_pgl_light.directionalInterception = unsupported("directionalInterception")
 _pgl_light_pkg = _types.ModuleType("openalea.plantgl.light")
 _pgl_light_pkg.light = _pgl_light
 _pgl = _module("openalea.plantgl", [])
@@ -430,20 +474,8 @@ _openalea.plantgl, _openalea.lpy = _pgl, _lpy
 OPENALEA = {"openalea": _openalea, "openalea.plantgl": _pgl, "openalea.plantgl.all": _pgl_all,
             "openalea.plantgl.math": _pgl_math, "openalea.plantgl.scenegraph": _pgl_sg, "openalea.lpy": _lpy,
             "openalea.plantgl.light": _pgl_light_pkg, "openalea.plantgl.light.light": _pgl_light,
-            "openalea.lpy.parameterset": _lpy_ps, "openalea.plantgl.scenegraph.nurbspatch_nd": _pgl_nd}
-
-
-class NotInVerdant(AttributeError):
-    """A PlantGL or L-Py name the shim does not have: the engine refuses the file (unsupported),
-    naming it; hasattr() and getattr(m, name, default) still see an AttributeError."""
-
-
-def _missing_attr(modname):
-    def __getattr__(name):
-        if name.startswith("__"):
-            raise AttributeError(name)
-        raise NotInVerdant("%s.%s (verdant's PlantGL / L-Py does not have it)" % (modname, name))
-    return __getattr__
+            "openalea.lpy.parameterset": _lpy_ps, "openalea.plantgl.scenegraph.nurbspatch_nd": _pgl_nd,
+            "openalea.plantgl.scenegraph.cspline": _pgl_cspline}
 
 
 _NotInShim = NotInVerdant
@@ -451,7 +483,16 @@ _NotInShim = NotInVerdant
 
 for _m in OPENALEA.values():
     _m.__vd_shim__ = True
-    _m.__getattr__ = _missing_attr(_m.__name__)
+    _m.__getattr__ = missing_attr(_m.__name__)
+
+
+def _lpy_getattr(name, _missing=_lpy.__getattr__):
+    """openalea.lpy's names beyond _LPY: the predefined module classes by name and alias."""
+    c = _predefined_class(name) if not name.startswith("__") else None
+    return c if c is not None else _missing(name)
+
+
+_lpy.__getattr__ = _lpy_getattr
 
 _BUILTINS = dict(_builtins.__dict__)
 _BUILTINS["__import__"] = _vd_import

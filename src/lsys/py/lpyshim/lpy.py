@@ -5,6 +5,7 @@ import sys as _sys
 import types as _types
 
 from . import _vd
+from .errors import NotInVerdant
 from .pgl_appearance import Material
 from .pgl_math import Vector3
 
@@ -406,6 +407,32 @@ class ModuleClass:
     def __repr__(self):
         return "ModuleClass(%r)" % self.name
 
+    def __call__(self, *args):
+        """A module of this class with these parameters (L-Py's generate_module)."""
+        return Module(self.name, *args)
+
+
+class _NewModuleClass(ModuleClass):
+    """L-Py's predefined module `new` (alias newmodule): newmodule('B', 1, 2) is the module
+    B(1, 2)."""
+
+    def __call__(self, name, *args):
+        if not isinstance(name, str):
+            raise TypeError("newmodule(name, ...): the first argument is the new module's name, got %r" % (name,))
+        return Module(name, *args)
+
+
+newmodule = _NewModuleClass("new")
+
+
+def _predefined_class(name):
+    """openalea.lpy.NAME for a predefined module (F, Left, Sphere, SetGuide, ...): its class, or
+    None when name is no predefined module."""
+    if name in ("new", "newmodule"):
+        return newmodule
+    short = _vd.predefined(name)
+    return ModuleClass(short) if short is not None else None
+
 
 class _PatternModuleType(type):
     @property
@@ -708,7 +735,7 @@ class _Options:
     def __getattr__(self, name):
         if name.startswith("__"):
             raise AttributeError(name)
-        return lambda *a, **k: None
+        raise NotInVerdant("context().options.%s (verdant's options are setSelection, selection and find)" % name)
 
 
 # the values of the options that change results, by index, as L-Py names them
@@ -771,10 +798,14 @@ class _TurtleSettings:
         _vd.set_turtle_angle(float(a))
 
     def __getattr__(self, name):
-        if name.startswith("__"):
-            raise AttributeError(name)
+        if name.startswith("__") or not name.startswith(("set", "clear", "add", "remove")):
+            raise (AttributeError if name.startswith("__") else NotInVerdant)(
+                "context().turtle.%s (verdant's turtle settings take commands set..., clear..., add..., remove...)"
+                % name)
 
         def record(*a, **k):
+            """A display setting of the turtle: recorded (the turtle's defaults come from the
+            settings that change the geometry: setAngleIncrement, setWidthIncrement, ...)."""
             self.settings[name] = a
         return record
 
@@ -804,7 +835,7 @@ class _Context:
             raise AttributeError(k)
         if k in self.attrs:
             return self.attrs[k]
-        return lambda *a, **kw: None
+        raise NotInVerdant("context().%s (verdant's L-system context does not have it)" % k)
 
     def hasObject(self, k):
         return k in self._ns

@@ -5,6 +5,7 @@ function/function.cpp): default knot vectors, homogeneous control points (x, y, 
 length by the stride's chords."""
 import math as _math
 
+from .errors import NotInVerdant
 from .pgl_geometry import _EPS, _Geometry
 from .pgl_math import Point2Array, Point3Array, Point4Array, RealArray, Vector2, Vector3, _Vec, _vec, norm
 
@@ -435,3 +436,90 @@ class QuantisedFunction:
             x = fx if fx is not None else x
             xs.append(x)
         return QuantisedFunction(xs, firstx=y0, lastx=y1)
+
+
+# ---------------------------------------------------------------------------------------------
+# cardinal splines (openalea.plantgl.scenegraph.cspline)
+
+
+class CSpline:
+    """A cardinal spline through points (PlantGL's scenegraph.cspline.CSpline): a C1 curve of
+    cubic Bezier arcs, one per pair of neighbours; at each inner point the derivative is half the
+    chord of its neighbours ((P[i+1] - P[i-1]) / 2), at the ends half the end chord (closed: the
+    chord across the joint); the arcs' inner control points lie a third of the derivatives away.
+    curve() gives it as a NurbsCurve2D / NurbsCurve of degree 3 whose knots are the cumulated
+    chord lengths (is_linear: 0, 1, 2, ...), stride_factor samples per arc."""
+
+    def __init__(self, points, is_closed=False):
+        pts = [_vec(p) for p in points]
+        if len(pts) < 2:
+            raise ValueError("CSpline: at least 2 points, got %d" % len(pts))
+        self.dim = len(pts[0])
+        if self.dim not in (2, 3):
+            raise ValueError("CSpline: points of 2 or 3 coordinates, got %d" % self.dim)
+        self.is_closed = bool(is_closed)
+        if self.is_closed and norm(pts[-1] - pts[0]) > 0.001:
+            pts.append(pts[0])
+        self.points = (Point2Array if self.dim == 2 else Point3Array)(pts)
+        self.nurbs = None
+
+    def __len__(self):
+        return len(self.points)
+
+    def distances(self):
+        self.dist = [norm(self.points[i + 1] - self.points[i]) for i in range(len(self.points) - 1)]
+        return self.dist
+
+    def derivatives(self):
+        p = self.points
+        if self.is_closed:
+            # as PlantGL's: the last point is the first again here, so this is (P[1] - P[0]) / 2
+            d0 = dn = (p[1] - p[-1]) / 2
+        else:
+            d0, dn = (p[1] - p[0]) / 2, (p[-1] - p[-2]) / 2
+        self.der = [d0] + [(p[i + 1] - p[i - 1]) / 2 for i in range(1, len(p) - 1)] + [dn]
+        return self.der
+
+    def bezier_cp(self):
+        p, d = self.points, self.der
+        cp = []
+        for i in range(len(p) - 1):
+            cp += [p[i], p[i] + d[i] / 3, p[i + 1] - d[i + 1] / 3]
+        cp.append(p[-1])
+        if self.is_closed:
+            # PlantGL's closing: the control points beside the joint are moved onto its tangent line
+            cp[1], cp[-2] = cp[2], cp[-3]
+        self.ctrl_pts = cp
+        return cp
+
+    def bezier_kv(self, is_linear=False):
+        if is_linear:
+            params = [float(i) for i in range(len(self.points))]
+        else:
+            params = [0.0]
+            for dd in self.dist:
+                params.append(params[-1] + dd)
+        self.kv = [params[0]] + [u for u in params for _ in range(3)] + [params[-1]]
+        return self.kv
+
+    def curve(self, is_linear=False, degree=3, stride_factor=10, distances=None):
+        if int(degree) != 3:
+            raise NotInVerdant("CSpline.curve(degree=%d): PlantGL's cardinal splines are cubic" % int(degree))
+        if self.nurbs is None:
+            self.dist = list(distances) if distances is not None else self.distances()
+            self.derivatives()
+            self.bezier_cp()
+            self.bezier_kv(is_linear)
+            stride = (len(self.points) - 1) * int(stride_factor)
+            hom = [tuple(p) + (1.0,) for p in self.ctrl_pts]
+            cls = NurbsCurve2D if self.dim == 2 else NurbsCurve
+            self.nurbs = cls(hom, RealArray(self.kv), 3, stride)
+        return self.nurbs
+
+
+def cspline(pts, is_closed=False, is_linear=False, distances=None, degree=3):
+    """The NurbsCurve of the cardinal spline through pts (PlantGL's cspline)."""
+    return CSpline(pts, is_closed).curve(is_linear, degree=degree, distances=distances)
+
+
+NurbsCurve.CSpline = staticmethod(cspline)

@@ -87,3 +87,29 @@ def test_bad_curves_are_errors():
         NurbsCurve2D([(0, 0, 1)])
     with pytest.raises(ValueError):
         NurbsCurve2D([(0, 0, 1), (1, 0, 1), (2, 0, 1)], knotList=[0, 0, 1, 1], degree=2)
+
+
+def test_cspline_interpolates_with_half_chord_tangents():
+    from lpyshim.pgl_curves import cspline
+    pts = [(0, 0), (1, 2), (3, 3), (4, 0)]
+    c = cspline(pts)
+    assert c.degree == 3 and c.stride == 30
+    d = [math.dist(pts[i], pts[i + 1]) for i in range(3)]
+    knots = [0, d[0], d[0] + d[1], sum(d)]
+    assert list(c.knotList) == pytest.approx([0] * 4 + [knots[1]] * 3 + [knots[2]] * 3 + [knots[3]] * 4)
+    for k, p in zip(knots, pts):
+        assert c.getPointAt(k) == Vector2(*p)
+    # at an inner point the derivative is (P[i+1] - P[i-1]) / 2 over the arc's knot span
+    h = 1e-7
+    dc = (c.getPointAt(knots[1] + h) - c.getPointAt(knots[1])) / h
+    want = (Vector2(3, 3) - Vector2(0, 0)) / 2 / d[1]
+    assert dc == pytest.approx(want, rel=1e-4)
+
+
+def test_cspline_3d_and_closed():
+    from lpyshim.pgl_curves import CSpline
+    c = CSpline([(0, 0, 0), (1, 0, 0), (1, 1, 0)], is_closed=True)
+    assert len(c) == 4  # the first point again at the end
+    n = c.curve()
+    assert isinstance(n, NurbsCurve)
+    assert n.getPointAt(n.getFirstKnot()) == n.getPointAt(n.getLastKnot())
