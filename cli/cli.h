@@ -62,21 +62,16 @@ void cli_out_plant_opts(const cli_plant_opts* o);
 
 // Load the plant: derive an .lpy (and keep its derived string's module counts in stats), read
 // a plant file, or build a plant from a curves file. On success *out is a new spec.
-typedef struct cli_grow_info {
-  int64_t modules;          // modules of the derived string (0 for plant files)
-  int nsym;                 // symbol count of the lsystem
-  int64_t* sym_count;       // per-symbol module counts (nsym), owned (free with vd_free)
-  char** sym_name;          // per-symbol names (nsym), owned
-  double seconds_derive, seconds_turtle;
-  const char* engine;       // the engine that ran the .lpy file ("native", "python"), NULL otherwise
-} cli_grow_info;
+typedef vd_plant_load_info cli_grow_info;  // what the load did (module counts for --stats)
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err);
+// The L-system of an .lpy file with the options' engine and --set overrides (sim --grow).
+vd_status cli_load_lsystem(const cli_plant_opts* o, vd_lsystem** out, vd_error* err);
 // What the file at path is when it is not a plant ("a mesh (PLY)", "a point cloud (LAS)", "a
 // simulation run", JSON of another format), told from its first bytes and its name; NULL when it
 // may be one (L-Py text, plant or curves JSON). buf holds the text for some kinds (cli_kind.c).
 const char* cli_not_a_plant(const char* path, char* buf, size_t cap);
 // Free what cli_load_plant put in info.
-void cli_grow_info_free(cli_grow_info* info);
+#define cli_grow_info_free vd_plant_load_info_free
 
 // Parse a whole decimal integer within [lo, hi]; 1 on success.
 int cli_parse_i64(const char* s, int64_t lo, int64_t hi, int64_t* out);

@@ -379,27 +379,6 @@ static int progress_cb(void* user, int step, int steps, int64_t modules) {
   return 0;
 }
 
-// a curves file (format "verdant-curves") built into a new spec with the --curve-* settings
-static vd_status load_curves(const cli_plant_opts* o, const char* text, size_t len, vd_plant_spec** out,
-                             vd_error* err) {
-  vd_curves* c;
-  vd_status st = vd_curves_parse(text, len, o->path, &c, err);
-  if (st) return st;
-  vd_curves_def def = vd_curves_file_def(c);
-  if (o->curve_step >= 0) def.sample_step = o->curve_step;
-  if (o->curve_connect >= 0) def.connect = o->curve_connect;
-  if (o->curve_distance >= 0) def.distance = o->curve_distance;
-  *out = vd_plant_spec_create();
-  st = *out ? vd_curves_build(c, &def, *out, NULL, err)
-            : vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-  vd_curves_destroy(c);
-  if (st) {
-    vd_plant_spec_destroy(*out);
-    *out = NULL;
-  }
-  return st;
-}
-
 int cli_frame_name(const char* pattern, int frame, char* buf, size_t cap) {
   size_t n = 0;
   int fields = 0;
@@ -430,29 +409,47 @@ int cli_frame_name(const char* pattern, int frame, char* buf, size_t cap) {
   return fields == 1;
 }
 
-// the file's label names, then --label, then the instances (organs unless --instances modules)
-static vd_status name_labels(const cli_plant_opts* o, const vd_lsystem* ls, vd_plant_spec* plant, vd_error* err) {
-  vd_status st = VD_OK;
-  for (int i = 0; !st && i < vd_lsys_label_count(ls); i++) {
-    int id;
-    const char* name;
-    vd_lsys_label_get(ls, i, &id, &name);
-    st = vd_plant_set_label(plant, id, name);
+// the plant options as the library's settings (vd_plant_load_def); the strings point into o and b
+typedef struct load_bufs {
+  char set_name[64][128];
+  const char* set_name_p[64];
+  const char* set_value[64];
+  int label_id[64];
+  const char* label_name[64];
+} load_bufs;
+
+static void load_def(const cli_plant_opts* o, load_bufs* b, vd_plant_load_def* d) {
+  *d = vd_plant_load_def_default();
+  d->lsys.steps = o->steps;
+  d->lsys.seed = o->seed;
+  d->lsys.max_modules = o->max_modules;
+  d->lsys.max_ops = o->max_ops;
+  if (o->progress) d->lsys.progress = progress_cb;
+  d->engine = (vd_lsys_engine)o->engine;
+  for (int i = 0; i < o->nset; i++) {  // NAME=VALUE, checked by cli_plant_opt
+    const char* eq = strchr(o->set[i], '=');
+    size_t n = (size_t)(eq - o->set[i]);
+    if (n >= sizeof b->set_name[i]) n = sizeof b->set_name[i] - 1;
+    memcpy(b->set_name[i], o->set[i], n);
+    b->set_name[i][n] = 0;
+    b->set_name_p[i] = b->set_name[i];
+    b->set_value[i] = eq + 1;
   }
-  for (int i = 0; !st && i < o->nlabel; i++) {
-    const char* eq = strchr(o->label[i], '=');
-    st = vd_plant_set_label(plant, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
+  d->set_name = b->set_name_p, d->set_value = b->set_value, d->nset = o->nset;
+  for (int i = 0; i < o->nlabel; i++) {  // ID=NAME, checked by cli_plant_opt
+    b->label_id[i] = (int)strtol(o->label[i], NULL, 10);
+    b->label_name[i] = strchr(o->label[i], '=') + 1;
   }
-  if (!st) st = vd_plant_complete_labels(plant);
-  if (!st) st = vd_plant_set_instances(plant, o->instances < 0 ? VD_INSTANCE_ORGANS : (vd_instance_mode)o->instances);
-  if (st) vd_error_set(err, st, o->path, 0, 0, "out of memory");
-  return st;
+  d->label_id = b->label_id, d->label_name = b->label_name, d->nlabel = o->nlabel;
+  d->curve_step = o->curve_step, d->curve_connect = o->curve_connect, d->curve_distance = o->curve_distance;
+  d->instances = o->instances < 0 ? VD_INSTANCE_DEFAULT : o->instances;
+  d->animate = o->animate;
+  d->call = o->call, d->ncall = o->ncall;
 }
 
-// an animation's frames written as they come (--frames)
+// an animation's frames written as they come (--frames); the loader names them as the plant
 typedef struct frame_writer {
   const cli_plant_opts* o;
-  const vd_lsystem* ls;
   vd_error* err;
   vd_status st;
   int last;  // frames written: 0..last-1
@@ -466,145 +463,48 @@ static int write_frame(void* user, int frame, const vd_lstring* s, const vd_plan
     w->st = vd_error_set(w->err, VD_ERR_ARG, w->o->frames, 0, 0, "frame %d: the file name is too long", frame);
     return 1;
   }
-  vd_plant_spec* p = vd_plant_spec_copy(plant);
-  w->st = p ? name_labels(w->o, w->ls, p, w->err) : vd_error_set(w->err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  if (!w->st) w->st = cli_write_plant(p, path, 0, w->err);
-  vd_plant_spec_destroy(p);
+  w->st = cli_write_plant(plant, path, 0, w->err);
   if (!w->st) w->last = frame + 1;
   return w->st != VD_OK;
 }
 
-// an L-system's run: its --set overrides, derivation (or animation), interpretation, the
-// turtle, --call; the plant in *out
-static vd_status run_lsystem(const cli_plant_opts* o, vd_lsystem* ls, vd_plant_spec** out, cli_grow_info* info,
-                             vd_error* err) {
-  info->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
-  vd_status st = VD_OK;
-  for (int i = 0; !st && i < o->nset; i++) {
-    char name[128];
-    const char* eq = strchr(o->set[i], '=');
-    size_t n = (size_t)(eq - o->set[i]);
-    if (n >= sizeof name) n = sizeof name - 1;
-    memcpy(name, o->set[i], n);
-    name[n] = 0;
-    st = vd_lsys_set_global(ls, name, eq + 1, err);
-  }
-  vd_plant_spec* plant = st ? NULL : vd_plant_spec_create();
-  if (!st && !plant) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
-  vd_lsys_def def = vd_lsys_def_default();
-  def.steps = o->steps;
-  def.seed = o->seed;
-  def.max_modules = o->max_modules;
-  def.max_ops = o->max_ops;
-  if (o->progress) def.progress = progress_cb;
-  double t0 = cli_now();
-  frame_writer fw = {o, ls, err, VD_OK, 0};
-  if (o->frames) def.frame = write_frame, def.frame_user = &fw;
-  // an animation draws every frame and ends with the plant of the last (the turtle's time is in
-  // the derivation's)
-  if (!st) st = o->animate ? vd_lsys_animate(ls, &def, &derived, plant, err) : vd_lsys_derive(ls, &def, &derived, err);
-  if (fw.st) st = fw.st;
-  double t1 = cli_now();
-  if (!st && o->lstring_out) st = write_lstring_json(o->lstring_out, ls, &derived, err);
-  if (!st && !o->animate) st = vd_lsys_interpret(ls, &def, &derived, &geo, err);
-  if (!st && !o->animate) {
-    vd_turtle_def td = vd_turtle_def_default();
-    st = vd_turtle_run(ls, &geo, &td, plant, err);
-  }
-  double t2 = cli_now();
-  // the file's functions, after the run (a check() of its asserts)
-  for (int i = 0; !st && i < o->ncall; i++) st = vd_lsys_call(ls, o->call[i], err);
-  if (!st) st = name_labels(o, ls, plant, err);
-  if (!st && !derived.n && !vd_lsys_axiom_line(ls))
-    fprintf(stderr, "verdant: %s:1:1: warning: the file has no Axiom: line, so its L-string starts empty and the "
-            "plant is empty\n", o->path);
-  if (!st) {
-    // module counts by symbol for --stats
-    info->modules = derived.n;
-    info->nsym = vd_lsys_symbol_count(ls);
-    info->sym_count = vd_calloc((size_t)info->nsym, sizeof(int64_t));
-    info->sym_name = vd_calloc((size_t)info->nsym, sizeof(char*));
-    if (!info->sym_count || !info->sym_name) {
-      st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-    } else {
-      for (int64_t i = 0; i < derived.n; i++) info->sym_count[derived.sym[i]]++;
-      for (int k = 0; k < info->nsym && !st; k++) {
-        info->sym_name[k] = vd_strdup(vd_lsys_symbol_name(ls, k));
-        if (!info->sym_name[k]) st = vd_error_set(err, VD_ERR_NOMEM, o->path, 0, 0, "out of memory");
-      }
-    }
-    info->seconds_derive = t1 - t0;
-    info->seconds_turtle = t2 - t1;
-  }
-  vd_lstring_free(&derived);
-  vd_lstring_free(&geo);
-  if (st) {
-    vd_plant_spec_destroy(plant);
-    cli_grow_info_free(info);
-    return st;
-  }
-  *out = plant;
-  return VD_OK;
+// --lstring: the derived string, unless a frame failed
+static vd_status write_derived(void* user, const vd_lsystem* ls, const vd_lstring* s, vd_error* err) {
+  const frame_writer* w = user;
+  return w->st ? w->st : write_lstring_json(w->o->lstring_out, ls, s, err);
+}
+
+vd_status cli_load_lsystem(const cli_plant_opts* o, vd_lsystem** out, vd_error* err) {
+  load_bufs b;
+  vd_plant_load_def d;
+  load_def(o, &b, &d);
+  return vd_plant_load_lsystem(o->path, &d, out, err);
 }
 
 vd_status cli_load_plant(const cli_plant_opts* o, vd_plant_spec** out, cli_grow_info* info, vd_error* err) {
   memset(info, 0, sizeof *info);
   *out = NULL;
-  vd_status st;
   // a file of another kind says what it is (not an L-Py syntax error in a mesh)
   char kind_buf[160];
   const char* kind = cli_not_a_plant(o->path, kind_buf, sizeof kind_buf);
   if (kind)
     return vd_error_set(err, VD_ERR_FORMAT, o->path, 0, 0, "%s, not a plant: verdant takes an .lpy file or a plant .json",
                         kind);
-  if (cli_has_ext(o->path, ".json")) {
-    if (o->nset) return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--set applies to .lpy files only");
-    if (o->animate || o->ncall)
-      return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "%s applies to .lpy files only",
-                          o->ncall ? "--call" : o->frames ? "--frames" : "--animate");
-    // a plant file or a curves file, by its "format"
-    char* text;
-    size_t len;
-    st = vd_file_read(o->path, &text, &len, err);
-    if (st) return st;
-    char fmt[32];
-    if (!strcmp(vd_plant_json_format(text, len, fmt, sizeof fmt), "verdant-curves")) {
-      st = load_curves(o, text, len, out, err);
-    } else if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0) {
-      st = vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
-    } else {
-      st = vd_plant_parse_json(text, len, o->path, out, err);
-    }
-    vd_free(text, len + 1);
-    for (int i = 0; !st && i < o->nlabel; i++) {
-      const char* eq = strchr(o->label[i], '=');
-      st = vd_plant_set_label(*out, (int)strtol(o->label[i], NULL, 10), eq + 1);  // checked by cli_plant_opt
-    }
-    if (!st && o->instances >= 0 && (st = vd_plant_set_instances(*out, (vd_instance_mode)o->instances)))
-      vd_error_set(err, st, o->path, 0, 0, "out of memory");
-    return st;
+  load_bufs b;
+  vd_plant_load_def d;
+  load_def(o, &b, &d);
+  frame_writer fw = {o, err, VD_OK, 0};
+  if (o->frames) d.lsys.frame = write_frame, d.lsys.frame_user = &fw;
+  if (o->lstring_out) d.derived = write_derived, d.user = &fw;
+  vd_status st = vd_plant_load(o->path, &d, out, info, err);
+  if (fw.st && !st) {
+    st = fw.st;
+    vd_plant_spec_destroy(*out);
+    *out = NULL;
+    vd_plant_load_info_free(info);
   }
-  if (o->curve_step >= 0 || o->curve_connect >= 0 || o->curve_distance >= 0)
-    return vd_error_set(err, VD_ERR_ARG, o->path, 0, 0, "--curve-* options apply to curves files only");
-  vd_lsystem* ls;
-  st = vd_lsys_load_engine(o->path, (vd_lsys_engine)o->engine, &ls, err);
-  if (st) return st;
-  st = run_lsystem(o, ls, out, info, err);
-  // what the native engine refuses only when it runs: the automatic choice runs it in CPython
-  if (st && vd_lsys_fallback(&ls, st)) {
-    memset(err, 0, sizeof *err);
-    st = run_lsystem(o, ls, out, info, err);
-  }
-  vd_lsys_destroy(ls);
+  if (!st && info->format == VD_PLANT_FORMAT_LPY && !info->modules && !info->axiom_line)
+    fprintf(stderr, "verdant: %s:1:1: warning: the file has no Axiom: line, so its L-string starts empty and the "
+            "plant is empty\n", o->path);
   return st;
-}
-
-void cli_grow_info_free(cli_grow_info* info) {
-  if (info->sym_name)
-    for (int k = 0; k < info->nsym; k++)
-      if (info->sym_name[k]) vd_free(info->sym_name[k], strlen(info->sym_name[k]) + 1);
-  vd_free(info->sym_name, sizeof(char*) * (size_t)info->nsym);
-  vd_free(info->sym_count, sizeof(int64_t) * (size_t)info->nsym);
-  memset(info, 0, sizeof *info);
 }

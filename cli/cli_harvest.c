@@ -170,6 +170,7 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
   cJSON_AddNumberToObject(o, "ik_error", r.ik_error);
   cJSON_AddNumberToObject(o, "track_error", r.track_error);
   cJSON_AddNumberToObject(o, "slip", r.slip);
+  cJSON_AddNumberToObject(o, "grip_force_measured", r.grip_force);
   cJSON_AddNumberToObject(o, "speed", s->method.speed);
   cJSON_AddNumberToObject(o, "distance", s->method.distance);
   cJSON_AddNumberToObject(o, "angle_deg", s->method.angle * 180 / M_PI);
@@ -178,6 +179,7 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
   cJSON_AddNumberToObject(o, "steps", (double)r.steps);
   cJSON_AddNumberToObject(o, "plant_warnings", (double)r.plant_warnings);
   cJSON_AddStringToObject(o, "reason", r.reason);
+  if (r.detail[0]) cJSON_AddStringToObject(o, "detail", r.detail);
   if (wall >= 0) {
     cJSON_AddNumberToObject(o, "wall_seconds", wall);
     cJSON_AddNumberToObject(o, "real_time_factor", wall > 0 ? r.duration / wall : 0);
@@ -335,14 +337,23 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     goto done;
   }
   st = vd_harvest_create(s, plant, &h, &err);
-  if (!h) {
+  if (st) {
     code = cli_report("harvest", &err, st);
     goto done;
   }
-  if (st) {
-    // no reachable target: a clean outcome, said on stderr
-    char buf[1024];
-    fprintf(stderr, "verdant harvest: %s\n", vd_error_format(&err, buf, sizeof buf));
+  vd_harvest_obs ob0;
+  vd_harvest_observe(h, &ob0);
+  if (ob0.target_reason) {
+    // a fruit the plant does not have is bad input; no reachable fruit is a clean outcome
+    vd_harvest_end(h, ob0.target_reason);
+    vd_harvest_summary r0;
+    vd_harvest_summarize(h, &r0);
+    if (!strcmp(ob0.target_reason, "no such fruit")) {
+      vd_error_set(&err, VD_ERR_VALUE, s->path, 0, 0, "%s", r0.detail);
+      code = cli_report("harvest", &err, VD_ERR_VALUE);
+      goto done;
+    }
+    fprintf(stderr, "verdant harvest: %s\n", r0.detail[0] ? r0.detail : r0.reason);
   }
   // the run folder: a simulation run (for 'verdant render RUN/') plus the harvest's files
   if (o->out) {
@@ -435,6 +446,7 @@ static uint64_t batch_key(const char* text, size_t len, uint64_t seed) {
 typedef struct batch {
   const harvest_opts* o;
   const vd_scene* scene;
+  const vd_robot* robot;  // loaded once, shared by every episode
   char key[32];
   char dir[4200];
 } batch;
@@ -469,6 +481,30 @@ static cJSON* complete_record(const batch* b, int k, int* mismatch) {
   return r;
 }
 
+// the record of an episode that failed (its plant did not load, its simulation failed): an
+// outcome with reason "failed" and the error, so that the batch goes on
+static cJSON* failure_json(const vd_scene* s, const vd_error* e, vd_status st) {
+  char buf[1024];
+  cJSON* o = cJSON_CreateObject();
+  if (!o) return NULL;
+  cJSON_AddStringToObject(o, "format", "verdant-harvest");
+  cJSON_AddNumberToObject(o, "version", VD_HARVEST_FORMAT_VERSION);
+  cJSON_AddStringToObject(o, "scene", s->path);
+  cJSON_AddStringToObject(o, "method", vd_harvest_method_name(s->method.method));
+  cJSON_AddNumberToObject(o, "plant_seed", (double)s->plant_seed);
+  cJSON_AddNumberToObject(o, "target_instance", 0);
+  cJSON_AddBoolToObject(o, "grasped", 0);
+  cJSON_AddBoolToObject(o, "detached", 0);
+  cJSON_AddStringToObject(o, "site", vd_harvest_site_name(VD_SITE_NONE));
+  cJSON_AddNumberToObject(o, "speed", s->method.speed);
+  cJSON_AddNumberToObject(o, "distance", s->method.distance);
+  cJSON_AddNumberToObject(o, "angle_deg", s->method.angle * 180 / M_PI);
+  cJSON_AddNumberToObject(o, "grip_force", s->method.grip_force);
+  cJSON_AddStringToObject(o, "reason", "failed");
+  cJSON_AddStringToObject(o, "detail", e->status ? vd_error_format(e, buf, sizeof buf) : vd_status_str(st));
+  return o;
+}
+
 // which of episodes 0..n-1 have a record file in the folder sub (calloc'd flags; NULL out of
 // memory): one listing of the folder, not a look-up per episode, so that a batch of millions
 // starts at once
@@ -486,7 +522,8 @@ static unsigned char* recorded_episodes(const char* sub, int n) {
   return has;
 }
 
-// run episode k and write its record
+// run episode k and write its record; an episode that fails is recorded as such (the batch
+// goes on); only a record that cannot be written is an error
 static vd_status make_episode(const batch* b, int k, vd_error* err) {
   vd_scene s;
   uint64_t tseed;
@@ -495,32 +532,22 @@ static vd_status make_episode(const batch* b, int k, vd_error* err) {
   vd_plant_spec* spec = NULL;
   vd_model* plant = NULL;
   vd_harvest* h = NULL;
-  st = scene_plant(&s, &spec, &plant, err);
-  if (!st) {
-    st = vd_harvest_create(&s, plant, &h, err);
-    if (h) st = VD_OK;
+  vd_error e = {0};
+  st = scene_plant(&s, &spec, &plant, &e);
+  if (!st) st = vd_harvest_create_with(&s, b->robot, plant, &h, &e);
+  if (!st) st = vd_harvest_reset(h, tseed, &e);
+  if (!st) st = vd_harvest_run(h, NULL, NULL, &e);
+  cJSON* r = st ? failure_json(&s, &e, st) : summary_json(h, -1);
+  if (r) {
+    cJSON_AddNumberToObject(r, "episode", k);
+    cJSON_AddStringToObject(r, "batch", b->key);
   }
-  if (!st) st = vd_harvest_reset(h, tseed, err);
-  if (st == VD_ERR_VALUE && h) {
-    // no fruit to pick (none reachable, none with that instance): an outcome, not a failure
-    vd_harvest_obs ob;
-    vd_harvest_observe(h, &ob);
-    if (!ob.target_instance) st = VD_OK;
-  }
-  if (!st) st = vd_harvest_run(h, NULL, NULL, err);
-  if (!st) {
-    cJSON* r = summary_json(h, -1);
-    if (r) {
-      cJSON_AddNumberToObject(r, "episode", k);
-      cJSON_AddStringToObject(r, "batch", b->key);
-    }
-    char path[4300];
-    record_path(b, k, path, sizeof path);
-    st = write_json(path, r, err);
-    // a complete episode is kept even when the batch stops later (it resumes from there)
-    const char* done[1] = {path};
-    if (!st && cli_out_publish(done, 1, 1)) st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot put the record in place");
-  }
+  char path[4300];
+  record_path(b, k, path, sizeof path);
+  st = write_json(path, r, err);
+  // a complete episode is kept even when the batch stops later (it resumes from there)
+  const char* done[1] = {path};
+  if (!st && cli_out_publish(done, 1, 1)) st = vd_error_set(err, VD_ERR_IO, path, 0, 0, "cannot put the record in place");
   vd_harvest_destroy(h);
   vd_model_destroy(plant);
   vd_plant_spec_destroy(spec);
@@ -715,6 +742,13 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
             b.dir, mismatch_at);
     return EXIT_USAGE;
   }
+  vd_robot* robot = NULL;
+  vd_status rst = vd_robot_load(s, &robot, &err);
+  if (rst) {
+    vd_free(todo, sizeof(int) * (size_t)n);
+    return cli_report("harvest", &err, rst);
+  }
+  b.robot = robot;
   double t0 = cli_now();
   int done = 0, failed = -1;
   vd_error first = {0};
@@ -743,6 +777,7 @@ static int run_batch(const harvest_opts* o, const vd_scene* s) {
   }
   if (o->progress) cli_progress_clear();
   vd_free(todo, sizeof(int) * (size_t)n);
+  vd_robot_destroy(robot);
   if (failed >= 0) {
     char buf[1024];
     fprintf(stderr, "verdant harvest: episode %d: %s\n", failed,

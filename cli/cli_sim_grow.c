@@ -592,16 +592,7 @@ int cli_sim_grow(int argc, char** argv) {
   double* wind = NULL;
   int nwind = 0, code = EXIT_OK;
   cJSON* index = NULL;
-  vd_status st = vd_lsys_load_engine(o.po.path, (vd_lsys_engine)o.po.engine, &ls, &err);
-  for (int i = 0; !st && i < o.po.nset; i++) {
-    char name[128];
-    const char* eq = strchr(o.po.set[i], '=');
-    size_t n = (size_t)(eq - o.po.set[i]);
-    if (n >= sizeof name) n = sizeof name - 1;
-    memcpy(name, o.po.set[i], n);
-    name[n] = 0;
-    st = vd_lsys_set_global(ls, name, eq + 1, &err);
-  }
+  vd_status st = cli_load_lsystem(&o.po, &ls, &err);
   if (!st && o.wind_file) st = vd_sim_read_wind(o.wind_file, &wind, &nwind, &err);
   int ages = o.ages >= 0 ? o.ages : o.po.steps >= 0 ? o.po.steps : st ? 0 : vd_lsys_derivation_length(ls);
   o.def.ages = ages;

@@ -101,5 +101,8 @@ cppcheck --project="$out/compile_commands.json" "${filters[@]}" \
   --suppress=invalidPointerCast --error-exitcode=1 -j "$jobs" --quiet --template='{file}:{line}:{column}: {severity}: {message} [{id}]' ||
   fail=1
 
+# the module dependency rules (docs/architecture.md, scripts/check_includes.py)
+python3 scripts/check_includes.py . || fail=1
+
 echo "lint: $([ $fail = 0 ] && echo clean || echo FINDINGS) in $(($(date +%s) - start)) s" >&2
 exit $fail

@@ -30,7 +30,7 @@ TEST(robot, lite6_kinematics) {
   vd_error e = {0};
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
-  s.base_pos = vd_v3(0, 0, 0), s.base_yaw = 0;
+  s.base_pos = vd_v3(10, 0, 0), s.base_yaw = 0;  // away from the truss (a base inside it is refused)
   vd_model* pm = robot_truss(0.012);
   REQUIRE(pm);
   vd_harvest* h = NULL;
@@ -39,13 +39,13 @@ TEST(robot, lite6_kinematics) {
   (void)st;
   double q[6] = {0, 0, 0, 0, 0, 0}, home[6] = {0, 0, M_PI / 2, 0, M_PI / 2, 0};
   for (int k = 0; k < 2; k++) {
-    for (int i = 0; i < 6; i++) h->dk->qpos[h->arm_qpos[i]] = k ? home[i] : q[i];
+    for (int i = 0; i < 6; i++) h->dk->qpos[h->rb->arm_qpos[i]] = k ? home[i] : q[i];
     mj_kinematics(h->m, h->dk);
     int b5 = mj_name2id(h->m, mjOBJ_BODY, "link5"), b6 = mj_name2id(h->m, mjOBJ_BODY, "link6");
     const double* w = h->dk->xpos + 3 * b5;
     const double* f = h->dk->xpos + 3 * b6;
     double wx = k ? 0.2276 : 0.087, wz = k ? 0.5307 : 0.2161, fz = k ? 0.4682 : 0.1536;
-    CHECK_NEAR(w[0], wx, 3e-4);
+    CHECK_NEAR(w[0] - 10, wx, 3e-4);
     CHECK_NEAR(w[1], 0, 1e-7);
     CHECK_NEAR(w[2], wz, 3e-4);
     CHECK_NEAR(f[2], fz, 3e-4);
@@ -73,7 +73,7 @@ TEST(robot, ik_reaches_targets) {
     // a target made by forward kinematics of random joints: reachable by construction
     double qt[6], q[6];
     for (int k = 0; k < 6; k++) {
-      double lo = fmax(h->arm_lo[k], -2.0), hi = fmin(h->arm_hi[k], 2.0);
+      double lo = fmax(h->rb->arm_lo[k], -2.0), hi = fmin(h->rb->arm_hi[k], 2.0);
       qt[k] = vd_rng_uniform(g, lo, hi);
       q[k] = h->q0[k];
     }
@@ -90,7 +90,7 @@ TEST(robot, ik_reaches_targets) {
       CHECK(pe < 1e-3);
       CHECK(re < 1e-2);
     }
-    for (int k = 0; k < 6; k++) CHECK(q[k] >= h->arm_lo[k] - 1e-12 && q[k] <= h->arm_hi[k] + 1e-12);
+    for (int k = 0; k < 6; k++) CHECK(q[k] >= h->rb->arm_lo[k] - 1e-12 && q[k] <= h->rb->arm_hi[k] + 1e-12);
   }
   CHECK(reached >= 16);
   vd_free(g, sizeof *g);
@@ -202,7 +202,7 @@ TEST(robot, stiff_branch_stops_weak_arm) {
 }
 
 // run the scripted method on the truss; summary out
-// stepwise: one vd_harvest_step_scripted at a time instead of vd_harvest_run
+// stepwise: one vd_script_step at a time instead of vd_harvest_run
 static void harvest_truss_by(const char* method, const char* extra, vd_harvest_summary* out, uint64_t* hash,
                              int stepwise) {
   vd_error e = {0};
@@ -217,7 +217,10 @@ static void harvest_truss_by(const char* method, const char* extra, vd_harvest_s
   vd_status st = vd_harvest_create(&s, pm, &h, &e);
   if (st) vdt_fail(__FILE__, __LINE__, "create: %s", e.msg);
   if (!st && !stepwise) st = vd_harvest_run(h, NULL, NULL, &e);
-  while (!st && stepwise && !vd_harvest_done(h)) st = vd_harvest_step_scripted(h, &e);
+  vd_script* c = NULL;
+  if (!st && stepwise) st = vd_script_create(h, &c, &e);
+  while (!st && stepwise && !vd_harvest_done(h)) st = vd_script_step(c, &e);
+  vd_script_destroy(c);
   if (st) vdt_fail(__FILE__, __LINE__, "run: %s", e.msg);
   if (h) vd_harvest_summarize(h, out);
   if (h && getenv("VDT_VERBOSE")) {
@@ -284,7 +287,9 @@ TEST(robot, deterministic) {
   CHECK(c.detached && c.time == a.time && c.steps == a.steps);
 }
 
-TEST(robot, scripted_steps_refused_after_external) {
+TEST(robot, script_and_external_control) {
+  // the scripted controller is a client of the step API: its phases are reported through it;
+  // an external controller may take over between its steps, and a new script begins after a reset
   vd_error e = {0};
   vd_scene s;
   CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
@@ -292,14 +297,129 @@ TEST(robot, scripted_steps_refused_after_external) {
   vd_harvest* h = NULL;
   CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
   REQUIRE(h);
-  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_OK, e);
-  CHECK_INT(h->phase, VD_PHASE_APPROACH);
+  vd_harvest_obs o;
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.phase, VD_PHASE_EXTERNAL);  // no controller yet
+  CHECK(o.target_instance > 0 && o.target_reason == NULL);
+  vd_script* c = NULL;
+  CHECK_STATUS(vd_script_create(h, &c, &e), VD_OK, e);
+  CHECK_STATUS(vd_script_step(c, &e), VD_OK, e);
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.phase, VD_PHASE_APPROACH);
   vd_harvest_action a = {{0, 0, 0}, {0, 0, 0}, 0};
+  int64_t step = o.step;
   CHECK_STATUS(vd_harvest_step(h, &a, &e), VD_OK, e);
-  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_ERR_ARG, e);
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.step, step + 1);
+  vd_script_destroy(c);
   CHECK_STATUS(vd_harvest_reset(h, 0, &e), VD_OK, e);
-  CHECK_STATUS(vd_harvest_step_scripted(h, &e), VD_OK, e);
+  CHECK_STATUS(vd_harvest_run(h, NULL, NULL, &e), VD_OK, e);
+  vd_harvest_summary r;
+  vd_harvest_summarize(h, &r);
+  CHECK(r.detached);
+  CHECK_INT(r.events_dropped, 0);
+  // a step after the end is refused
+  CHECK_STATUS(vd_harvest_step(h, &a, &e), VD_ERR_ARG, e);
   vd_harvest_destroy(h);
+  vd_model_destroy(pm);
+  vd_scene_free(&s);
+}
+
+TEST(robot, description_shared_by_episodes) {
+  // one robot description, two episodes with other base poses and grip forces: each the same,
+  // byte for byte, as an episode with a description of its own; a scene naming another robot is
+  // refused
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\", \"speed\": 0.04, \"distance\": 0.1", NULL, &s, &e), VD_OK, e);
+  vd_model* pm = robot_truss(0.012);
+  vd_robot* rb = NULL;
+  CHECK_STATUS(vd_robot_load(&s, &rb, &e), VD_OK, e);
+  REQUIRE(rb);
+  for (int k = 0; k < 2; k++) {
+    s.base_pos.x = 0.45 + 0.01 * k;
+    s.method.grip_force = 3 - k;
+    vd_harvest *h1 = NULL, *h2 = NULL;
+    CHECK_STATUS(vd_harvest_create_with(&s, rb, pm, &h1, &e), VD_OK, e);
+    CHECK_STATUS(vd_harvest_create(&s, pm, &h2, &e), VD_OK, e);
+    REQUIRE(h1 && h2);
+    CHECK_STATUS(vd_harvest_run(h1, NULL, NULL, &e), VD_OK, e);
+    CHECK_STATUS(vd_harvest_run(h2, NULL, NULL, &e), VD_OK, e);
+    vd_harvest_summary a, b;
+    vd_harvest_summarize(h1, &a);
+    vd_harvest_summarize(h2, &b);
+    CHECK(a.time == b.time && a.pull_force == b.pull_force && a.steps == b.steps);
+    CHECK_STR(a.reason, b.reason);
+    const vd_sim_data* d1 = vd_harvest_sim_data(h1);
+    const vd_sim_data* d2 = vd_harvest_sim_data(h2);
+    CHECK(!memcmp(d1->node_pos, d2->node_pos, sizeof(vd_vec3) * (size_t)d1->nnode_all));
+    vd_harvest_destroy(h1);
+    vd_harvest_destroy(h2);
+  }
+  snprintf(s.ee_site, sizeof s.ee_site, "flange");
+  vd_harvest* h = NULL;
+  CHECK_STATUS(vd_harvest_create_with(&s, rb, pm, &h, &e), VD_ERR_ARG, e);
+  CHECK(!h);
+  vd_robot_destroy(rb);
+  vd_model_destroy(pm);
+  vd_scene_free(&s);
+}
+
+TEST(robot, grip_sweep_friction_boundary) {
+  // a friction-limited grasp: the hold may pull across the fingers' closing axis with at most
+  // mu (N_l + N_r), N the finger actuators' measured squeeze (here their force limit). A slow pull
+  // (quasi-static) on the truss's fruit, whose calyx breaks at F_b, detaches it when
+  // 2 mu F_grip > F_b and slips it out of the fingers below: the boundary F_b / (2 mu) within 10 %
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  double fb = s.sim_def.material[VD_SIM_FRUIT].break_force, mu = s.method.grip_friction;
+  double fstar = fb / (2 * mu);
+  vd_scene_free(&s);
+  const double factor[] = {0.8, 0.9, 1.1, 1.2};
+  for (int k = 0; k < 4; k++) {
+    char m[256];
+    snprintf(m, sizeof m, "\"name\": \"pull\", \"speed\": 0.02, \"distance\": 0.1, \"grip_force\": %.6f",
+             factor[k] * fstar);
+    vd_harvest_summary r;
+    harvest_truss(m, NULL, &r, NULL);
+    if (getenv("VDT_VERBOSE"))
+      printf("  grip %.4f N (x%.2f of %.4f): %s, slip %.4f m, measured %.4f N, pull %.4f N\n", factor[k] * fstar,
+             factor[k], fstar, r.reason, r.slip, r.grip_force, r.max_pull_force);
+    CHECK(r.grasped);
+    CHECK_NEAR(r.grip_force, factor[k] * fstar, 1e-6 * fstar);  // the actuators' force limit
+    if (factor[k] < 1) {
+      CHECK_STR(r.reason, "slipped");
+      CHECK(!r.detached);
+      CHECK(r.slip > 0.005);
+      CHECK(r.max_pull_force <= 2 * mu * r.grip_force * 1.02);  // never beyond friction
+    } else {
+      CHECK_STR(r.reason, "detached");
+      CHECK(r.detached);
+    }
+  }
+}
+
+TEST(robot, start_inside_plant_refused) {
+  // the robot's base on the truss's fruit: refused before the first step, naming the geom and
+  // the organ (not a plant blown apart by the first contact)
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  vd_model* pm = robot_truss(0.012);
+  vd_harvest* h = NULL;
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
+  REQUIRE(h);
+  vd_harvest_obs o;
+  vd_harvest_observe(h, &o);
+  vd_vec3 f = o.fruit_pos;
+  vd_harvest_destroy(h);
+  h = NULL;
+  s.base_pos = vd_v3(f.x, f.y, f.z - 0.03);
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_ERR_VALUE, e);
+  CHECK(!h);
+  CHECK(strstr(e.msg, "starts inside the plant: geom '") != NULL);
+  CHECK(strstr(e.msg, "overlaps ") != NULL && strstr(e.msg, " mm at q0") != NULL);
   vd_model_destroy(pm);
   vd_scene_free(&s);
 }
@@ -313,13 +433,19 @@ TEST(robot, unreachable_target) {
   s.base_pos = vd_v3(3, 0, 0.2);
   vd_model* pm = robot_truss(0.012);
   vd_harvest* h = NULL;
-  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_ERR_VALUE, e);
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
   REQUIRE(h);
+  vd_harvest_obs o;
+  vd_harvest_observe(h, &o);
+  CHECK_INT(o.target_instance, 0);
+  CHECK(o.target_reason && !strcmp(o.target_reason, "no reachable fruit"));
   CHECK_STATUS(vd_harvest_run(h, NULL, NULL, &e), VD_OK, e);
   CHECK(vd_harvest_done(h));
   vd_harvest_summarize(h, &r);
   CHECK(!r.detached);
   CHECK_STR(r.reason, "no reachable fruit");
+  // the detail names the nearest fruit and how far it is
+  CHECK(strstr(r.detail, "fruit ") && strstr(r.detail, " m from the robot's base"));
   vd_harvest_destroy(h);
   vd_model_destroy(pm);
   vd_scene_free(&s);

@@ -43,12 +43,14 @@ static vd_model* scene_plant(const vd_scene* s) {
   vd_error err = {0};
   vd_plant_spec* spec = vd_plant_spec_create();
   vd_model* m = NULL;
-  vd_lsys_def def = vd_lsys_def_default();
-  def.seed = s->plant_seed;
-  def.steps = s->plant_steps;
+  vd_plant_load_def def = vd_plant_load_def_default();
+  def.lsys.seed = s->plant_seed;
+  def.lsys.steps = s->plant_steps;
+  vd_plant_spec_destroy(spec);
+  spec = NULL;
   if (s->nplant_set) {
     fprintf(stderr, "bench: the scene sets plant globals; this bench grows the file as it is\n");
-  } else if (spec && !vd_lsys_load(s->plant_path, &ls, &err) && !vd_lsys_grow(ls, &def, NULL, spec, &err)) {
+  } else if (!vd_plant_load(s->plant_path, &def, &spec, NULL, &err)) {
     vd_scene_place_plant(s, spec);
     vd_plant_compile(spec, &m, &err);
   }

@@ -77,6 +77,25 @@ vd_status vd_error_set(vd_error* err, vd_status status, const char* file, int li
 const char* vd_error_format(const vd_error* err, char* buf, size_t cap);
 
 // ---------------------------------------------------------------------------------------------
+// binary scalars of PLY, PCD and LAS files (the mesh and cloud readers share them)
+
+typedef enum vd_scalar {
+  VD_SCALAR_I8 = 0, VD_SCALAR_U8, VD_SCALAR_I16, VD_SCALAR_U16, VD_SCALAR_I32, VD_SCALAR_U32,
+  VD_SCALAR_I64, VD_SCALAR_U64, VD_SCALAR_F32, VD_SCALAR_F64, VD_SCALAR_BAD
+} vd_scalar;
+
+// Bytes of a scalar (0 for VD_SCALAR_BAD).
+static inline int vd_scalar_size(vd_scalar t) {
+  static const int size[] = {1, 1, 2, 2, 4, 4, 8, 8, 4, 8, 0};
+  return t >= 0 && t <= VD_SCALAR_BAD ? size[t] : 0;
+}
+// The scalar a PLY property type names ("char" or "int8" ... "double" or "float64");
+// VD_SCALAR_BAD for any other name.
+vd_scalar vd_scalar_ply(const char* name);
+// The little-endian scalar of type t at p, as a double.
+double vd_scalar_get_le(const unsigned char* p, vd_scalar t);
+
+// ---------------------------------------------------------------------------------------------
 // allocation: all heap traffic goes through one hook that sees sizes
 
 // Allocator hook: realloc semantics (ptr NULL = malloc, size 0 = free). user is passed back.

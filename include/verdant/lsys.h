@@ -304,6 +304,88 @@ vd_status vd_turtle_run(const vd_lsystem* ls, const vd_lstring* s, const vd_turt
 vd_status vd_lsys_grow(vd_lsystem* ls, const vd_lsys_def* def, const vd_turtle_def* tdef,
                        vd_plant_spec* plant, vd_error* err);
 
+// ---------------------------------------------------------------------------------------------
+// Loading a plant from any file verdant accepts (lsys_load.c): the one entry the command line,
+// the Python package, growth, harvest scenes and export all go through, so that the same file
+// with the same settings makes the same plant (ids and bytes) everywhere. A new input format is
+// one entry in the table of lsys_load.c.
+
+// The kinds of plant input.
+typedef enum vd_plant_format {
+  VD_PLANT_FORMAT_LPY = 0,  // an L-Py file: derived, interpreted, drawn by the turtle
+  VD_PLANT_FORMAT_JSON,     // a plant file (JSON, format "verdant-plant")
+  VD_PLANT_FORMAT_CURVES,   // a curves file (JSON, format "verdant-curves")
+  VD_PLANT_FORMAT_COUNT
+} vd_plant_format;
+
+// Name of a format ("lpy", "plant", "curves").
+const char* vd_plant_format_name(vd_plant_format f);
+
+// vd_plant_load_def::instances: organs for a plant drawn from an L-system, a file's own numbering.
+#define VD_INSTANCE_DEFAULT (-1)
+
+// Settings of vd_plant_load: one struct for every format (what does not apply to the input is an
+// error when set: VD_ERR_ARG naming the setting).
+typedef struct vd_plant_load_def {
+  vd_lsys_def lsys;             // L-systems: steps, seed, limits, progress and frame callbacks
+  vd_turtle_def turtle;         // L-systems: the turtle
+  vd_lsys_engine engine;        // L-systems: who runs the file's Python (VD_LSYS_AUTO)
+  const char* const* set_name;  // L-systems: globals to override before the run (nset), and
+  const char* const* set_value; // their values as Python expressions
+  int nset;
+  const int* label_id;          // label names given after the file's own (nlabel): ids 0..65535
+  const char* const* label_name;
+  int nlabel;
+  double curve_step;            // curves files: dense sampling step (m); < 0: the file's or default
+  double curve_connect;         // curves files: largest branch gap (m); < 0: the file's or default
+  double curve_distance;        // curves files: segment length (m); < 0: the file's or default
+  int instances;                // a vd_instance_mode, or VD_INSTANCE_DEFAULT: organs for what an
+                                // L-system draws, a plant or curves file keeps its own numbering
+  int animate;                  // L-systems: draw after every step (vd_lsys_animate); the plant is
+                                // the last frame's
+  const char* const* call;      // L-systems: the file's functions called after the run (ncall)
+  int ncall;
+  // Nullable, L-systems: called with the derived string before it is drawn; a status other than
+  // VD_OK stops the load with it (the command line's --lstring writes the string here).
+  vd_status (*derived)(void* user, const vd_lsystem* ls, const vd_lstring* s, vd_error* err);
+  void* user;                   // passed to derived
+} vd_plant_load_def;
+
+// Defaults: vd_lsys_def_default, vd_turtle_def_default, VD_LSYS_AUTO, no overrides, curve
+// settings -1, instances VD_INSTANCE_DEFAULT.
+vd_plant_load_def vd_plant_load_def_default(void);
+
+// What a load did (vd_plant_load_info_free frees the arrays).
+typedef struct vd_plant_load_info {
+  vd_plant_format format;       // what the input was
+  const char* engine;           // L-systems: the engine that ran it ("native", "python"), else NULL
+  int64_t modules;              // L-systems: modules of the derived string, else 0
+  int nsym;                     // L-systems: symbols of the file
+  int64_t* sym_count;           // modules of each symbol in the derived string (nsym)
+  char** sym_name;              // each symbol's name (nsym)
+  double seconds_derive;        // L-systems: wall time of the derivation (s)
+  double seconds_turtle;        // ... and of the interpretation and the turtle (s)
+  int axiom_line;               // L-systems: the line of the file's Axiom:, 0 when it has none
+} vd_plant_load_info;
+
+// Make a plant from the file at path: an .lpy file, a plant file or a curves file (.json, told
+// apart by their "format"). *out gets a new spec; info (Nullable) what was done. Errors name the
+// file, line and column (VD_ERR_ARG for a setting that does not apply to the input).
+vd_status vd_plant_load(const char* path, const vd_plant_load_def* def, vd_plant_spec** out,
+                        vd_plant_load_info* info, vd_error* err);
+// The same from text in memory: JSON when it starts with '{', else L-Py; name (Nullable) is
+// used in errors.
+vd_status vd_plant_load_text(const char* text, size_t len, const char* name, const vd_plant_load_def* def,
+                             vd_plant_spec** out, vd_plant_load_info* info, vd_error* err);
+// The L-system of an .lpy file as vd_plant_load opens it (def's engine and overrides of its
+// globals; def Nullable): for callers that derive it themselves (growth).
+vd_status vd_plant_load_lsystem(const char* path, const vd_plant_load_def* def, vd_lsystem** out, vd_error* err);
+// Name the labels and instances of a plant that ls drew, as vd_plant_load does (the file's
+// labels, def's, then the instances): for frames drawn outside it. VD_ERR_NOMEM.
+vd_status vd_plant_load_name(const vd_lsystem* ls, const vd_plant_load_def* def, vd_plant_spec* plant);
+// Free the arrays of info (a zeroed one is fine).
+void vd_plant_load_info_free(vd_plant_load_info* info);
+
 #ifdef __cplusplus
 }
 #endif

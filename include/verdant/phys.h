@@ -5,6 +5,8 @@
 #ifndef VERDANT_PHYS_H
 #define VERDANT_PHYS_H
 
+#include <stdarg.h>
+
 #include "verdant/core.h"
 #include "verdant/plant.h"
 
@@ -49,6 +51,10 @@ typedef struct vd_validate_list {
 int vd_validate_add(vd_validate_list* l, const char* name, const char* form, const char* quantity,
                     double measured, double reference, double tol, int abs_err, const char* note,
                     ...) __attribute__((format(printf, 9, 10)));
+// The same with the note's arguments in a va_list.
+int vd_validate_addv(vd_validate_list* l, const char* name, const char* form, const char* quantity,
+                     double measured, double reference, double tol, int abs_err, const char* note,
+                     va_list ap);
 // Hand the list's results to a caller as vd_sim_validate does (*out exactly n entries, or NULL).
 vd_status vd_validate_finish(vd_validate_list* l, vd_validate_result** out, int* n, vd_error* err);
 

@@ -16,27 +16,66 @@
 // and is let go when the gripper opens. Detachment is the plant's fracture: the event that
 // disconnects the fruit from the root names the site (calyx, abscission node, elsewhere).
 //
-// Control: an episode advances one control step (scene control_dt) at a time under an action:
-// an end-effector velocity (linear and angular, world frame) and a gripper command. The action
-// moves a commanded pose, which damped least-squares inverse kinematics on mj_jac turns into
-// joint targets for the robot's position servos (joint limits respected; gravity compensated).
-// vd_harvest_run drives a whole episode with the scene's scripted method (approach, pre-grasp,
-// grasp, then pull, bend or twist); an external controller (a learning agent, the Python
-// HarvestEnv) calls vd_harvest_reset and vd_harvest_step itself and reads vd_harvest_observe.
+// Three parts, as MuJoCo's mjModel, mjData and mjcb_control:
+// * the robot description (vd_robot): the MJCF loaded once, its site, fingers, arm joints and
+//   collision shapes; immutable, shared by every episode of a batch (any thread);
+// * the episode (vd_harvest): robot state, plant, coupling, grasp, outcomes. It advances one
+//   control step (scene control_dt) at a time under an action: an end-effector velocity (linear
+//   and angular, world frame) and a gripper command (or a joint-space goal: vd_harvest_step_joints). The action moves a
+//   commanded pose, which damped least-squares inverse kinematics on mj_jac turns into joint
+//   targets for the robot's position servos (joint limits respected; gravity compensated);
+// * a controller: anything that reads vd_harvest_observe and calls vd_harvest_step. The scripted
+//   controller (vd_script: approach, pre-grasp, grasp, then pull, bend or twist) is one, written
+//   against this header only; a learning agent (the Python HarvestEnv) is another.
+// The episode never calls a controller. A controller may report its phase
+// (vd_harvest_set_phase, logged as an event) and end the episode with a reason (vd_harvest_end).
 //
 // Ownership: a scene owns its strings; an episode copies the scene and borrows the plant
-// (vd_model), which must outlive it. Nothing is global but MuJoCo's error hook (src/mjtrap/):
-// MuJoCo errors come back as VD_ERR_VALUE, never an exit. One episode per thread; episodes on
-// different threads are independent (same seed, same bytes).
+// (vd_model) and the robot description, which must outlive it. Nothing is global but MuJoCo's
+// error hook (src/mjtrap/): MuJoCo errors come back as VD_ERR_VALUE, never an exit. One episode
+// per thread; episodes on different threads are independent (same seed, same bytes).
 //
-// Usage (an external controller):
-//   vd_scene sc; vd_scene_read("data/scenes/tomato_pull.json", &sc, &err);
-//   /* load the plant sc.plant_path with sc.plant_seed (lsys or plant JSON) -> plant */
-//   vd_harvest* h; vd_harvest_create(&sc, plant, &h, &err);
+// Statuses: VD_OK whenever the call did what it says, whatever the episode's outcome (no
+// reachable fruit is an outcome: vd_harvest_observe's target_reason, the summary's reason);
+// VD_ERR_ARG for a call the episode's state does not allow; VD_ERR_VALUE for bad input (an MJCF
+// without the named site, q0 out of range) or a simulation that failed (the episode is then
+// done); VD_ERR_IO / VD_ERR_FORMAT / VD_ERR_NOMEM as everywhere.
+//
+// Usage (compiled and run as written by tests/test_robot_example.c, from the source folder):
+//   vd_error err = {0};
+//   vd_scene sc;
+//   vd_scene_read("data/scenes/tomato_pull.json", &sc, &err);
+//   vd_lsystem* ls;                                        // the scene's plant, an .lpy here
+//   vd_lsys_load(sc.plant_path, &ls, &err);                // (a plant JSON: vd_plant_read_json)
+//   vd_lsys_def def = vd_lsys_def_default();
+//   def.seed = sc.plant_seed;
+//   vd_plant_spec* spec = vd_plant_spec_create();
+//   vd_lsys_grow(ls, &def, NULL, spec, &err);
+//   vd_plant_set_instances(spec, VD_INSTANCE_ORGANS);      // one instance per fruit
+//   vd_scene_place_plant(&sc, spec);
+//   vd_model* plant;
+//   vd_plant_compile(spec, &plant, &err);
+//   vd_robot* robot;                                       // once for a whole batch
+//   vd_robot_load(&sc, &robot, &err);
+//   vd_harvest* h;
+//   vd_harvest_create_with(&sc, robot, plant, &h, &err);
 //   vd_harvest_reset(h, 7, &err);
 //   vd_harvest_action a = {{0, 0, -0.02}, {0, 0, 0}, 1.0};   // down at 2 cm/s, gripper closed
-//   while (!vd_harvest_done(h)) { vd_harvest_step(h, &a, &err); vd_harvest_observe(h, &obs); }
-//   vd_harvest_destroy(h); vd_scene_free(&sc);
+//   vd_harvest_obs obs;
+//   for (int k = 0; k < 50 && !vd_harvest_done(h); k++) {  // an external controller
+//     vd_harvest_step(h, &a, &err);
+//     vd_harvest_observe(h, &obs);
+//   }
+//   vd_harvest_reset(h, 7, &err);                          // the scripted controller instead
+//   vd_harvest_run(h, NULL, NULL, &err);
+//   vd_harvest_summary sum;
+//   vd_harvest_summarize(h, &sum);                         // sum.reason: "detached", ...
+//   vd_harvest_destroy(h);
+//   vd_robot_destroy(robot);
+//   vd_model_destroy(plant);
+//   vd_plant_spec_destroy(spec);
+//   vd_lsys_destroy(ls);
+//   vd_scene_free(&sc);
 #ifndef VERDANT_ROBOT_H
 #define VERDANT_ROBOT_H
 
@@ -163,9 +202,24 @@ vd_status vd_scene_episode(const vd_scene* s, uint64_t seed, int64_t k, vd_scene
                            uint64_t* target_seed, vd_error* err);
 
 // ---------------------------------------------------------------------------------------------
+// robot descriptions
+
+// A robot loaded from its MJCF (immutable; share it between episodes and threads).
+typedef struct vd_robot vd_robot;
+
+// Load the scene's robot: the MJCF scene->robot_path (VD_ERR_IO / VD_ERR_FORMAT naming the file,
+// line where MuJoCo gives one), its end-effector site scene->ee_site, fingers scene->gripper and
+// the arm joints between them and the root (VD_ERR_VALUE naming what is missing), the collision
+// shapes of its collidable geoms. Every scene with the same robot_path, ee_site and gripper may
+// use it (vd_harvest_create_with).
+vd_status vd_robot_load(const vd_scene* scene, vd_robot** out, vd_error* err);
+// Free a robot description (NULL is fine); after every episode that uses it.
+void vd_robot_destroy(vd_robot* r);
+
+// ---------------------------------------------------------------------------------------------
 // episodes
 
-// One harvest episode: robot, plant and their coupling.
+// One harvest episode: robot state, plant and their coupling.
 typedef struct vd_harvest vd_harvest;
 
 // Control action of one step.
@@ -175,9 +229,9 @@ typedef struct vd_harvest_action {
   double gripper;   // gripper command in [0, 1]: 0 open, 1 closed
 } vd_harvest_action;
 
-// Phases of the scripted controller (VD_PHASE_EXTERNAL under an external controller).
+// Phases of a controller (VD_PHASE_EXTERNAL until a controller reports one).
 typedef enum vd_harvest_phase {
-  VD_PHASE_EXTERNAL = 0, // driven by vd_harvest_step's caller
+  VD_PHASE_EXTERNAL = 0, // no phase reported
   VD_PHASE_APPROACH,     // to the pre-grasp pose, gripper open
   VD_PHASE_REACH,        // straight in to the grasp pose
   VD_PHASE_CLOSE,        // closing until both fingers touch
@@ -214,13 +268,22 @@ typedef struct vd_harvest_obs {
   vd_vec3 ee_pos;           // end-effector site position (m)
   vd_quat ee_quat;          // end-effector site orientation
   vd_vec3 cmd_pos;          // commanded end-effector position (m)
-  int target_instance;      // the target fruit's organ instance
+  vd_quat cmd_quat;         // ... orientation
+  const double* q_cmd;      // the servos' joint targets (nq), valid until the next step
+  const double* q0;         // initial arm joints (nq)
+  double cmd_scale;         // fraction of the last action's motion the command took (joint speed
+                            // limits scale a step down; 0 when out of reach)
+  int orient;               // 1 when the arm can turn the end-effector (a gantry cannot)
+  vd_vec3 base_pos;         // the robot's root body (m)
+  int target_instance;      // the target fruit's organ instance; 0: none
+  const char* target_reason; // why there is none ("no fruit", "no such fruit", "unreachable",
+                            // "no reachable fruit"), else NULL
   vd_vec3 fruit_pos;        // the target fruit's centre (m)
   vd_vec3 fruit_vel;        // its velocity (m/s)
   int held;                 // 1 while the fruit is held
   int touching[2];          // finger l / r touches the target fruit
   double finger_force[2];   // normal force of each finger on the fruit (N)
-  double grip_force;        // squeeze on the held fruit (N per finger)
+  double grip_force;        // squeeze on the held fruit: the finger actuators' mean force (N)
   vd_vec3 pull_force;       // force of the held fruit on the gripper (N)
   double pull_torque;       // torque of the held fruit on the gripper (N m)
   double slip;              // slip of the held fruit in the grip so far (m)
@@ -276,40 +339,92 @@ typedef struct vd_harvest_summary {
   double ik_error;             // inverse kinematics residual at the grasp pose (m)
   double track_error;          // end-effector distance from the commanded pose at grasp (m)
   double slip;                 // slip in the grip (m)
+  double grip_force;           // the fingers' measured mean squeeze when the fruit came off (or
+                               // when last held) (N)
   double duration;             // simulated time of the episode (s)
   int64_t steps;               // control steps
   int64_t plant_warnings;      // numerical warnings of the plant simulation
   int target_instance;         // the target fruit
+  int events_dropped;          // events the log had no memory for (none is logged after one)
   char reason[128];            // why it ended ("detached", "not grasped", "time", ...)
+  char detail[256];            // the reason in words where there is more to say (which fruit,
+                               // how far), else ""
 } vd_harvest_summary;
 
-// Build an episode from a scene and its plant (placed already: vd_scene_place_plant): load the
-// MJCF (VD_ERR_IO / VD_ERR_FORMAT naming the file, line where MuJoCo gives one), find the site,
-// fingers and arm joints (VD_ERR_VALUE naming what is missing), build the rod model, then reset
-// with seed 0. The plant must outlive the episode.
+// A fruit of the plant as an episode sees it now.
+typedef struct vd_harvest_fruit {
+  int instance;     // organ instance
+  vd_vec3 pos;      // centre (m)
+  vd_vec3 calyx;    // the calyx: where the fruit's stalk starts (m)
+  vd_vec3 knuckle;  // the pedicel's abscission node within 8 segments of the fruit, else the calyx
+  double radius;    // (m)
+  int attached;     // 1 while on the plant
+} vd_harvest_fruit;
+
+// Build an episode from a scene, a robot description loaded for a scene with the same robot
+// (VD_ERR_ARG when the scene names another MJCF, site or fingers) and the plant (placed already:
+// vd_scene_place_plant): the robot's model copied (no parsing) with the scene's base pose and
+// grip force, q0 and time steps checked (VD_ERR_VALUE), the rod model built, then reset with
+// seed 0. The plant and the robot must outlive the episode.
+vd_status vd_harvest_create_with(const vd_scene* scene, const vd_robot* robot, const vd_model* plant,
+                                 vd_harvest** out, vd_error* err);
+// The same with a robot description of its own, loaded from the scene (vd_robot_load's errors).
 vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_harvest** out,
                             vd_error* err);
 // Free an episode (NULL is fine).
 void vd_harvest_destroy(vd_harvest* h);
-// Start again: robot at q0, plant at its modelled (sag-free) shape, events cleared, the target
-// chosen (a random reachable fruit from seed when target_instance is -1), the scripted
-// controller at its first phase. VD_ERR_VALUE when no fruit is reachable (the episode is then
-// done, with reason "unreachable").
+// Start again: robot at q0, plant at its modelled (sag-free) shape, events cleared, phase
+// external, the target chosen (a random reachable fruit from seed when target_instance is -1).
+// Without a target (none reachable, no fruit, an instance the plant does not have) the episode
+// still runs under an external controller; observations say why (target_reason), and the
+// scripted controller ends it at once with that reason. VD_OK unless MuJoCo failed.
 vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err);
-// Advance one control step under action a (external control: the scripted controller is off
-// until the next reset). VD_ERR_VALUE when MuJoCo or the plant failed (the episode is done).
+// Advance one control step under action a. VD_ERR_ARG when the episode is over or the action is
+// not finite; VD_ERR_VALUE when MuJoCo or the plant failed (the episode is then done).
 vd_status vd_harvest_step(vd_harvest* h, const vd_harvest_action* a, vd_error* err);
-// The scripted controller's action for the current state (stepping with it through
-// vd_harvest_step turns the scripted controller off; vd_harvest_step_scripted keeps it on).
-void vd_harvest_scripted_action(vd_harvest* h, vd_harvest_action* a);
-// Advance one control step under the scene's scripted controller, with its phase bookkeeping:
-// a caller can observe between steps and the episode is the same, byte for byte, as
-// vd_harvest_run's. VD_ERR_ARG when the episode is over or vd_harvest_step has driven it since
-// the last reset; VD_ERR_VALUE when MuJoCo or the plant failed (the episode is done).
-vd_status vd_harvest_step_scripted(vd_harvest* h, vd_error* err);
-// Run the scene's scripted method to the end (detached and held, failed, or duration).
-// on_step (Nullable) is called once before the first control step and after every one (for
-// outputs and progress); a status it returns stops the run and is returned.
+// Advance one control step in joint space: the joint targets move straight toward q (the nq arm
+// joints, MJCF order; rad or m; clamped to the joints' ranges), every joint arriving together
+// under the joints' speed limits; gripper as in an action. Errors as vd_harvest_step's.
+vd_status vd_harvest_step_joints(vd_harvest* h, const double* q, double gripper, vd_error* err);
+// A controller's phase, for observations; a change is logged as a VD_EV_PHASE event.
+void vd_harvest_set_phase(vd_harvest* h, vd_harvest_phase p);
+// End the episode with a reason (a controller gave up, "approach timeout"); nothing when over.
+void vd_harvest_end(vd_harvest* h, const char* reason);
+// The grasp geometry of the target fruit where it is now: the grasp point (its centre), the
+// gripper's orientation (z along the approach, fingers closing across the pedicel), the
+// approach direction and the pedicel axis (calyx to centre). 0 when there is no target.
+int vd_harvest_grasp_pose(vd_harvest* h, vd_vec3* pos, vd_quat* rot, vd_vec3* approach,
+                          vd_vec3* pedicel);
+// The plant's fruits now: how many there are; the first cap of them into out (Nullable).
+int vd_harvest_fruits(const vd_harvest* h, vd_harvest_fruit* out, int cap);
+// The fruit with organ instance id; VD_ERR_ARG when the plant has none.
+vd_status vd_harvest_find_fruit(const vd_harvest* h, int instance, vd_harvest_fruit* out, vd_error* err);
+
+// ---------------------------------------------------------------------------------------------
+// the scripted controller (a client of the functions above; src/robot/robot_control.c)
+
+// The scene's scripted method driving one episode: approach in joint space to the pre-grasp pose,
+// reach in along the approach, close until the fingers hold, then pull, bend or twist, hold the
+// detached fruit. It reports its phases and ends the episode on its timeouts.
+typedef struct vd_script vd_script;
+
+// A scripted controller for episode h, beginning at h's current state (after vd_harvest_reset;
+// an episode without a target is ended at once with its target_reason). VD_ERR_NOMEM only.
+vd_status vd_script_create(vd_harvest* h, vd_script** out, vd_error* err);
+// Free it (NULL is fine).
+void vd_script_destroy(vd_script* c);
+// The action for the current state (also advances the controller's own plan; call once per step).
+// During the approach the script moves in joint space: the action is then zero and *joints
+// (Nullable) gets 1 with the goal in q (nq values; vd_script_step steps with
+// vd_harvest_step_joints); else *joints gets 0.
+void vd_script_action(vd_script* c, vd_harvest_action* a, int* joints, double* q);
+// One control step: the action, vd_harvest_step, the phase bookkeeping. VD_ERR_ARG when the
+// episode is over; vd_harvest_step's errors.
+vd_status vd_script_step(vd_script* c, vd_error* err);
+// Run the scene's scripted method from the current state (just reset) to the end (detached and
+// held, failed, or duration). on_step (Nullable) is called once before the first control step
+// and after every one (for outputs and progress); a status it returns stops the run and is
+// returned.
 vd_status vd_harvest_run(vd_harvest* h, vd_status (*on_step)(void* user, const vd_harvest* h),
                          void* user, vd_error* err);
 // 1 when the episode is over.

@@ -308,11 +308,18 @@ typedef struct vd_sim_event {
   int cause;          // 0 force, 1 moment, 2 C_s, 3 C_b
 } vd_sim_event;
 
-// A user tie: a node pulled toward a target point by a spring (a displacement pull).
+// A user tie: a node pulled toward a target point by a spring (a displacement pull). A tie with
+// max_force > 0 is a friction-limited hold (a grasp): the part of its pull across axis may not
+// exceed max_force; at every solver iteration, before the tie enters the solve, a target farther
+// than that lets its target slide toward the node (slip grows by the distance), so the limit
+// holds inside the solve, not after it. Along axis (the fingers' closing direction) it holds.
 typedef struct vd_sim_tie {
   int node;           // rod node
   vd_vec3 target;     // target point (m), may move each step
   double compliance;  // 1 / stiffness (m/N), > 0
+  double max_force;   // largest pull across axis (N); 0: unlimited (vd_sim_add_tie's default)
+  vd_vec3 axis;       // unit direction left unlimited; zero: the whole pull limited
+  double slip;        // how far the target has slid so far (m)
 } vd_sim_tie;
 
 // The state of one rod model.

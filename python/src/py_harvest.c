@@ -57,7 +57,7 @@ static int same_method(const vd_method_def* a, const vd_method_def* b) {
 static int no_target(const vd_harvest* h) {
   vd_harvest_obs b;
   vd_harvest_observe(h, &b);
-  return vd_harvest_done(h) || b.phase == VD_PHASE_DONE;
+  return vd_harvest_done(h) || b.target_reason != NULL;  // none chosen at the reset
 }
 
 // the episode of scene s (taken into o->scene): plant grown when its seed differs, episode built
@@ -89,7 +89,6 @@ static vd_status episode(vdpy_slot* o, vd_scene* s, uint64_t target_seed, vd_err
     vd_harvest_destroy(o->h);
     o->h = NULL;
     st = vd_harvest_create(&o->scene, o->plant, &o->h, err);
-    if (o->h && st == VD_ERR_VALUE) st = VD_OK;  // an unreachable target is an outcome: done
     if (st) return st;
   }
   memset(err, 0, sizeof *err);

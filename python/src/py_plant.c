@@ -34,165 +34,26 @@ typedef struct grow_args {
   char (*label_name)[VD_LABEL_NAME_MAX];  // --label names
   double curve[3];       // curve step, connect, distance (m), < 0: file's or default
   vd_lsys_engine engine; // who runs the file's Python (--engine)
-  int module_instances;  // instances="modules": the turtle's numbering (0: one per organ)
+  int instances;         // instances=: a vd_instance_mode, or VD_INSTANCE_DEFAULT
 } grow_args;
 
-// What grow() made.
-typedef struct grow_out {
-  vd_plant_spec* spec;
-  int64_t modules;       // modules of the derived string (0 for files)
-  int nsym;
-  int64_t* sym_count;    // per symbol (nsym), vd_malloc
-  char (*sym_name)[64];  // per symbol (nsym), vd_malloc
-  double seconds_derive, seconds_turtle;
-  const char* engine;    // the engine that ran an .lpy ("native", "python"), NULL for files
-} grow_out;
-
-static void grow_out_free(grow_out* o) {
-  vd_plant_spec_destroy(o->spec);
-  vd_free(o->sym_count, (size_t)o->nsym * sizeof *o->sym_count);
-  vd_free(o->sym_name, (size_t)o->nsym * sizeof *o->sym_name);
-  memset(o, 0, sizeof *o);
-}
-
-static double now(void) {
-  struct timespec ts;
-  timespec_get(&ts, TIME_UTC);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-// name labels: the caller's, after the file's (the command line's --label order)
-static vd_status apply_labels(const grow_args* a, vd_plant_spec* s) {
-  vd_status st = VD_OK;
-  for (int i = 0; !st && i < a->nlabel; i++) st = vd_plant_set_label(s, a->label_id[i], a->label_name[i]);
-  return st;
-}
-
-// a JSON text: a plant file or a curves file by its "format"
-static vd_status grow_json(const grow_args* a, const char* text, size_t len, const char* name,
-                           grow_out* out, vd_error* err) {
-  char fmt[32];
-  int curves = !strcmp(vd_plant_json_format(text, len, fmt, sizeof fmt), "verdant-curves");
-  if (a->nset) return vd_error_set(err, VD_ERR_ARG, name, 0, 0, "set= applies to .lpy files only");
-  if (!curves && (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0))
-    return vd_error_set(err, VD_ERR_ARG, name, 0, 0, "curve_* options apply to curves files only");
-  vd_status st;
-  if (curves) {
-    vd_curves* c;
-    st = vd_curves_parse(text, len, name, &c, err);
-    if (st) return st;
-    vd_curves_def def = vd_curves_file_def(c);
-    if (a->curve[0] >= 0) def.sample_step = a->curve[0];
-    if (a->curve[1] >= 0) def.connect = a->curve[1];
-    if (a->curve[2] >= 0) def.distance = a->curve[2];
-    out->spec = vd_plant_spec_create();
-    st = out->spec ? vd_curves_build(c, &def, out->spec, NULL, err)
-                   : vd_error_set(err, VD_ERR_NOMEM, name, 0, 0, "out of memory");
-    vd_curves_destroy(c);
-  } else {
-    st = vd_plant_parse_json(text, len, name, &out->spec, err);
-  }
-  if (!st) st = apply_labels(a, out->spec);
-  return st;
-}
-
-// an L-system: derive, interpret, turtle, labels; module counts by symbol
-static vd_status grow_lsys(const grow_args* a, vd_lsystem* ls, const char* name, grow_out* out,
-                           vd_error* err) {
-  vd_status st = VD_OK;
-  out->engine = vd_lsys_engine_name(vd_lsys_get_engine(ls));
-  for (int i = 0; !st && i < a->nset; i++) st = vd_lsys_set_global(ls, a->set_name[i], a->set_value[i], err);
-  if (st) return st;
-  out->spec = vd_plant_spec_create();
-  if (!out->spec) return vd_error_set(err, VD_ERR_NOMEM, name, 0, 0, "out of memory");
-  vd_lstring derived = vd_lstring_empty(), geo = vd_lstring_empty();
-  double t0 = now();
-  st = vd_lsys_derive(ls, &a->def, &derived, err);
-  double t1 = now();
-  if (!st) st = vd_lsys_interpret(ls, &a->def, &derived, &geo, err);
-  if (!st) {
-    vd_turtle_def td = vd_turtle_def_default();
-    st = vd_turtle_run(ls, &geo, &td, out->spec, err);
-  }
-  double t2 = now();
-  for (int i = 0; !st && i < vd_lsys_label_count(ls); i++) {
-    int id;
-    const char* label;
-    vd_lsys_label_get(ls, i, &id, &label);
-    st = vd_plant_set_label(out->spec, id, label);
-  }
-  if (!st) st = apply_labels(a, out->spec);
-  if (!st) st = vd_plant_complete_labels(out->spec);
-  // one instance per organ, as the command line (instances="modules": per module)
-  if (!st && (st = vd_plant_set_instances(out->spec, a->module_instances ? VD_INSTANCE_MODULES : VD_INSTANCE_ORGANS)))
-    vd_error_set(err, st, name, 0, 0, "out of memory");
-  if (!st) {
-    out->modules = derived.n;
-    out->nsym = vd_lsys_symbol_count(ls);
-    out->sym_count = vd_calloc((size_t)out->nsym, sizeof *out->sym_count);
-    out->sym_name = vd_calloc((size_t)out->nsym, sizeof *out->sym_name);
-    if (!out->sym_count || !out->sym_name) {
-      st = vd_error_set(err, VD_ERR_NOMEM, name, 0, 0, "out of memory");
-    } else {
-      for (int64_t i = 0; i < derived.n; i++) out->sym_count[derived.sym[i]]++;
-      for (int k = 0; k < out->nsym; k++)
-        snprintf(out->sym_name[k], sizeof out->sym_name[k], "%s", vd_lsys_symbol_name(ls, k));
-    }
-    out->seconds_derive = t1 - t0;
-    out->seconds_turtle = t2 - t1;
-  }
-  vd_lstring_free(&derived);
-  vd_lstring_free(&geo);
-  return st;
-}
-
-// grow_lsys, again in CPython when the automatic engine choice took native and native refused
-// what it met only when running (vd_lsys_fallback)
-static vd_status grow_lsys_auto(const grow_args* a, vd_lsystem** ls, const char* name, grow_out* out,
-                                vd_error* err) {
-  vd_status st = grow_lsys(a, *ls, name, out, err);
-  if (st && vd_lsys_fallback(ls, st)) {
-    vd_plant_spec_destroy(out->spec);
-    out->spec = NULL;
-    memset(err, 0, sizeof *err);
-    st = grow_lsys(a, *ls, name, out, err);
-  }
-  return st;
-}
-
-// the whole load, without the GIL
-static vd_status grow_run(const grow_args* a, grow_out* out, vd_error* err) {
-  const char* name = a->path[0] ? a->path : "<string>";
-  if (!a->path[0]) {
-    size_t len = (size_t)a->text_len;
-    const char* p = a->text;
-    while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n') p++;
-    if (*p == '{') return grow_json(a, a->text, len, name, out, err);
-    if (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0)
-      return vd_error_set(err, VD_ERR_ARG, name, 0, 0, "curve_* options apply to curves files only");
-    vd_lsystem* ls;
-    vd_status st = vd_lsys_parse_engine(a->text, len, name, a->engine, &ls, err);
-    if (st) return st;
-    st = grow_lsys_auto(a, &ls, name, out, err);
-    vd_lsys_destroy(ls);
-    return st;
-  }
-  if (has_ext(a->path, ".json")) {
-    char* text;
-    size_t len;
-    vd_status st = vd_file_read(a->path, &text, &len, err);
-    if (st) return st;
-    st = grow_json(a, text, len, a->path, out, err);
-    vd_free(text, len + 1);
-    return st;
-  }
-  if (a->curve[0] >= 0 || a->curve[1] >= 0 || a->curve[2] >= 0)
-    return vd_error_set(err, VD_ERR_ARG, a->path, 0, 0, "curve_* options apply to curves files only");
-  vd_lsystem* ls;
-  vd_status st = vd_lsys_load_engine(a->path, a->engine, &ls, err);
-  if (st) return st;
-  st = grow_lsys_auto(a, &ls, a->path, out, err);
-  vd_lsys_destroy(ls);
+// the whole load, without the GIL: the library's one loader (vd_plant_load), as the command line
+static vd_status grow_run(const grow_args* a, vd_plant_spec** out, vd_plant_load_info* info, vd_error* err) {
+  const char** names = vd_calloc((size_t)a->nset + (size_t)a->nlabel + 1, sizeof *names);
+  if (!names) return vd_error_set(err, VD_ERR_NOMEM, a->path, 0, 0, "out of memory");
+  const char** labels = names + a->nset;
+  for (int i = 0; i < a->nset; i++) names[i] = a->set_name[i];
+  for (int i = 0; i < a->nlabel; i++) labels[i] = a->label_name[i];
+  vd_plant_load_def d = vd_plant_load_def_default();
+  d.lsys = a->def;
+  d.engine = a->engine;
+  d.set_name = names, d.set_value = (const char* const*)a->set_value, d.nset = a->nset;
+  d.label_id = a->label_id, d.label_name = labels, d.nlabel = a->nlabel;
+  d.curve_step = a->curve[0], d.curve_connect = a->curve[1], d.curve_distance = a->curve[2];
+  d.instances = a->instances;
+  vd_status st = a->path[0] ? vd_plant_load(a->path, &d, out, info, err)
+                            : vd_plant_load_text(a->text, (size_t)a->text_len, NULL, &d, out, info, err);
+  vd_free(names, ((size_t)a->nset + (size_t)a->nlabel + 1) * sizeof *names);
   return st;
 }
 
@@ -205,6 +66,7 @@ vd_status vdpy_grow_file(const char* path, uint64_t seed, int steps, char* const
   a.def.seed = seed;
   a.def.steps = steps;
   a.curve[0] = a.curve[1] = a.curve[2] = -1;
+  a.instances = VD_INSTANCE_DEFAULT;
   snprintf(a.path, sizeof a.path, "%s", path);
   // "NAME=VALUE" overrides, split into the arrays grow_run reads
   char(*names)[128] = nset ? vd_calloc((size_t)nset, sizeof *names) : NULL;
@@ -221,18 +83,14 @@ vd_status vdpy_grow_file(const char* path, uint64_t seed, int steps, char* const
     values[i] = eq ? (char*)eq + 1 : (char*)"";
   }
   a.nset = nset, a.set_name = names, a.set_value = values;
-  grow_out o;
-  memset(&o, 0, sizeof o);
-  vd_status st = grow_run(&a, &o, err);
-  if (!st) *out = o.spec, o.spec = NULL;
-  grow_out_free(&o);
+  vd_status st = grow_run(&a, out, NULL, err);
   vd_free(names, (size_t)nset * sizeof *names);
   vd_free(values, (size_t)nset * sizeof *values);
   return st;
 }
 
 // the derivation's summary: modules, module_counts (by symbol, in symbol order), seconds
-static PyObject* grow_info(const grow_out* o, int lsys) {
+static PyObject* grow_info(const vd_plant_load_info* o, int lsys) {
   if (!lsys) return PyDict_New();
   PyObject* counts = PyDict_New();
   for (int k = 0; counts && k < o->nsym; k++) {
@@ -266,6 +124,7 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   a.def = vd_lsys_def_default();
   a.def.max_modules = 50000000;  // the command line's default
   a.curve[0] = a.curve[1] = a.curve[2] = -1;
+  a.instances = VD_INSTANCE_DEFAULT;
   PyObject* values = NULL;  // keeps set= texts alive
   PyObject* result = NULL;
   PyObject* o;
@@ -309,8 +168,9 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
   if ((o = vdpy_kw(kw, "instances"))) {
     char e[16];
     if (!vdpy_str(o, "instances", e, sizeof e)) return NULL;
-    if (!strcmp(e, "modules")) a.module_instances = 1;
-    else if (strcmp(e, "organs")) return vdpy_arg_error("instances expects 'organs' or 'modules', got '%s'", e);
+    if (!strcmp(e, "modules")) a.instances = VD_INSTANCE_MODULES;
+    else if (!strcmp(e, "organs")) a.instances = VD_INSTANCE_ORGANS;
+    else return vdpy_arg_error("instances expects 'organs' or 'modules', got '%s'", e);
   }
   const char* curve_names[3] = {"curve_step", "curve_connect", "curve_distance"};
   for (int k = 0; k < 3; k++)
@@ -362,25 +222,27 @@ PyObject* vdpy_grow(PyObject* self, PyObject* args, PyObject* kw) {
     }
   }
   {
-    grow_out out;
+    vd_plant_spec* spec = NULL;
+    vd_plant_load_info out;
     memset(&out, 0, sizeof out);
     vd_error err = {0};
     vd_status st;
     Py_BEGIN_ALLOW_THREADS
-    st = grow_run(&a, &out, &err);
+    st = grow_run(&a, &spec, &out, &err);
     Py_END_ALLOW_THREADS
     if (st) {
       if (!err.file[0] && err.status) snprintf(err.file, sizeof err.file, "%.255s", label);
       vdpy_raise(st, &err);
     } else {
-      PyObject* info = grow_info(&out, out.nsym > 0);
+      PyObject* info = grow_info(&out, out.format == VD_PLANT_FORMAT_LPY);
       if (info) {
-        result = vdpy_plant_new(out.spec, a.def.seed, label, info);
-        out.spec = NULL;  // taken
+        result = vdpy_plant_new(spec, a.def.seed, label, info);
+        spec = NULL;  // taken
         Py_DECREF(info);
       }
     }
-    grow_out_free(&out);
+    vd_plant_spec_destroy(spec);
+    vd_plant_load_info_free(&out);
   }
 done:
   Py_XDECREF(values);

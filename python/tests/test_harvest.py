@@ -85,7 +85,9 @@ def test_scripted_run_equals_cli(cli):
     ref = json.loads(cli("harvest", PICK, "--stats").stdout)
     assert s["detached"] == ref["detached"] and s["site"] == ref["site"] and s["reason"] == ref["reason"]
     assert s["steps"] == ref["steps"] and s["target_instance"] == ref["target_instance"]
-    assert s["pull_force"] == ref["pull_force"] and s["time"] == pytest.approx(ref["detach_time"] or s["time"])
+    # the same double: cJSON prints 15 digits whenever they read back within DBL_EPSILON
+    assert s["pull_force"] == pytest.approx(ref["pull_force"], rel=4e-16, abs=0)
+    assert s["time"] == pytest.approx(ref["detach_time"] or s["time"])
     with pytest.raises(verdant.ArgumentError):
         h.step((0, 0, 0), (0, 0, 0), 0)                 # the episode is over
     h.reset(0)

@@ -27,55 +27,11 @@ static int field_of(const char* name) {
   return -1;
 }
 
-// scalar types of binary columns
-typedef enum { T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_I64, T_U64, T_F32, T_F64, T_BAD } ctype;
-static const int type_size[] = {1, 1, 2, 2, 4, 4, 8, 8, 4, 8, 0};
-
-static ctype ply_type(const char* s) {
-  static const struct {
-    const char* name;
-    ctype t;
-  } tab[] = {{"char", T_I8},     {"int8", T_I8},    {"uchar", T_U8},   {"uint8", T_U8},
-             {"short", T_I16},   {"int16", T_I16},  {"ushort", T_U16}, {"uint16", T_U16},
-             {"int", T_I32},     {"int32", T_I32},  {"uint", T_U32},   {"uint32", T_U32},
-             {"float", T_F32},   {"float32", T_F32}, {"double", T_F64}, {"float64", T_F64}};
-  for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++)
-    if (!strcmp(s, tab[i].name)) return tab[i].t;
-  return T_BAD;
-}
-
-static double get_le(const unsigned char* p, ctype t) {
-  uint64_t u = 0;
-  for (int k = type_size[t] - 1; k >= 0; k--)
-    u = (u << 8) | p[k];
-  switch (t) {
-    case T_I8: return (double)(int8_t)u;
-    case T_U8: return (double)(uint8_t)u;
-    case T_I16: return (double)(int16_t)u;
-    case T_U16: return (double)(uint16_t)u;
-    case T_I32: return (double)(int32_t)u;
-    case T_U32: return (double)(uint32_t)u;
-    case T_I64: return (double)(int64_t)u;
-    case T_U64: return (double)u;
-    case T_F32: {
-      uint32_t w = (uint32_t)u;
-      float f;
-      memcpy(&f, &w, 4);
-      return (double)f;
-    }
-    default: {
-      double d;
-      memcpy(&d, &u, 8);
-      return d;
-    }
-  }
-}
-
 // a table of columns: name, type, byte offset in a binary record, field fed
 typedef struct cols {
   int n;
   char name[64][64];
-  ctype type[64];
+  vd_scalar type[64];
   int offset[64];
   int field[64];
   int record;  // bytes per binary record
@@ -249,7 +205,7 @@ static vd_status read_binary_rows(reader* r, const unsigned char* data, size_t a
     const unsigned char* rec = data + (size_t)i * (size_t)cs->record;
     for (int k = 0; k < cs->n; k++) {
       if (cs->field[k] < 0) continue;
-      if (!put_field(c, i, cs->field[k], get_le(rec + cs->offset[k], cs->type[k]))) {
+      if (!put_field(c, i, cs->field[k], vd_scalar_get_le(rec + cs->offset[k], cs->type[k]))) {
         return fail(r, 0, "column '%s' of point %lld (byte %llu): bad value", cs->name[k], (long long)i,
                     (unsigned long long)base + (unsigned long long)i * (unsigned long long)cs->record + (unsigned long long)cs->offset[k]);
       }
@@ -311,14 +267,14 @@ static vd_status read_ply(reader* r, const char* s, size_t len, vd_cloud* out) {
       if (k >= 2 && !strcmp(tok[1], "list"))
         return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, t.line, 0, "list properties are not supported in clouds");
       if (k != 3) return fail(r, t.line, "expected 'property TYPE NAME'");
-      ctype ty = ply_type(tok[1]);
-      if (ty == T_BAD) return fail(r, t.line, "unknown property type '%s'", tok[1]);
+      vd_scalar ty = vd_scalar_ply(tok[1]);
+      if (ty == VD_SCALAR_BAD) return fail(r, t.line, "unknown property type '%s'", tok[1]);
       if (cs.n == 64) return fail(r, t.line, "more than 64 properties");
       if (strlen(tok[2]) >= sizeof cs.name[0]) return fail(r, t.line, "property name too long");
       strcpy(cs.name[cs.n], tok[2]);
       cs.type[cs.n] = ty;
       cs.offset[cs.n] = cs.record;
-      cs.record += type_size[ty];
+      cs.record += vd_scalar_size(ty);
       cs.n++;
     } else {
       return fail(r, t.line, "unknown header line '%.40s'", tok[0]);
@@ -409,12 +365,12 @@ static vd_status read_pcd(reader* r, const char* s, size_t len, vd_cloud* out) {
   for (int i = 0; i < cs.n; i++) {
     if (ncount >= 0 && counts[i] != 1)
       return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, 0, 0, "field '%s': COUNT %d is not supported", cs.name[i], counts[i]);
-    ctype ty = T_BAD;
+    vd_scalar ty = VD_SCALAR_BAD;
     int sz = sizes[i];
-    if (types[i] == 'F') ty = sz == 4 ? T_F32 : sz == 8 ? T_F64 : T_BAD;
-    if (types[i] == 'U') ty = sz == 1 ? T_U8 : sz == 2 ? T_U16 : sz == 4 ? T_U32 : sz == 8 ? T_U64 : T_BAD;
-    if (types[i] == 'I') ty = sz == 1 ? T_I8 : sz == 2 ? T_I16 : sz == 4 ? T_I32 : sz == 8 ? T_I64 : T_BAD;
-    if (ty == T_BAD) return fail(r, 0, "field '%s': bad SIZE/TYPE", cs.name[i]);
+    if (types[i] == 'F') ty = sz == 4 ? VD_SCALAR_F32 : sz == 8 ? VD_SCALAR_F64 : VD_SCALAR_BAD;
+    if (types[i] == 'U') ty = sz == 1 ? VD_SCALAR_U8 : sz == 2 ? VD_SCALAR_U16 : sz == 4 ? VD_SCALAR_U32 : sz == 8 ? VD_SCALAR_U64 : VD_SCALAR_BAD;
+    if (types[i] == 'I') ty = sz == 1 ? VD_SCALAR_I8 : sz == 2 ? VD_SCALAR_I16 : sz == 4 ? VD_SCALAR_I32 : sz == 8 ? VD_SCALAR_I64 : VD_SCALAR_BAD;
+    if (ty == VD_SCALAR_BAD) return fail(r, 0, "field '%s': bad SIZE/TYPE", cs.name[i]);
     cs.type[i] = ty;
     cs.offset[i] = cs.record;
     cs.record += sz;
@@ -594,7 +550,7 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
       for (unsigned e = 0; e + 192 <= vlen; e += 192) {
         const unsigned char* d = b + pos + e;
         int dt = d[2];
-        static const ctype map[] = {T_BAD, T_U8, T_I8, T_U16, T_I16, T_U32, T_I32, T_U64, T_I64, T_F32, T_F64};
+        static const vd_scalar map[] = {VD_SCALAR_BAD, VD_SCALAR_U8, VD_SCALAR_I8, VD_SCALAR_U16, VD_SCALAR_I16, VD_SCALAR_U32, VD_SCALAR_I32, VD_SCALAR_U64, VD_SCALAR_I64, VD_SCALAR_F32, VD_SCALAR_F64};
         if (dt < 1 || dt > 10)
           return vd_error_set(r->err, VD_ERR_UNSUPPORTED, r->path, 0, 0, "extra bytes data type %d is not supported", dt);
         if (cs.n == 64) return fail(r, 0, "more than 64 extra dimensions");
@@ -602,7 +558,7 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
         cs.name[cs.n][32] = 0;
         cs.type[cs.n] = map[dt];
         cs.offset[cs.n] = 30 + at;
-        at += type_size[map[dt]];
+        at += vd_scalar_size(map[dt]);
         cs.n++;
       }
       if (at > extra_bytes) return fail(r, 0, "extra bytes descriptors exceed the record length");
@@ -639,7 +595,7 @@ static vd_status read_las(reader* r, const char* s, size_t len, vd_cloud* out) {
     out->label[i] = p[16];
     out->view[i] = (int)le(p + 20, 2);
     for (int k = 0; k < cs.n; k++)
-      if (cs.field[k] >= 0 && !put_field(out, (int64_t)i, cs.field[k], get_le(p + cs.offset[k], cs.type[k])))
+      if (cs.field[k] >= 0 && !put_field(out, (int64_t)i, cs.field[k], vd_scalar_get_le(p + cs.offset[k], cs.type[k])))
         return fail(r, 0, "extra dimension '%s' of point %lld: bad value", cs.name[k], (long long)i);
   }
   r->nview = -1;

@@ -277,44 +277,6 @@ static vd_status read_obj(mreader* r, const char* s, size_t len) {
 // ---------------------------------------------------------------------------------------------
 // PLY
 
-typedef enum { T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64, T_BAD } ptype;
-static const int ptype_size[] = {1, 1, 2, 2, 4, 4, 4, 8, 0};
-
-static ptype ply_type(const char* s) {
-  static const char* names[][2] = {{"char", "int8"},   {"uchar", "uint8"},  {"short", "int16"},
-                                   {"ushort", "uint16"}, {"int", "int32"},  {"uint", "uint32"},
-                                   {"float", "float32"}, {"double", "float64"}};
-  for (int t = 0; t < T_BAD; t++)
-    if (!strcmp(s, names[t][0]) || !strcmp(s, names[t][1])) return (ptype)t;
-  return T_BAD;
-}
-
-// a little-endian binary value
-static double ply_get(const unsigned char* p, ptype t) {
-  uint64_t u = 0;
-  for (int k = ptype_size[t] - 1; k >= 0; k--)
-    u = (u << 8) | p[k];
-  switch (t) {
-  case T_I8: return (double)(int8_t)u;
-  case T_U8: return (double)(uint8_t)u;
-  case T_I16: return (double)(int16_t)u;
-  case T_U16: return (double)(uint16_t)u;
-  case T_I32: return (double)(int32_t)u;
-  case T_U32: return (double)(uint32_t)u;
-  case T_F32: {
-    uint32_t w = (uint32_t)u;
-    float f;
-    memcpy(&f, &w, 4);
-    return (double)f;
-  }
-  default: {
-    double d;
-    memcpy(&d, &u, 8);
-    return d;
-  }
-  }
-}
-
 // what a property of the vertex or face element feeds
 enum { P_NONE, P_X, P_Y, P_Z, P_NX, P_NY, P_NZ, P_INDICES, P_LABEL, P_INSTANCE };
 
@@ -324,8 +286,8 @@ typedef struct pelem {
   char name[32];
   long count;
   int nprop;
-  ptype type[PLY_MAX_PROP];  // scalar type, or the item type of a list
-  ptype count_type[PLY_MAX_PROP]; // T_BAD for scalars
+  vd_scalar type[PLY_MAX_PROP];  // scalar type, or the item type of a list
+  vd_scalar count_type[PLY_MAX_PROP]; // VD_SCALAR_BAD for scalars
   int feed[PLY_MAX_PROP];    // P_*
 } pelem;
 
@@ -356,14 +318,14 @@ typedef struct pbody {
 } pbody;
 
 // next value of type ty; 0 with an error set at the end of the data or on a bad number
-static int ply_next(mreader* r, pbody* pb, ptype ty, double* x, vd_status* st) {
+static int ply_next(mreader* r, pbody* pb, vd_scalar ty, double* x, vd_status* st) {
   if (pb->binary) {
-    size_t k = (size_t)ptype_size[ty];
+    size_t k = (size_t)vd_scalar_size(ty);
     if (pb->nb - pb->ib < k) {
       *st = fail(r, 0, "the binary data end at byte %zu (of the body) inside a record", pb->ib);
       return 0;
     }
-    *x = ply_get(pb->b + pb->ib, ty);
+    *x = vd_scalar_get_le(pb->b + pb->ib, ty);
     pb->ib += k;
     if (!isfinite(*x)) {
       *st = fail(r, 0, "value at byte %zu of the body is not finite", pb->ib - k);
@@ -460,8 +422,8 @@ static vd_status read_ply(mreader* r, const char* s, size_t len) {
         st = fail(r, t.line, "expected 'property TYPE NAME' or 'property list COUNT ITEM NAME'");
         break;
       }
-      ptype ct = list ? ply_type(w[2]) : T_BAD, it = ply_type(w[list ? 3 : 1]);
-      if (it == T_BAD || (list && (ct == T_BAD || ct == T_F32 || ct == T_F64))) {
+      vd_scalar ct = list ? vd_scalar_ply(w[2]) : VD_SCALAR_BAD, it = vd_scalar_ply(w[list ? 3 : 1]);
+      if (it == VD_SCALAR_BAD || (list && (ct == VD_SCALAR_BAD || ct == VD_SCALAR_F32 || ct == VD_SCALAR_F64))) {
         st = fail(r, t.line, "unknown property type");
         break;
       }
@@ -470,7 +432,7 @@ static vd_status read_ply(mreader* r, const char* s, size_t len) {
         break;
       }
       e->type[e->nprop] = it;
-      e->count_type[e->nprop] = list ? ct : T_BAD;
+      e->count_type[e->nprop] = list ? ct : VD_SCALAR_BAD;
       e->feed[e->nprop] = ply_feed(e->name, w[list ? 4 : 2], list);
       e->nprop++;
     } else {
@@ -516,7 +478,7 @@ static vd_status read_ply(mreader* r, const char* s, size_t len) {
       int label = 0, inst = 0, has_n = 0, f0 = r->nf;
       for (int k = 0; !st && k < E->nprop; k++) {
         int feed = E->feed[k];
-        if (E->count_type[k] == T_BAD) { // a scalar
+        if (E->count_type[k] == VD_SCALAR_BAD) { // a scalar
           if (!ply_next(r, pb, E->type[k], &x, &st)) break;
           if (feed >= P_X && feed <= P_Z) pos[feed - P_X] = x;
           if (feed >= P_NX && feed <= P_NZ) nrm[feed - P_NX] = x, has_n = 1;

@@ -344,6 +344,27 @@ static vd_quat node_turn(const vd_plant_spec* s, const int* owner_seg, const vd_
   return qbetween(vd_sub(x[a], x[p]), vd_sub(y[a], y[p]));
 }
 
+// out (a copy of s) with s's nodes at to[] and its spheres and mesh vertices moved with the node
+// they hang from, turned by the turn of that node's internode from s's shape to to[]
+static void turn_organs(const vd_plant_spec* s, const int* owner_seg, const vd_vec3* to, vd_plant_spec* out) {
+  for (int i = 0; i < s->nnode; i++) out->node[i] = to[i];
+  for (int k = 0; k < s->nsphere; k++) {
+    int n = s->sphere[k].node;
+    if (n < 0 && s->sphere[k].parent >= 0) n = s->seg[s->sphere[k].parent].node1;
+    if (n < 0) continue;
+    vd_quat q = node_turn(s, owner_seg, s->node, to, n);
+    out->sphere[k].center = vd_add(to[n], vd_quat_rotate(q, vd_sub(s->sphere[k].center, s->node[n])));
+  }
+  for (int k = 0; k < s->nmesh; k++) {
+    int n = s->mesh[k].node;
+    if (n < 0 && s->mesh[k].parent >= 0) n = s->seg[s->mesh[k].parent].node1;
+    if (n < 0) continue;
+    vd_quat q = node_turn(s, owner_seg, s->node, to, n);
+    for (int v = s->mesh[k].vert_start; v < s->mesh[k].vert_start + s->mesh[k].nvert; v++)
+      out->vert[v] = vd_add(to[n], vd_quat_rotate(q, vd_sub(s->vert[v], s->node[n])));
+  }
+}
+
 // the physics node a plant node moves with: itself when it is one, else the nearest ancestor
 static int find_attach(const vd_plant_spec* s, const int* owner_seg, const int* phys, int n) {
   for (int guard = s->nnode + 1; n >= 0 && guard-- > 0;) {
@@ -369,13 +390,9 @@ static vd_status turtle_plant(vd_growth* g, vd_plant_spec** out, vd_error* err) 
   if (!st) st = vd_lsys_interpret(g->ls, &g->def.lsys, &g->str, &geo, err);
   g->str.src = src;
   if (!st) st = vd_turtle_run(g->ls, &geo, &g->def.turtle, spec, err);
-  for (int i = 0; !st && i < vd_lsys_label_count(g->ls); i++) {
-    int id;
-    const char* name;
-    vd_lsys_label_get(g->ls, i, &id, &name);
-    st = vd_plant_set_label(spec, id, name);
-  }
-  if (!st) st = vd_plant_complete_labels(spec);
+  // labels and instances as every front end names a plant (vd_plant_load: organs)
+  vd_plant_load_def ld = vd_plant_load_def_default();
+  if (!st && (st = vd_plant_load_name(g->ls, &ld, spec))) vd_error_set(err, st, "", 0, 0, "out of memory");
   // the axiom's roots and trunk start at one node (the base)
   if (!st) vd_plant_join_bases(spec);
   vd_lstring_free(&geo);
@@ -778,25 +795,8 @@ static vd_status rebuild(vd_growth* g, int grown, vd_error* err) {
   // the model at rest: the spec's nodes at their rest positions, organs turned with their node
   vd_plant_spec* rs = vd_plant_spec_copy(spec);
   if (!rs) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
-  {
-    for (int i = 0; i < spec->nnode; i++) rs->node[i] = g->rest[i];
-    // spheres and mesh vertices: turtle -> rest with the turn of their node's internode
-    for (int k = 0; k < spec->nsphere; k++) {
-      int n = spec->sphere[k].node;
-      if (n < 0 && spec->sphere[k].parent >= 0) n = spec->seg[spec->sphere[k].parent].node1;
-      if (n < 0) continue;
-      vd_quat q = node_turn(spec, g->owner_seg, spec->node, g->rest, n);
-      rs->sphere[k].center = vd_add(g->rest[n], vd_quat_rotate(q, vd_sub(spec->sphere[k].center, spec->node[n])));
-    }
-    for (int k = 0; k < spec->nmesh; k++) {
-      int n = spec->mesh[k].node;
-      if (n < 0 && spec->mesh[k].parent >= 0) n = spec->seg[spec->mesh[k].parent].node1;
-      if (n < 0) continue;
-      vd_quat q = node_turn(spec, g->owner_seg, spec->node, g->rest, n);
-      for (int v = spec->mesh[k].vert_start; v < spec->mesh[k].vert_start + spec->mesh[k].nvert; v++)
-        rs->vert[v] = vd_add(g->rest[n], vd_quat_rotate(q, vd_sub(spec->vert[v], spec->node[n])));
-    }
-  }
+  // spheres and mesh vertices: turtle -> rest with the turn of their node's internode
+  turn_organs(spec, g->owner_seg, g->rest, rs);
   vd_model_destroy(g->plant);
   g->plant = NULL;
   st = vd_plant_compile(rs, &g->plant, err);
@@ -1241,22 +1241,7 @@ vd_status vd_growth_plant(const vd_growth* g, vd_plant_spec** out, vd_error* err
   vd_plant_spec* p = vd_plant_spec_copy(s);
   if (!p) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   // nodes where they are; organs and up vectors turned with the node they hang from
-  for (int i = 0; i < s->nnode; i++) p->node[i] = g->pos[i];
-  for (int k = 0; k < s->nsphere; k++) {
-    int n = s->sphere[k].node;
-    if (n < 0 && s->sphere[k].parent >= 0) n = s->seg[s->sphere[k].parent].node1;
-    if (n < 0) continue;
-    vd_quat q = node_turn(s, g->owner_seg, s->node, g->pos, n);
-    p->sphere[k].center = vd_add(g->pos[n], vd_quat_rotate(q, vd_sub(s->sphere[k].center, s->node[n])));
-  }
-  for (int k = 0; k < s->nmesh; k++) {
-    int n = s->mesh[k].node;
-    if (n < 0 && s->mesh[k].parent >= 0) n = s->seg[s->mesh[k].parent].node1;
-    if (n < 0) continue;
-    vd_quat q = node_turn(s, g->owner_seg, s->node, g->pos, n);
-    for (int v = s->mesh[k].vert_start; v < s->mesh[k].vert_start + s->mesh[k].nvert; v++)
-      p->vert[v] = vd_add(g->pos[n], vd_quat_rotate(q, vd_sub(s->vert[v], s->node[n])));
-  }
+  turn_organs(s, g->owner_seg, g->pos, p);
   for (int j = 0; j < s->nseg; j++) {
     vd_quat q = node_turn(s, g->owner_seg, s->node, g->pos, s->seg[j].node1);
     vd_vec3 u = vd_quat_rotate(q, s->seg[j].up);

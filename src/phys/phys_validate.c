@@ -7,6 +7,15 @@
 
 int vd_validate_add(vd_validate_list* l, const char* name, const char* form, const char* quantity, double measured,
                     double reference, double tol, int abs_err, const char* note, ...) {
+  va_list ap;
+  va_start(ap, note);
+  int ok = vd_validate_addv(l, name, form, quantity, measured, reference, tol, abs_err, note, ap);
+  va_end(ap);
+  return ok;
+}
+
+int vd_validate_addv(vd_validate_list* l, const char* name, const char* form, const char* quantity, double measured,
+                     double reference, double tol, int abs_err, const char* note, va_list ap) {
   if (!vd_grow((void**)&l->r, &l->cap, l->n + 1, sizeof(vd_validate_result))) return 0;
   vd_validate_result* r = &l->r[l->n++];
   memset(r, 0, sizeof *r);
@@ -18,10 +27,7 @@ int vd_validate_add(vd_validate_list* l, const char* name, const char* form, con
   r->error = abs_err || reference == 0 ? fabs(measured - reference) : fabs(measured - reference) / fabs(reference);
   r->tolerance = tol;
   r->pass = isfinite(measured) && r->error <= tol;
-  va_list ap;
-  va_start(ap, note);
   vsnprintf(r->note, sizeof r->note, note, ap);
-  va_end(ap);
   return 1;
 }
 

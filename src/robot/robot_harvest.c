@@ -10,6 +10,7 @@
 //   as xfrc_applied on the robot bodies -> mj_step2.
 // The plant thus sees the robot one robot step late (2 ms with the bundled robots), and the
 // robot feels the plant's reaction of the step before: the usual explicit co-simulation.
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -39,8 +40,13 @@ const char* vd_harvest_event_name(vd_harvest_event_kind k) {
 // ---------------------------------------------------------------------------------------------
 // events and the end
 
-void harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg, int instance) {
-  if (!vd_grow((void**)&h->ev, &h->cap_ev, h->nev + 1, sizeof *h->ev)) return;  // log full: dropped
+vd_harvest_event* harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg,
+                                int instance) {
+  // out of memory: this event and every later one dropped (the log stays a true prefix)
+  if (h->ev_dropped || !vd_grow((void**)&h->ev, &h->cap_ev, h->nev + 1, sizeof *h->ev)) {
+    h->ev_dropped++;
+    return NULL;
+  }
   vd_harvest_event* e = &h->ev[h->nev++];
   memset(e, 0, sizeof *e);
   e->time = h->sd->time;
@@ -49,13 +55,24 @@ void harvest_event(vd_harvest* h, vd_harvest_event_kind k, double value, int seg
   e->seg = seg;
   e->instance = instance;
   e->cls = seg >= 0 ? h->sm->seg_class[seg] : -1;
+  return e;
+}
+
+void vd_harvest_set_phase(vd_harvest* h, vd_harvest_phase p) {
+  if (h->phase == p) return;
+  h->phase = p;
+  harvest_event(h, VD_EV_PHASE, p, -1, 0);
 }
 
 void harvest_finish(vd_harvest* h, const char* reason) {
   if (h->done) return;
   h->done = 1;
   if (reason != h->reason) snprintf(h->reason, sizeof h->reason, "%s", reason);
-  if (h->phase != VD_PHASE_EXTERNAL) control_set_phase(h, VD_PHASE_DONE);
+  if (h->phase != VD_PHASE_EXTERNAL) vd_harvest_set_phase(h, VD_PHASE_DONE);
+}
+
+void vd_harvest_end(vd_harvest* h, const char* reason) {
+  harvest_finish(h, reason && *reason ? reason : "ended");
 }
 
 // remove the grasp tie (the last user tie of the state) and let the fingers touch the fruit again
@@ -86,6 +103,7 @@ static void harvest_free_parts(vd_harvest* h) {
   vd_sim_model_destroy(h->sm);
   vd_free(h->ev, (size_t)h->cap_ev * sizeof *h->ev);
   vd_scene_free(&h->scene);
+  vd_robot_destroy(h->own_rb);
 }
 
 void vd_harvest_destroy(vd_harvest* h) {
@@ -94,14 +112,76 @@ void vd_harvest_destroy(vd_harvest* h) {
   vd_free(h, sizeof *h);
 }
 
+// Before the first step: no robot geom may start inside the plant (its modelled shape) deeper
+// than START_OVERLAP; the plant would be blown apart by the first contact projection. The error
+// names the geom, the organ and the depth.
+#define START_OVERLAP 1e-3  // (m)
+static vd_status start_pose_check(const vd_harvest* h, vd_error* err) {
+  const vd_sim_model* sm = h->sm;
+  const vd_sim_data* sd = h->sd;
+  for (int k = 0; k < h->ncol; k++) {
+    const vd_collider* c = &h->col[k].shape;
+    vd_vec3 lo, hi;
+    vd_collider_bounds(c, &lo, &hi);
+    double worst = -START_OVERLAP;
+    int seg = -1, sphere = 0;
+    for (int t = 0; t < sm->nseg; t++) {
+      int a = sm->seg_node[2 * t], b = sm->seg_node[2 * t + 1];
+      vd_vec3 pa = sd->node_pos[a], pb = sd->node_pos[b];
+      double r = sm->seg_radius[t];
+      if (fmin(pa.x, pb.x) - r > hi.x || fmax(pa.x, pb.x) + r < lo.x || fmin(pa.y, pb.y) - r > hi.y ||
+          fmax(pa.y, pb.y) + r < lo.y || fmin(pa.z, pb.z) - r > hi.z || fmax(pa.z, pb.z) + r < lo.z)
+        continue;
+      double d = vd_collide_capsule(c, pa, pb, r, r).dist;
+      if (d < worst) worst = d, seg = t, sphere = 0;
+      double rs = sm->node_sphere[b];
+      if (rs > 0 && (d = vd_collide_sphere(c, pb, rs).dist) < worst) worst = d, seg = t, sphere = 1;
+    }
+    if (seg < 0) continue;
+    const mjModel* m = h->m;
+    const char* gname = mj_id2name(m, mjOBJ_GEOM, h->col[k].geom);
+    const char* bname = mj_id2name(m, mjOBJ_BODY, h->col[k].body);
+    return vd_error_set(err, VD_ERR_VALUE, h->scene.path, 0, 0,
+                        "the robot starts inside the plant: geom '%s' (body '%s') overlaps %s %d "
+                        "(%s) by %.1f mm at q0; move robot.base (now %.3f, %.3f, %.3f m) or the plant",
+                        gname ? gname : "(unnamed)", bname ? bname : "(unnamed)",
+                        vd_sim_class_name((vd_sim_class)sm->seg_class[seg]), sm->seg_instance[seg],
+                        sphere ? "its sphere" : "a segment", -worst * 1e3, h->scene.base_pos.x,
+                        h->scene.base_pos.y, h->scene.base_pos.z);
+  }
+  return VD_OK;
+}
+
 vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_harvest** out,
                             vd_error* err) {
   *out = NULL;
+  vd_robot* rb;
+  vd_status st = vd_robot_load(scene, &rb, err);
+  if (st) return st;
+  st = vd_harvest_create_with(scene, rb, plant, out, err);
+  if (st || !*out) {
+    vd_robot_destroy(rb);
+    return st ? st : vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  (*out)->own_rb = rb;
+  return VD_OK;
+}
+
+vd_status vd_harvest_create_with(const vd_scene* scene, const vd_robot* robot, const vd_model* plant,
+                                 vd_harvest** out, vd_error* err) {
+  *out = NULL;
+  if (!robot_matches(robot, scene))
+    return vd_error_set(err, VD_ERR_ARG, scene->path, 0, 0,
+                        "the robot was loaded for %s (site '%s', fingers '%s', '%s'), the scene names "
+                        "%s (site '%s', fingers '%s', '%s')",
+                        robot->path, robot->ee_site_name, robot->gripper_name[0], robot->gripper_name[1],
+                        scene->robot_path, scene->ee_site, scene->gripper[0], scene->gripper[1]);
   vd_mj_trap_install();
   vd_harvest* h = vd_calloc(1, sizeof *h);
   if (!h) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   h->tie = -1;
   h->target = -1;
+  h->rb = robot;
   vd_status st = vd_scene_copy(scene, &h->scene, err);
   if (st) {
     vd_free(h, sizeof *h);
@@ -116,7 +196,7 @@ vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_har
     h->on = vd_malloc((size_t)h->sm->nseg + 1);
     if (!h->sd || !h->on) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory (plant state)");
   }
-  if (!st) st = robot_load(h, err);
+  if (!st) st = robot_attach(h, err);
   if (!st && isfinite(h->scene.ground)) {
     vd_sim_collider g;
     memset(&g, 0, sizeof g);
@@ -141,13 +221,13 @@ vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_har
     return st;
   }
   st = vd_harvest_reset(h, 0, err);
-  if (st && st != VD_ERR_VALUE) {
+  if (!st) st = start_pose_check(h, err);
+  if (st) {
     vd_harvest_destroy(h);
     return st;
   }
-  // a target that cannot be reached is an outcome (the episode is done), not a failure
   *out = h;
-  return st;
+  return VD_OK;
 }
 
 // is fruit f still on the plant? else *seg gets the broken joint nearest the fruit
@@ -161,55 +241,125 @@ static int fruit_attached(const vd_harvest* h, int f, int* seg) {
   return 1;
 }
 
-// the grasp pose of fruit f is reachable from q0 through its pre-grasp pose
+// base of the robot (for "nearest")
+static vd_vec3 base_pos(const vd_harvest* h) {
+  int r = h->rb->root_body;
+  return vd_v3(h->d->xpos[3 * r], h->d->xpos[3 * r + 1], h->d->xpos[3 * r + 2]);
+}
+
+static vd_vec3 unit_or(vd_vec3 v, vd_vec3 fallback) {
+  double n = vd_norm(v);
+  return n > 1e-9 ? vd_scale(v, 1.0 / n) : fallback;
+}
+
+// Grasp geometry: the pedicel axis p runs from the calyx (the fruit stalk's start) to the
+// fruit's centre; the approach a is the horizontal direction from the robot's base to the fruit
+// (made normal to p when the calyx would otherwise lie toward the palm); the gripper's z axis is
+// a and its fingers close along p x a, so they meet the fruit's sides and the pedicel stays
+// between them at the top. A robot that cannot turn its end-effector (a gantry) approaches along
+// its tool axis.
+void harvest_grasp_pose(vd_harvest* h, int f, vd_vec3* pos, vd_quat* rot, vd_vec3* approach,
+                        vd_vec3* pedicel) {
+  const vd_sim_data* sd = h->sd;
+  const robot_fruit* fr = &h->fruit[f];
+  vd_vec3 c = sd->node_pos[fr->node], calyx = sd->node_pos[sd->seg_start[fr->seg]];
+  vd_vec3 p = unit_or(vd_sub(c, calyx), vd_v3(0, 0, -1));
+  vd_vec3 ah = vd_sub(c, base_pos(h));
+  ah.z = 0;
+  ah = unit_or(ah, vd_v3(1, 0, 0));
+  // horizontal, unless the calyx would then lie toward the palm: a . p <= 0 keeps the pedicel
+  // ahead of the fingers
+  double ap = vd_dot(ah, p);
+  vd_vec3 a = ap > 0 ? vd_madd(ah, p, -ap) : ah;
+  a = vd_norm(a) > 0.2 ? unit_or(a, ah) : ah;
+  if (h->orient) {
+    vd_vec3 y = unit_or(vd_cross(p, a), vd_v3(0, 0, 1));
+    vd_vec3 x = vd_cross(y, a);
+    *rot = vd_quat_from_axes(x, y, a);
+  } else {
+    vd_vec3 tmp;
+    vd_harvest_fk(h, h->q0, &tmp, rot);
+    a = vd_quat_rotate(*rot, vd_v3(0, 0, 1));
+  }
+  *pos = c;
+  *approach = a;
+  *pedicel = p;
+}
+
+int vd_harvest_grasp_pose(vd_harvest* h, vd_vec3* pos, vd_quat* rot, vd_vec3* approach,
+                          vd_vec3* pedicel) {
+  if (h->target < 0) return 0;
+  harvest_grasp_pose(h, h->target, pos, rot, approach, pedicel);
+  return 1;
+}
+
+// the grasp pose of fruit f is reachable from q0 through its pre-grasp pose; *ik_err gets the
+// distance the arm stays short of the grasp point (m)
 static int reachable(vd_harvest* h, int f, double* ik_err) {
   vd_vec3 pos, a, p;
   vd_quat rot;
-  control_grasp_pose(h, f, &pos, &rot, &a, &p);
+  harvest_grasp_pose(h, f, &pos, &rot, &a, &p);
   double q[VD_ROBOT_MAX_JOINTS], e1, r1, e2, r2;
   memcpy(q, h->q0, sizeof q);
   vd_ik_def def = vd_ik_def_default();
   def.max_iter = 400;
   vd_vec3 pre = vd_madd(pos, a, -h->scene.method.pregrasp);
   robot_ik(h, &def, pre, &rot, q, &e1, &r1);
-  memcpy(h->qpre, q, sizeof q);
   robot_ik(h, &def, pos, &rot, q, &e2, &r2);
   if (ik_err) *ik_err = e2;
   return e1 < 1e-3 && e2 < 1e-3 && r1 < 1e-2 && r2 < 1e-2;
 }
 
-// base of the robot (for "nearest")
-static vd_vec3 base_pos(const vd_harvest* h) {
-  int r = h->root_body;
-  return vd_v3(h->d->xpos[3 * r], h->d->xpos[3 * r + 1], h->d->xpos[3 * r + 2]);
+// no target: the reason (a key) and what to tell a user
+static void no_target(vd_harvest* h, const char* reason, const char* fmt, ...) {
+  snprintf(h->target_reason, sizeof h->target_reason, "%s", reason);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(h->target_detail, sizeof h->target_detail, fmt, ap);
+  va_end(ap);
 }
 
-// choose the target fruit; -1 with the episode finished when there is none
+// the plant's fruit instances as "3, 7, 12" (the first ones, when many) into buf
+static void fruit_list(const vd_harvest* h, char* buf, size_t cap) {
+  size_t n = 0;
+  buf[0] = 0;
+  for (int f = 0; f < h->nfruit && n + 16 < cap; f++)
+    n += (size_t)snprintf(buf + n, cap - n, "%s%d", f ? ", " : "", h->fruit[f].instance);
+  if (n + 16 >= cap && cap > 4) snprintf(buf + cap - 5, 5, "...");
+}
+
+// choose the target fruit; -1 with the reason in target_reason when there is none
 static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
   const vd_scene* s = &h->scene;
   h->target = -1;
+  h->target_reason[0] = h->target_detail[0] = 0;
   if (!h->nfruit) {
-    snprintf(h->reason, sizeof h->reason, "no fruit");
-    return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0, "the plant has no fruit");
+    no_target(h, "no fruit", "the plant has no fruit");
+    return VD_OK;
   }
   int random = s->target_instance < 0;
+  vd_vec3 b = base_pos(h);
   if (s->target_instance > 0) {
     for (int f = 0; f < h->nfruit; f++)
       if (h->fruit[f].instance == s->target_instance) h->target = f;
     if (h->target < 0) {
-      snprintf(h->reason, sizeof h->reason, "no such fruit");
-      return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0,
-                          "target.fruit: the plant has no fruit with instance %d",
-                          s->target_instance);
+      char ids[160];
+      fruit_list(h, ids, sizeof ids);
+      no_target(h, "no such fruit", "target.fruit: the plant has no fruit with instance %d (its fruits: %s)",
+                s->target_instance, ids);
+      return VD_OK;
     }
     if (!reachable(h, h->target, &h->grasp_ik_err)) {
-      snprintf(h->reason, sizeof h->reason, "unreachable");
+      const robot_fruit* f = &h->fruit[h->target];
+      no_target(h, "unreachable",
+                "fruit %d is out of reach: %.3f m from the robot's base, the arm stays %.3f m short "
+                "of its grasp pose",
+                f->instance, vd_norm(vd_sub(h->sd->node_pos[f->node], b)), h->grasp_ik_err);
       h->target = -1;
     }
     return VD_OK;
   }
   // fruits by distance from the robot's base (instance breaks ties), the reachable ones
-  vd_vec3 b = base_pos(h);
   int* order = vd_malloc((size_t)h->nfruit * sizeof(int));
   if (!order) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   for (int f = 0; f < h->nfruit; f++) order[f] = f;
@@ -221,10 +371,14 @@ static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
       if (dx < dy || (dx == dy && h->fruit[x].instance < h->fruit[y].instance)) break;
       order[k - 1] = y, order[k] = x;
     }
-  int nok = 0;
+  int nok = 0, nearest = order[0];
+  double nearest_short = 0;
   for (int i = 0; i < h->nfruit; i++) {
     double e;
-    if (!reachable(h, order[i], &e)) continue;
+    if (!reachable(h, order[i], &e)) {
+      if (i == 0) nearest_short = e;
+      continue;
+    }
     order[nok++] = order[i];
     if (!random) break;
   }
@@ -242,7 +396,13 @@ static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
     reachable(h, h->target, &h->grasp_ik_err);
   }
   vd_free(order, (size_t)h->nfruit * sizeof(int));
-  if (h->target < 0) snprintf(h->reason, sizeof h->reason, "no reachable fruit");
+  if (h->target < 0) {
+    const robot_fruit* f = &h->fruit[nearest];
+    no_target(h, "no reachable fruit",
+              "none of the plant's %d fruits is in reach: the nearest, fruit %d, is %.3f m from the "
+              "robot's base and the arm stays %.3f m short of its grasp pose",
+              h->nfruit, f->instance, vd_norm(vd_sub(h->sd->node_pos[f->node], b)), nearest_short);
+  }
   return VD_OK;
 }
 
@@ -256,14 +416,14 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   }
   // robot at q0, gripper open
   mj_resetData(m, d);
-  for (int k = 0; k < h->narm; k++) {
-    d->qpos[h->arm_qpos[k]] = h->q0[k];
-    d->ctrl[h->arm_act[k]] = h->q0[k];
+  for (int k = 0; k < h->rb->narm; k++) {
+    d->qpos[h->rb->arm_qpos[k]] = h->q0[k];
+    d->ctrl[h->rb->arm_act[k]] = h->q0[k];
     h->qcmd[k] = h->q0[k];
   }
   for (int k = 0; k < 2; k++) {
-    d->qpos[h->grip_qpos[k]] = h->scene.gripper_open;
-    d->ctrl[h->grip_act[k]] = h->scene.gripper_open;
+    d->qpos[h->rb->grip_qpos[k]] = h->scene.gripper_open;
+    d->ctrl[h->rb->grip_act[k]] = h->scene.gripper_open;
   }
   mj_forward(m, d);
   vd_mj_trap_end(&trap);
@@ -282,9 +442,10 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   h->xcmd = h->ee_pos, h->rcmd = h->ee_quat;
   h->grip_cmd = 0;
   h->ik_err = 0;
-  h->joint_move = 0;
+  h->cmd_scale = 1;
   h->held = h->ever_held = 0, h->tie = -1;
-  h->slip = 0;
+  h->slip = h->tie_slip0 = 0;
+  h->grip_n[0] = h->grip_n[1] = h->grip_at_detach = 0;
   h->pull_force = h->pull_torque = h->robot_force = vd_v3(0, 0, 0);
   h->touching[0] = h->touching[1] = h->touched[0] = h->touched[1] = 0;
   h->finger_force[0] = h->finger_force[1] = 0;
@@ -292,19 +453,11 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   h->detach_time = h->detach_force = h->detach_moment = h->detach_pull = 0;
   h->max_pull = h->max_disp = h->grasp_ik_err = h->grasp_track_err = h->pull_at_break = 0;
   h->done = 0, h->reason[0] = 0;
-  h->nevent_seen = 0, h->nev = 0, h->step = 0;
+  h->nevent_seen = 0, h->nev = 0, h->ev_dropped = 0, h->step = 0;
   for (int f = 0; f < h->nfruit; f++) h->fruit[f].hit = h->fruit[f].dropped = 0;
-  h->scripted = 1;
-  h->phase = VD_PHASE_APPROACH;
-  // without a target the episode can still be driven from outside; the scripted run ends at
-  // once with the reason (no fruit, unreachable, no reachable fruit)
-  vd_status st = choose_target(h, seed, err);
-  if (!st && h->target >= 0) control_begin(h);
-  if (!st && h->target < 0) {
-    h->phase = VD_PHASE_DONE;
-    st = vd_error_set(err, VD_ERR_VALUE, h->scene.path, 0, 0, "%s", h->reason);
-  }
-  return st;
+  h->phase = VD_PHASE_EXTERNAL;
+  // without a target the episode can still be driven from outside; target_reason says why
+  return choose_target(h, seed, err);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -329,31 +482,41 @@ static void grasp_drive(vd_harvest* h, vd_pose e, vd_vec3* torque) {
   vd_quat want = vd_quat_mul(e.rot, h->hold_rot);
   vd_vec3 tau = vd_sub(vd_scale(quat_log_v(vd_quat_mul(want, vd_quat_conj(sd->seg_quat[t]))), k),
                        vd_scale(sd->seg_omega[t], c));
-  // the grip's friction torque bounds it: mu * 2 F_grip * r
+  // the grip's friction torque bounds it: mu (N_l + N_r) r, the fingers' measured squeeze
   const vd_method_def* md = &h->scene.method;
-  double lim = md->grip_friction * 2 * md->grip_force * f->radius, n = vd_norm(tau);
+  double lim = md->grip_friction * (h->grip_n[0] + h->grip_n[1]) * f->radius, n = vd_norm(tau);
   if (n > lim && n > 0) tau = vd_scale(tau, lim / n);
   sd->seg_torque[t] = tau;
   *torque = tau;
+  // the hold's friction limit inside the plant solve: mu (N_l + N_r) across the closing axis
+  vd_sim_tie* tie = &sd->tie[h->tie];
+  tie->max_force = md->grip_friction * (h->grip_n[0] + h->grip_n[1]);
+  if (!(tie->max_force > 0)) tie->max_force = 1e-9;  // no squeeze: nothing holds
+  tie->axis = vd_quat_rotate(e.rot, vd_v3(0, 1, 0));
 }
 
-// after a plant substep: the tie's force on the gripper; slipping when beyond friction x grip
+// after a plant substep: the tie's force on the gripper and the slip the solve let happen (the
+// tie's target slid inside the solver's iterations where the pull across the closing axis
+// reached mu (N_l + N_r)); the grasp point in the gripper moves with it
 static void grasp_slip(vd_harvest* h, vd_pose e, vd_vec3* force) {
   const robot_fruit* f = &h->fruit[h->target];
-  vd_sim_data* sd = h->sd;
-  vd_vec3 p = sd->node_pos[f->node], tg = sd->tie[h->tie].target;
-  vd_vec3 fg = vd_scale(vd_sub(p, tg), 1.0 / ROBOT_TIE_COMPLIANCE);
-  const vd_method_def* md = &h->scene.method;
-  double lim = md->grip_friction * 2 * md->grip_force, n = vd_norm(fg);
-  if (n > lim) {
-    // the fruit slides in the fingers until the tie pulls with the friction limit
-    vd_vec3 nt = vd_add(p, vd_scale(vd_sub(tg, p), lim / n));
-    h->slip += vd_norm(vd_sub(nt, tg));
-    h->hold_local = vd_quat_rotate(vd_quat_conj(e.rot), vd_sub(nt, e.pos));
-    sd->tie[h->tie].target = nt;
-    fg = vd_scale(fg, lim / n);
+  const vd_sim_tie* t = &h->sd->tie[h->tie];
+  *force = vd_scale(vd_sub(h->sd->node_pos[f->node], t->target), 1.0 / ROBOT_TIE_COMPLIANCE);
+  h->slip = h->tie_slip0 + t->slip;
+  h->hold_local = vd_quat_rotate(vd_quat_conj(e.rot), vd_sub(t->target, e.pos));
+}
+
+// the squeeze finger k's actuator exerts held at position q with target ctrl, at rest (N): its
+// gain and bias (MuJoCo's affine actuator: gain0 ctrl + bias0 + bias1 q) within its force range
+static double finger_squeeze(const mjModel* m, int a, double ctrl, double q) {
+  const mjtNum* g = m->actuator_gainprm + mjNGAIN * a;
+  const mjtNum* b = m->actuator_biasprm + mjNBIAS * a;
+  double f = g[0] * ctrl + b[0] + b[1] * q;
+  if (m->actuator_forcelimited[a]) {
+    const mjtNum* r = m->actuator_forcerange + 2 * a;
+    f = f < r[0] ? r[0] : f > r[1] ? r[1] : f;
   }
-  *force = fg;
+  return fabs(f);
 }
 
 // the finger touches and forces on the target fruit, from the last robot step
@@ -390,10 +553,16 @@ static void grasp_check(vd_harvest* h) {
   h->tie = vd_sim_add_tie(sd, f->node, p, ROBOT_TIE_COMPLIANCE);
   if (h->tie < 0) return;  // out of memory: try again next step
   h->held = h->ever_held = 1;
-  h->slip = 0;
+  h->slip = 0, h->tie_slip0 = 0;
   h->hold_local = vd_quat_rotate(vd_quat_conj(h->ee_quat), vd_sub(p, h->ee_pos));
   h->hold_rot = vd_quat_mul(vd_quat_conj(h->ee_quat), sd->seg_quat[f->seg]);
-  for (int k = 0; k < 2; k++) h->finger_q[k] = h->d->qpos[h->grip_qpos[k]];
+  // the fingers stay where they met the fruit, their servos commanded closed: each squeezes
+  // with its actuator's force there (the grip force limit, unless the fruit holds them early)
+  for (int k = 0; k < 2; k++) {
+    h->finger_q[k] = h->d->qpos[h->rb->grip_qpos[k]];
+    h->grip_n[k] = finger_squeeze(h->m, h->rb->grip_act[k], h->scene.gripper_closed, h->finger_q[k]);
+  }
+  h->grip_at_detach = 0.5 * (h->grip_n[0] + h->grip_n[1]);
   // the fingers hold the fruit through the tie now: they no longer push it
   for (int k = 0; k < h->ncol; k++)
     if (h->col[k].finger >= 0) sd->collider_pass[h->col[k].sim] = f->node;
@@ -406,10 +575,16 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
   mjData* d = h->d;
   vd_sim_data* sd = h->sd;
   vd_mj_trap trap;
+  if (h->held)
+    for (int k = 0; k < 2; k++) {
+      // a held finger stays against the fruit (the fruit is in the plant solve, not in MuJoCo)
+      d->qpos[h->rb->grip_qpos[k]] = h->finger_q[k];
+      d->qvel[h->rb->grip_dof[k]] = 0;
+    }
   if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
   mj_step1(m, d);
   // the arm's controller compensates gravity and the velocity-dependent forces
-  for (int k = 0; k < h->narm; k++) d->qfrc_applied[h->arm_dof[k]] = d->qfrc_bias[h->arm_dof[k]];
+  for (int k = 0; k < h->rb->narm; k++) d->qfrc_applied[h->rb->arm_dof[k]] = d->qfrc_bias[h->rb->arm_dof[k]];
   vd_mj_trap_end(&trap);
   // poses at this robot step
   for (int k = 0; k < h->ncol; k++) {
@@ -474,7 +649,7 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
       mjtNum* x = d->xfrc_applied + 6 * b;
       memset(x, 0, 6 * sizeof(mjtNum));
     }
-    int gb = m->site_bodyid[h->ee_site];
+    int gb = m->site_bodyid[h->rb->ee_site];
     memset(d->xfrc_applied + 6 * gb, 0, 6 * sizeof(mjtNum));
     for (int k = 0; k <= h->ncol; k++) {
       int b;
@@ -494,6 +669,11 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
   if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
   mj_step2(m, d);
   vd_mj_trap_end(&trap);
+  if (h->held) {
+    // the squeeze measured: the finger actuators' force in this step
+    for (int k = 0; k < 2; k++) h->grip_n[k] = fabs(d->actuator_force[h->rb->grip_act[k]]);
+    if (!h->detached) h->grip_at_detach = 0.5 * (h->grip_n[0] + h->grip_n[1]);
+  }
   finger_contacts(h, force);
   grasp_check(h);
   return VD_OK;
@@ -530,9 +710,8 @@ static void outcomes(vd_harvest* h) {
   // fractures
   for (; h->nevent_seen < sd->nevent; h->nevent_seen++) {
     const vd_sim_event* e = &sd->event[h->nevent_seen];
-    harvest_event(h, VD_EV_FRACTURE, e->force, e->seg, e->instance);
-    h->ev[h->nev - 1].force = e->force;
-    h->ev[h->nev - 1].moment = e->moment;
+    vd_harvest_event* x = harvest_event(h, VD_EV_FRACTURE, e->force, e->seg, e->instance);
+    if (x) x->force = e->force, x->moment = e->moment;
   }
   // the target
   int seg;
@@ -550,9 +729,8 @@ static void outcomes(vd_harvest* h) {
         break;
       }
     h->detach_pull = h->held ? h->pull_at_break : 0;
-    harvest_event(h, VD_EV_DETACH, h->detach_pull, seg, h->fruit[h->target].instance);
-    vd_harvest_event* e = &h->ev[h->nev - 1];
-    e->site = h->site, e->force = h->detach_force, e->moment = h->detach_moment;
+    vd_harvest_event* e = harvest_event(h, VD_EV_DETACH, h->detach_pull, seg, h->fruit[h->target].instance);
+    if (e) e->site = h->site, e->force = h->detach_force, e->moment = h->detach_moment;
   }
   // other fruits: touched by the robot, come off
   for (int f = 0; f < h->nfruit; f++) {
@@ -577,7 +755,9 @@ static void outcomes(vd_harvest* h) {
 // ---------------------------------------------------------------------------------------------
 // control steps
 
-static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_error* err) {
+// one control step: under action a, or toward the joint goal qgoal (Nullable; a's velocities ignored)
+static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, const double* qgoal,
+                              vd_error* err) {
   if (h->done) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the episode is over (reset it)");
   const vd_scene* s = &h->scene;
   double dt = s->control_dt;
@@ -588,9 +768,14 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_erro
     return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "action: velocities must be finite");
   double q[VD_ROBOT_MAX_JOINTS], re = 0;
   memcpy(q, h->qcmd, sizeof q);
-  if (h->joint_move) {
-    // joint space (the scripted approach): straight to the goal, every joint arriving together
-    memcpy(q, h->qgoal, sizeof q);
+  int joint_move = qgoal != NULL;
+  if (joint_move) {
+    // joint space: straight to the goal, every joint arriving together
+    const vd_robot* rb = h->rb;
+    for (int k = 0; k < rb->narm; k++) {
+      if (!isfinite(qgoal[k])) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "q[%d] must be finite", k);
+      q[k] = qgoal[k] < rb->arm_lo[k] ? rb->arm_lo[k] : qgoal[k] > rb->arm_hi[k] ? rb->arm_hi[k] : qgoal[k];
+    }
   } else {
     h->xcmd = vd_madd(h->xcmd, v, dt);
     if (h->orient) h->rcmd = vd_quat_normalize(vd_quat_mul(quat_exp_v(vd_scale(w, dt)), h->rcmd));
@@ -608,21 +793,21 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_erro
   }
   // the joints' speed limits: the whole step scaled down so that the path stays the same
   double sc = 1;
-  for (int k = 0; k < h->narm; k++) {
-    double dq = fabs(q[k] - h->qcmd[k]), lim = h->qd_max[k] * dt;
+  for (int k = 0; k < h->rb->narm; k++) {
+    double dq = fabs(q[k] - h->qcmd[k]), lim = h->rb->qd_max[k] * dt;
     if (dq > lim && lim / dq < sc) sc = lim / dq;
   }
-  for (int k = 0; k < h->narm; k++) h->qcmd[k] += sc * (q[k] - h->qcmd[k]);
-  h->cmd_scale = h->joint_move ? 1 : sc;
-  if (h->joint_move || sc < 1) {
+  for (int k = 0; k < h->rb->narm; k++) h->qcmd[k] += sc * (q[k] - h->qcmd[k]);
+  h->cmd_scale = joint_move ? 1 : sc;
+  if (joint_move || sc < 1) {
     vd_quat r;
     vd_vec3 x;
     vd_harvest_fk(h, h->qcmd, &x, &r);
-    if (!h->joint_move) h->ik_err = vd_norm(vd_sub(x, h->xcmd));
+    if (!joint_move) h->ik_err = vd_norm(vd_sub(x, h->xcmd));
     h->xcmd = x;
     if (h->orient) h->rcmd = r;
   }
-  if (!h->joint_move && (h->ik_err > 5e-3 || re > 5e-2)) {
+  if (!joint_move && (h->ik_err > 5e-3 || re > 5e-2)) {
     // out of reach: the command stops where the arm can be (no wind-up)
     harvest_event(h, VD_EV_IK, h->ik_err, -1, 0);
     h->cmd_scale = 0;
@@ -631,14 +816,14 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_erro
     if (h->orient) h->rcmd = r;
   }
   mjData* d = h->d;
-  for (int k = 0; k < h->narm; k++) d->ctrl[h->arm_act[k]] = h->qcmd[k];
+  for (int k = 0; k < h->rb->narm; k++) d->ctrl[h->rb->arm_act[k]] = h->qcmd[k];
   if (h->held && h->grip_cmd < 0.5) harvest_release(h);
   for (int r = 0; r < h->nrobot; r++) {
     // fingers: frozen on a held fruit, else their targets move toward the command
     for (int k = 0; k < 2; k++) {
-      int act = h->grip_act[k];
+      int act = h->rb->grip_act[k];
       if (h->held) {
-        d->ctrl[act] = h->finger_q[k];
+        d->ctrl[act] = s->gripper_closed;  // squeezing; the fruit holds the finger (robot_step)
         continue;
       }
       double want = s->gripper_open + h->grip_cmd * (s->gripper_closed - s->gripper_open);
@@ -658,46 +843,12 @@ static vd_status control_step(vd_harvest* h, const vd_harvest_action* a, vd_erro
 }
 
 vd_status vd_harvest_step(vd_harvest* h, const vd_harvest_action* a, vd_error* err) {
-  if (h->scripted) {
-    h->scripted = 0;
-    h->joint_move = 0;
-    h->phase = VD_PHASE_EXTERNAL;
-  }
-  return control_step(h, a, err);
+  return control_step(h, a, NULL, err);
 }
 
-void vd_harvest_scripted_action(vd_harvest* h, vd_harvest_action* a) {
-  control_action(h, a);
-}
-
-// one control step of the scripted controller: its action, the step, its phase bookkeeping
-static vd_status scripted_step(vd_harvest* h, vd_error* err) {
-  vd_harvest_action a;
-  control_action(h, &a);
-  vd_status st = control_step(h, &a, err);
-  if (!st) control_after_step(h);
-  return st;
-}
-
-vd_status vd_harvest_step_scripted(vd_harvest* h, vd_error* err) {
-  if (!h->scripted)
-    return vd_error_set(err, VD_ERR_ARG, "", 0, 0,
-                        "the scripted controller is off (vd_harvest_step drove this episode): reset it");
-  if (h->target < 0) harvest_finish(h, h->reason);  // nothing to pick: over at once
-  if (h->done) return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the episode is over (reset it)");
-  return scripted_step(h, err);
-}
-
-vd_status vd_harvest_run(vd_harvest* h, vd_status (*on_step)(void* user, const vd_harvest* h),
-                         void* user, vd_error* err) {
-  vd_status st = VD_OK;
-  if (h->target < 0 && h->scripted) harvest_finish(h, h->reason);
-  if (on_step && (st = on_step(user, h))) return st;
-  while (!h->done) {
-    if ((st = scripted_step(h, err))) return st;
-    if (on_step && (st = on_step(user, h))) return st;
-  }
-  return VD_OK;
+vd_status vd_harvest_step_joints(vd_harvest* h, const double* q, double gripper, vd_error* err) {
+  vd_harvest_action a = {{0, 0, 0}, {0, 0, 0}, gripper};
+  return control_step(h, &a, q, err);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -713,17 +864,24 @@ void vd_harvest_observe(const vd_harvest* h, vd_harvest_obs* o) {
   o->time = h->sd->time;
   o->step = h->step;
   o->phase = h->phase;
-  o->nq = h->narm;
-  for (int k = 0; k < h->narm; k++) {
-    w->qbuf[k] = h->d->qpos[h->arm_qpos[k]];
-    w->qdbuf[k] = h->d->qvel[h->arm_dof[k]];
+  o->nq = h->rb->narm;
+  for (int k = 0; k < h->rb->narm; k++) {
+    w->qbuf[k] = h->d->qpos[h->rb->arm_qpos[k]];
+    w->qdbuf[k] = h->d->qvel[h->rb->arm_dof[k]];
   }
   o->q = w->qbuf;
   o->qd = w->qdbuf;
-  o->gripper_opening = h->d->qpos[h->grip_qpos[0]] + h->d->qpos[h->grip_qpos[1]];
+  o->gripper_opening = h->d->qpos[h->rb->grip_qpos[0]] + h->d->qpos[h->rb->grip_qpos[1]];
   o->ee_pos = h->ee_pos;
   o->ee_quat = h->ee_quat;
   o->cmd_pos = h->xcmd;
+  o->cmd_quat = h->rcmd;
+  o->q_cmd = h->qcmd;
+  o->q0 = h->q0;
+  o->cmd_scale = h->cmd_scale;
+  o->orient = h->orient;
+  o->base_pos = base_pos(h);
+  o->target_reason = h->target < 0 ? h->target_reason : NULL;
   if (h->target >= 0) {
     const robot_fruit* f = &h->fruit[h->target];
     o->target_instance = f->instance;
@@ -733,7 +891,7 @@ void vd_harvest_observe(const vd_harvest* h, vd_harvest_obs* o) {
   o->held = h->held;
   o->touching[0] = h->touching[0], o->touching[1] = h->touching[1];
   o->finger_force[0] = h->finger_force[0], o->finger_force[1] = h->finger_force[1];
-  o->grip_force = h->held ? h->scene.method.grip_force : 0;
+  o->grip_force = h->held ? 0.5 * (h->grip_n[0] + h->grip_n[1]) : 0;
   o->pull_force = h->pull_force;
   o->pull_torque = vd_norm(h->pull_torque);
   o->slip = h->slip;
@@ -766,11 +924,47 @@ void vd_harvest_summarize(const vd_harvest* h, vd_harvest_summary* o) {
   o->ik_error = h->grasp_ik_err;
   o->track_error = h->grasp_track_err;
   o->slip = h->slip;
+  o->grip_force = h->grip_at_detach;
   o->duration = h->sd->time;
   o->steps = h->step;
   o->plant_warnings = h->sd->nwarning;
   o->target_instance = h->target >= 0 ? h->fruit[h->target].instance : 0;
+  o->events_dropped = h->ev_dropped;
   snprintf(o->reason, sizeof o->reason, "%s", h->done ? h->reason : "running");
+  if (h->done && h->target < 0 && !strcmp(h->reason, h->target_reason))
+    snprintf(o->detail, sizeof o->detail, "%s", h->target_detail);
+}
+
+// fruit f as the public record
+static void fruit_info(const vd_harvest* h, int f, vd_harvest_fruit* o) {
+  const robot_fruit* fr = &h->fruit[f];
+  const vd_sim_model* sm = h->sm;
+  const vd_sim_data* sd = h->sd;
+  memset(o, 0, sizeof *o);
+  o->instance = fr->instance;
+  o->pos = sd->node_pos[fr->node];
+  o->calyx = o->knuckle = sd->node_pos[sd->seg_start[fr->seg]];
+  for (int s = fr->seg, n = 0; s >= 0 && n < 8; s = sm->seg_parent[s], n++)
+    if (sm->seg_flags[s] & VD_SIM_ABSCISSION) {
+      o->knuckle = sd->node_pos[sd->seg_start[s]];
+      break;
+    }
+  o->radius = fr->radius;
+  o->attached = fruit_attached(h, f, NULL);
+}
+
+int vd_harvest_fruits(const vd_harvest* h, vd_harvest_fruit* out, int cap) {
+  for (int f = 0; out && f < h->nfruit && f < cap; f++) fruit_info(h, f, &out[f]);
+  return h->nfruit;
+}
+
+vd_status vd_harvest_find_fruit(const vd_harvest* h, int instance, vd_harvest_fruit* out, vd_error* err) {
+  for (int f = 0; f < h->nfruit; f++)
+    if (h->fruit[f].instance == instance) {
+      fruit_info(h, f, out);
+      return VD_OK;
+    }
+  return vd_error_set(err, VD_ERR_ARG, "", 0, 0, "the plant has no fruit with instance %d", instance);
 }
 
 const vd_sim_model* vd_harvest_sim_model(const vd_harvest* h) {

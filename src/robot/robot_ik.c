@@ -45,7 +45,7 @@ static int spd_solve(double* a, double* e, int n) {
 
 // site pose at arm joints q in the scratch data (kinematics and com positions for the Jacobian)
 static void pose_at(vd_harvest* h, const double* q, vd_vec3* p, vd_quat* r) {
-  for (int k = 0; k < h->narm; k++) h->dk->qpos[h->arm_qpos[k]] = q[k];
+  for (int k = 0; k < h->rb->narm; k++) h->dk->qpos[h->rb->arm_qpos[k]] = q[k];
   mj_kinematics(h->m, h->dk);
   mj_comPos(h->m, h->dk);
   robot_site_pose(h, h->dk, p, r);
@@ -54,7 +54,7 @@ static void pose_at(vd_harvest* h, const double* q, vd_vec3* p, vd_quat* r) {
 int robot_ik(vd_harvest* h, const vd_ik_def* def, vd_vec3 pos, const vd_quat* rot, double* q,
              double* pos_err, double* rot_err) {
   const mjModel* m = h->m;
-  int n = h->narm, use_rot = rot && h->orient, rows = use_rot ? 6 : 3, nv = m->nv;
+  int n = h->rb->narm, use_rot = rot && h->orient, rows = use_rot ? 6 : 3, nv = m->nv;
   double w = def->rot_weight, lam2 = def->damping * def->damping;
   int mark = h->dk->pstack;
   mjtNum* jp = mj_stackAlloc(h->dk, 3 * nv);
@@ -73,13 +73,13 @@ int robot_ik(vd_harvest* h, const vd_ik_def* def, vd_vec3 pos, const vd_quat* ro
       break;
     }
     if (it == def->max_iter) break;
-    mj_jacSite(m, h->dk, jp, jr, h->ee_site);
+    mj_jacSite(m, h->dk, jp, jr, h->rb->ee_site);
     // J (rows x n) over the arm's dofs, e (rows)
     double J[6 * VD_ROBOT_MAX_JOINTS], e[6] = {ep.x, ep.y, ep.z, w * er.x, w * er.y, w * er.z};
     for (int i = 0; i < 3; i++)
       for (int k = 0; k < n; k++) {
-        J[i * n + k] = jp[i * nv + h->arm_dof[k]];
-        if (use_rot) J[(3 + i) * n + k] = w * jr[i * nv + h->arm_dof[k]];
+        J[i * n + k] = jp[i * nv + h->rb->arm_dof[k]];
+        if (use_rot) J[(3 + i) * n + k] = w * jr[i * nv + h->rb->arm_dof[k]];
       }
     double a[36];
     for (int i = 0; i < rows; i++)
@@ -99,7 +99,7 @@ int robot_ik(vd_harvest* h, const vd_ik_def* def, vd_vec3 pos, const vd_quat* ro
     double sc = big > 0.2 ? 0.2 / big : 1.0;
     for (int k = 0; k < n; k++) {
       double v = q[k] + sc * dq[k];
-      q[k] = v < h->arm_lo[k] ? h->arm_lo[k] : v > h->arm_hi[k] ? h->arm_hi[k] : v;
+      q[k] = v < h->rb->arm_lo[k] ? h->rb->arm_lo[k] : v > h->rb->arm_hi[k] ? h->rb->arm_hi[k] : v;
     }
   }
   h->dk->pstack = mark;

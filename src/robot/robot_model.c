@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// The robot of an episode: the MJCF loaded under the MuJoCo error trap, its root body placed at
-// the scene's base pose, the end-effector site, the finger actuators and the arm joints found;
-// every collidable robot geom made a collider of the plant (cylinders, ellipsoids and meshes
-// through signed distance grids); the plant's fruits listed.
+// The robot description (vd_robot): the MJCF loaded once under the MuJoCo error trap, the
+// end-effector site, the finger actuators and the arm joints found, every collidable robot geom's
+// shape (cylinders, ellipsoids and meshes through signed distance grids). An episode copies the
+// description's model (no parsing), places its root body at the scene's base pose, limits the
+// fingers to the grip force, makes its colliders of the plant from the shapes and lists the
+// plant's fruits.
 #include <stdio.h>
 #include <string.h>
 
@@ -41,13 +43,13 @@ vd_pose robot_geom_pose(const mjModel* m, const mjData* d, int g) {
 }
 
 void robot_site_pose(const vd_harvest* h, const mjData* d, vd_vec3* pos, vd_quat* rot) {
-  int s = h->ee_site;
+  int s = h->rb->ee_site;
   *pos = vd_v3(d->site_xpos[3 * s], d->site_xpos[3 * s + 1], d->site_xpos[3 * s + 2]);
   if (rot) *rot = quat_from_mat(d->site_xmat + 9 * s);
 }
 
 void robot_get_q(const vd_harvest* h, const mjData* d, double* q) {
-  for (int k = 0; k < h->narm; k++) q[k] = d->qpos[h->arm_qpos[k]];
+  for (int k = 0; k < h->rb->narm; k++) q[k] = d->qpos[h->rb->arm_qpos[k]];
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -74,9 +76,8 @@ static const char* name_of(const mjModel* m, int t, int k) {
 }
 
 // what the loaded model must have; errors name the MJCF and what is missing
-static vd_status describe(vd_harvest* h, vd_error* err) {
+static vd_status describe(vd_robot* h, const vd_scene* s, vd_error* err) {
   const mjModel* m = h->m;
-  const vd_scene* s = &h->scene;
   const char* file = s->robot_path;
   h->ee_site = mj_name2id(m, mjOBJ_SITE, s->ee_site);
   if (h->ee_site < 0)
@@ -99,6 +100,7 @@ static vd_status describe(vd_harvest* h, vd_error* err) {
                           "robot: actuator '%s' does not drive a slide or hinge joint", s->gripper[k]);
     h->grip_act[k] = a;
     h->grip_qpos[k] = m->jnt_qposadr[j];
+    h->grip_dof[k] = m->jnt_dofadr[j];
     h->finger_body[k] = m->jnt_bodyid[j];
   }
   // arm: the joints on the path from the site's body to the root, each with a servo
@@ -137,15 +139,25 @@ static vd_status describe(vd_harvest* h, vd_error* err) {
     h->arm_hi[k] = m->jnt_limited[j] ? m->jnt_range[2 * j + 1] : 1e10;
     h->qd_max[k] = m->jnt_type[j] == mjJNT_SLIDE ? 0.25 : 1.0;
   }
+  return VD_OK;
+}
+
+// what the episode's scene asks of the robot: q0 within the joints' ranges, time steps that
+// divide each other
+static vd_status episode_checks(vd_harvest* h, vd_error* err) {
+  const vd_robot* r = h->rb;
+  const mjModel* m = h->m;
+  const vd_scene* s = &h->scene;
+  int n = r->narm;
   if (s->nq0 && s->nq0 != n)
     return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0,
                         "robot.q0: the robot has %d arm joints, q0 gives %d", n, s->nq0);
   for (int k = 0; k < n; k++) {
-    h->q0[k] = s->nq0 ? s->q0[k] : m->qpos0[h->arm_qpos[k]];
-    if (h->q0[k] < h->arm_lo[k] - 1e-9 || h->q0[k] > h->arm_hi[k] + 1e-9)
+    h->q0[k] = s->nq0 ? s->q0[k] : m->qpos0[r->arm_qpos[k]];
+    if (h->q0[k] < r->arm_lo[k] - 1e-9 || h->q0[k] > r->arm_hi[k] + 1e-9)
       return vd_error_set(err, VD_ERR_VALUE, s->path, 0, 0,
                           "robot.q0[%d]: %g is outside joint '%s' range %g..%g", k, h->q0[k],
-                          name_of(m, mjOBJ_JOINT, h->arm_jnt[k]), h->arm_lo[k], h->arm_hi[k]);
+                          name_of(m, mjOBJ_JOINT, r->arm_jnt[k]), r->arm_lo[k], r->arm_hi[k]);
   }
   // time steps: control step = nrobot robot steps, robot step = nsub plant steps
   double ts = m->opt.timestep, dt = s->sim_opt.dt;
@@ -162,27 +174,64 @@ static vd_status describe(vd_harvest* h, vd_error* err) {
   return VD_OK;
 }
 
-vd_status robot_load(vd_harvest* h, vd_error* err) {
-  mjModel* m;
-  vd_status st = vd_mj_load_xml(h->scene.robot_path, "robot MJCF", &m, err);
-  if (st) return st;
+static vd_status robot_shapes(vd_robot* r, vd_error* err);
+
+vd_status vd_robot_load(const vd_scene* scene, vd_robot** out, vd_error* err) {
+  *out = NULL;
+  vd_mj_trap_install();
+  vd_robot* r = vd_calloc(1, sizeof *r);
+  if (!r) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  snprintf(r->path, sizeof r->path, "%s", scene->robot_path);
+  snprintf(r->ee_site_name, sizeof r->ee_site_name, "%s", scene->ee_site);
+  for (int k = 0; k < 2; k++)
+    snprintf(r->gripper_name[k], sizeof r->gripper_name[k], "%s", scene->gripper[k]);
+  vd_status st = vd_mj_load_xml(scene->robot_path, "robot MJCF", &r->m, err);
+  if (!st) st = describe(r, scene, err);
+  if (!st) st = robot_shapes(r, err);
+  if (st) {
+    vd_robot_destroy(r);
+    return st;
+  }
+  *out = r;
+  return VD_OK;
+}
+
+void vd_robot_destroy(vd_robot* r) {
+  if (!r) return;
+  for (int k = 0; k < r->ngeom; k++) vd_sdf_destroy(r->geom[k].sdf);
+  if (r->m) mj_deleteModel(r->m);
+  vd_free(r, sizeof *r);
+}
+
+int robot_matches(const vd_robot* r, const vd_scene* s) {
+  return !strcmp(r->path, s->robot_path) && !strcmp(r->ee_site_name, s->ee_site) &&
+         !strcmp(r->gripper_name[0], s->gripper[0]) && !strcmp(r->gripper_name[1], s->gripper[1]);
+}
+
+vd_status robot_attach(vd_harvest* h, vd_error* err) {
+  const vd_robot* rb = h->rb;
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
+  mjModel* m = mj_copyModel(NULL, rb->m);
+  vd_mj_trap_end(&trap);
+  if (!m) return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory (MuJoCo model)");
   h->m = m;
-  if ((st = describe(h, err))) return st;
+  vd_status st = episode_checks(h, err);
+  if (st) return st;
   // the scene's base pose replaces the root body's; the grip force limits the fingers
   vd_quat q = vd_quat_axis_angle(vd_v3(0, 0, 1), h->scene.base_yaw);
-  int r = h->root_body;
+  int r = rb->root_body;
   m->body_pos[3 * r] = h->scene.base_pos.x;
   m->body_pos[3 * r + 1] = h->scene.base_pos.y;
   m->body_pos[3 * r + 2] = h->scene.base_pos.z;
   m->body_quat[4 * r] = q.w, m->body_quat[4 * r + 1] = q.x;
   m->body_quat[4 * r + 2] = q.y, m->body_quat[4 * r + 3] = q.z;
   for (int k = 0; k < 2; k++) {
-    int a = h->grip_act[k];
+    int a = rb->grip_act[k];
     m->actuator_forcelimited[a] = 1;
     m->actuator_forcerange[2 * a] = -h->scene.method.grip_force;
     m->actuator_forcerange[2 * a + 1] = h->scene.method.grip_force;
   }
-  vd_mj_trap trap;
   if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
   h->d = mj_makeData(m);
   h->dk = mj_makeData(m);
@@ -195,14 +244,14 @@ vd_status robot_load(vd_harvest* h, vd_error* err) {
     vd_free(jr, sizeof(mjtNum) * 3 * (size_t)m->nv);
     return vd_mj_trap_status(&trap, err);
   }
-  for (int k = 0; k < h->narm; k++) h->dk->qpos[h->arm_qpos[k]] = h->q0[k];
+  for (int k = 0; k < rb->narm; k++) h->dk->qpos[rb->arm_qpos[k]] = h->q0[k];
   mj_kinematics(m, h->dk);
   mj_comPos(m, h->dk);
-  mj_jacSite(m, h->dk, NULL, jr, h->ee_site);
+  mj_jacSite(m, h->dk, NULL, jr, rb->ee_site);
   vd_mj_trap_end(&trap);
   double s2 = 0;
-  for (int k = 0; k < h->narm; k++)
-    for (int i = 0; i < 3; i++) s2 += jr[i * m->nv + h->arm_dof[k]] * jr[i * m->nv + h->arm_dof[k]];
+  for (int k = 0; k < rb->narm; k++)
+    for (int i = 0; i < 3; i++) s2 += jr[i * m->nv + rb->arm_dof[k]] * jr[i * m->nv + rb->arm_dof[k]];
   h->orient = s2 > 1e-12;
   vd_free(jr, sizeof(mjtNum) * 3 * (size_t)m->nv);
   return VD_OK;
@@ -271,40 +320,39 @@ static vd_status geom_mesh(const mjModel* m, int g, double** vert, int* nv, int*
   return VD_OK;
 }
 
-vd_status robot_colliders(vd_harvest* h, vd_error* err) {
-  const mjModel* m = h->m;
-  const char* file = h->scene.robot_path;
-  h->ncol = 0;
+// the collision shapes of the robot's collidable geoms, in their own frames
+static vd_status robot_shapes(vd_robot* r, vd_error* err) {
+  const mjModel* m = r->m;
+  const char* file = r->path;
+  r->ngeom = 0;
   for (int g = 0; g < m->ngeom; g++) {
     int b = m->geom_bodyid[g], type = m->geom_type[g];
-    if (b == 0 || m->body_rootid[b] != h->root_body) continue;
+    if (b == 0 || m->body_rootid[b] != r->root_body) continue;
     if (!m->geom_contype[g] && !m->geom_conaffinity[g]) continue;
     if (type == mjGEOM_PLANE || type == mjGEOM_HFIELD) continue;
-    if (h->ncol == ROBOT_MAX_COLLIDERS)
+    if (r->ngeom == ROBOT_MAX_COLLIDERS)
       return vd_error_set(err, VD_ERR_LIMIT, file, 0, 0,
                           "robot: more than %d collidable geoms (set contype and conaffinity of "
                           "visual geoms to 0)",
                           ROBOT_MAX_COLLIDERS);
-    robot_collider* c = &h->col[h->ncol];
+    robot_geom* c = &r->geom[r->ngeom];
     memset(c, 0, sizeof *c);
     c->geom = g, c->body = b, c->finger = -1;
     for (int k = 0; k < 2; k++)
-      if (below(m, b, h->finger_body[k])) c->finger = k;
+      if (below(m, b, r->finger_body[k])) c->finger = k;
     const mjtNum* sz = m->geom_size + 3 * g;
-    vd_sim_collider sc;
-    memset(&sc, 0, sizeof sc);
-    sc.quat = vd_quat_identity();
-    memset(&c->shape, 0, sizeof c->shape);
+    vd_sim_collider* sc = &c->sc;
+    sc->quat = vd_quat_identity();
     c->shape.pose = vd_pose_identity();
     c->shape.id = g;
     if (type == mjGEOM_SPHERE) {
-      sc.shape = VD_SIM_SPHERE, sc.size[0] = sz[0];
+      sc->shape = VD_SIM_SPHERE, sc->size[0] = sz[0];
       c->shape.shape = VD_SHAPE_SPHERE, c->shape.radius = sz[0];
     } else if (type == mjGEOM_CAPSULE) {
-      sc.shape = VD_SIM_CAPSULE, sc.size[0] = sz[0], sc.size[1] = sz[1];
+      sc->shape = VD_SIM_CAPSULE, sc->size[0] = sz[0], sc->size[1] = sz[1];
       c->shape.shape = VD_SHAPE_CAPSULE, c->shape.radius = sz[0], c->shape.half_length = sz[1];
     } else if (type == mjGEOM_BOX) {
-      sc.shape = VD_SIM_BOX, sc.size[0] = sz[0], sc.size[1] = sz[1], sc.size[2] = sz[2];
+      sc->shape = VD_SIM_BOX, sc->size[0] = sz[0], sc->size[1] = sz[1], sc->size[2] = sz[2];
       c->shape.shape = VD_SHAPE_BOX, c->shape.half_size = vd_v3(sz[0], sz[1], sz[2]);
     } else {
       // cylinder, ellipsoid, mesh: a signed distance grid of the closed surface
@@ -323,15 +371,29 @@ vd_status robot_colliders(vd_harvest* h, vd_error* err) {
         snprintf(why, sizeof why, "%s", err ? err->msg : "no distance grid");
         return vd_error_set(err, st, file, 0, 0, "robot geom '%s': %s", name_of(m, mjOBJ_GEOM, g), why);
       }
-      sc.shape = VD_SIM_MESH, sc.sdf = c->sdf;
+      sc->shape = VD_SIM_MESH, sc->sdf = c->sdf;
       c->shape.shape = VD_SHAPE_SDF, c->shape.sdf = c->sdf;
     }
-    c->cur = c->prev = robot_geom_pose(m, h->d, g);
+    r->ngeom++;
+  }
+  return VD_OK;
+}
+
+vd_status robot_colliders(vd_harvest* h, vd_error* err) {
+  const vd_robot* rb = h->rb;
+  h->ncol = 0;
+  for (int k = 0; k < rb->ngeom; k++) {
+    const robot_geom* g = &rb->geom[k];
+    robot_collider* c = &h->col[h->ncol];
+    memset(c, 0, sizeof *c);
+    c->geom = g->geom, c->body = g->body, c->finger = g->finger;
+    c->shape = g->shape;
+    c->cur = c->prev = c->shape.pose = robot_geom_pose(h->m, h->d, g->geom);
+    vd_sim_collider sc = g->sc;
     sc.pos = c->cur.pos, sc.quat = c->cur.rot;
-    c->shape.pose = c->cur;
     c->sim = vd_sim_add_collider(h->sd, &sc);
     if (c->sim < 0)
-      return vd_error_set(err, VD_ERR_LIMIT, file, 0, 0, "robot: too many colliders for the plant");
+      return vd_error_set(err, VD_ERR_LIMIT, rb->path, 0, 0, "robot: too many colliders for the plant");
     h->ncol++;
   }
   // the fruits
@@ -354,7 +416,6 @@ vd_status robot_colliders(vd_harvest* h, vd_error* err) {
 }
 
 void robot_free(vd_harvest* h) {
-  for (int k = 0; k < h->ncol; k++) vd_sdf_destroy(h->col[k].sdf);
   h->ncol = 0;
   if (h->d) mj_deleteData(h->d);
   if (h->dk) mj_deleteData(h->dk);

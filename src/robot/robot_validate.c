@@ -161,7 +161,7 @@ void robot_push_rod(int two_way, double kp, double fmax, double young, const cha
   vd_scene_parse(text, strlen(text), NULL, &s, &e);
   vd_model* pm = rod_plant(0.2, 0.004);
   vd_harvest* h = NULL;
-  vd_harvest_create(&s, pm, &h, &e);  // no fruit: VD_ERR_VALUE, the handle is there
+  vd_harvest_create(&s, pm, &h, &e);  // no fruit: the episode has no target (an outcome)
   unlink(path);
   *tip = *lag = *reaction = *servo = *clamp = *tip_mass = NAN;
   if (!h) {
@@ -182,7 +182,7 @@ void robot_push_rod(int two_way, double kp, double fmax, double young, const cha
   *tip = vd_norm(vd_sub(vd_harvest_sim_data(h)->node_pos[tipn], sm->node_pos0[tipn]));
   *lag = o.cmd_pos.y - o.ee_pos.y;
   *reaction = o.robot_force.y;
-  *servo = h->d->actuator_force[h->arm_act[0]];
+  *servo = h->d->actuator_force[h->rb->arm_act[0]];
   // the rod's force on its clamp: the stretch-shear multiplier of the first free segment
   const vd_sim_data* sd = vd_harvest_sim_data(h);
   for (int t = 0; t < sm->nseg; t++) {

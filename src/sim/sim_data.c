@@ -160,8 +160,22 @@ int vd_sim_add_tie(vd_sim_data* d, int node, vd_vec3 target, double compliance) 
     w->cap_tie_lambda = cap;
   }
   vd_sim_tie* t = &d->tie[d->ntie];
+  memset(t, 0, sizeof *t);
   t->node = node, t->target = target, t->compliance = compliance;
   return d->ntie++;
+}
+
+void sim_tie_limit(const vd_sim_model* m, vd_sim_data* d, int k) {
+  if (k < m->ntie) return;
+  vd_sim_tie* t = &d->tie[k - m->ntie];
+  if (!(t->max_force > 0)) return;
+  vd_vec3 c = vd_sub(d->node_pos[t->node], t->target);
+  vd_vec3 ct = vd_sub(c, vd_scale(t->axis, vd_dot(c, t->axis)));  // across the axis
+  double n = vd_norm(ct), lim = t->max_force * t->compliance;
+  if (n <= lim) return;
+  vd_vec3 shift = vd_scale(ct, 1 - lim / n);
+  t->target = vd_add(t->target, shift);
+  t->slip += vd_norm(shift);
 }
 
 int sim_tie_count(const vd_sim_model* m, const vd_sim_data* d) {

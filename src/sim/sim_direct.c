@@ -943,6 +943,7 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     int n;
     vd_vec3 target;
     double comp;
+    sim_tie_limit(m, d, k);
     sim_tie_get(m, d, k, &n, &target, &comp);
     int s = tie_slot(m, d, p, n);
     if (s < 0) continue;
@@ -1014,11 +1015,13 @@ static int iterate(const vd_sim_model* m, vd_sim_data* d, sim_work* w, const sim
     const double* o = p->spare_dy + 3 * k;
     d->node_pos[n] = vd_add(d->node_pos[n], vd_v3(scale * o[0], scale * o[1], scale * o[2]));
   }
-  // tie multipliers: the node has moved already, the new constraint value is c + dx
+  // tie multipliers: the node has moved already, the new constraint value is c + dx (a
+  // friction-limited tie slides first: its multiplier stays inside its limit)
   for (int k = 0; k < ntie; k++) {
     int n;
     vd_vec3 target;
     double comp;
+    sim_tie_limit(m, d, k);
     sim_tie_get(m, d, k, &n, &target, &comp);
     if (tie_slot(m, d, p, n) < 0) continue;
     vd_vec3 cc = vd_sub(d->node_pos[n], target);

@@ -97,6 +97,7 @@ static void project_ties(const vd_sim_model* m, vd_sim_data* d, const sim_step_c
     int n;
     vd_vec3 target;
     double comp;
+    sim_tie_limit(m, d, k);
     sim_tie_get(m, d, k, &n, &target, &comp);
     double wn = sim_node_w(m, d, n);
     if (wn <= 0) continue;

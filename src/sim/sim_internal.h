@@ -264,6 +264,9 @@ static inline double sim_node_w(const vd_sim_model* m, const vd_sim_data* d, int
 int sim_tie_count(const vd_sim_model* m, const vd_sim_data* d);
 void sim_tie_get(const vd_sim_model* m, const vd_sim_data* d, int k, int* node, vd_vec3* target,
                  double* compliance);
+// A friction-limited user tie (max_force > 0): its target slides toward the node until the pull
+// across its axis is max_force (vd_sim_tie); called at every solver iteration.
+void sim_tie_limit(const vd_sim_model* m, vd_sim_data* d, int k);
 
 // ---------------------------------------------------------------------------------------------
 // contacts (sim_contact_basic.c until the collide module takes over)

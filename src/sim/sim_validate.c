@@ -41,17 +41,14 @@ static void check(vctx* v, const char* name, const char* form, const char* qty, 
                   double tol, int abs_err, const char* fmt, ...) __attribute__((format(printf, 9, 10)));
 static void check(vctx* v, const char* name, const char* form, const char* qty, double meas, double ref,
                   double tol, int abs_err, const char* fmt, ...) {
-  vd_validate_result* r = push(v, name, form, qty);
-  if (!r) return;
-  r->measured = meas;
-  r->reference = ref;
-  r->error = abs_err || ref == 0 ? fabs(meas - ref) : fabs(meas - ref) / fabs(ref);
-  r->tolerance = tol;
-  r->pass = isfinite(meas) && r->error <= tol;
+  if (v->st) return;
+  vd_validate_list l = {v->r, v->n, v->cap};
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(r->note, sizeof r->note, fmt, ap);
+  int ok = vd_validate_addv(&l, name, form, qty, meas, ref, tol, abs_err, fmt, ap);
   va_end(ap);
+  v->r = l.r, v->n = l.n, v->cap = l.cap;
+  if (!ok) v->st = vd_error_set(v->err, VD_ERR_NOMEM, "", 0, 0, "validate: out of memory");
 }
 
 // a control: a case that means something only if the measured value reaches a minimum (a run
