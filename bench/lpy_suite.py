@@ -10,7 +10,9 @@
              and rule bodies passed),
    refused   exit 2 with an `unsupported: ...` message naming the construct,
    failed    any other error (a Python exception in the file, a syntax error, ...),
-   crashed   killed by a signal, or no answer within the time limit.
+   crashed   killed by a signal, or over the time limit: --timeout seconds of CPU time (user +
+             system, so a busy machine does not count a file as crashed), or ten times that of
+             wall-clock time for a process that waits without computing.
 2. The L-Py unit tests that check the language (test_matching.py, test_fibonacci.py,
    test_nproduce.py, test_endeach.py, test_kwd.py, test_starmatching.py, test_regexpmatching.py)
    are run unchanged, with an `openalea.lpy` module written here whose Lsystem runs the
@@ -29,10 +31,13 @@ import inspect
 import json
 import os
 import re
+import resource
+import signal
 import subprocess
 import sys
 import tempfile
 import textwrap
+import threading
 import traceback
 import types
 import warnings
@@ -41,13 +46,51 @@ UNIT_TESTS = ["test_matching.py", "test_fibonacci.py", "test_nproduce.py", "test
               "test_kwd.py", "test_starmatching.py", "test_regexpmatching.py"]
 
 VERDANT = "verdant"
-TIMEOUT = 60
+TIMEOUT = 60      # CPU seconds per run
+WALL_FACTOR = 10  # a run that waits (no CPU) is stopped after WALL_FACTOR * TIMEOUT wall seconds
+
+
+def run_limited(cmd, cwd):
+    """Run cmd in cwd under TIMEOUT seconds of CPU time (RLIMIT_CPU: SIGXCPU, then SIGKILL 5 s
+    later) and WALL_FACTOR * TIMEOUT seconds of wall-clock time. Returns (rc, stdout, stderr,
+    cpu seconds, over the limit); rc is -signal when a signal ended it."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_CPU, (TIMEOUT, TIMEOUT + 5))
+
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        p = subprocess.Popen(cmd, cwd=cwd, stdout=out, stderr=err, preexec_fn=limit)
+        lock, state = threading.Lock(), {"done": False, "walled": False}
+
+        def wall_kill():
+            with lock:
+                if not state["done"]:
+                    state["walled"] = True
+                    os.kill(p.pid, signal.SIGKILL)
+
+        timer = threading.Timer(WALL_FACTOR * TIMEOUT, wall_kill)
+        timer.start()
+        _, status, ru = os.wait4(p.pid, 0)
+        with lock:
+            state["done"] = True
+        timer.cancel()
+        rc = os.waitstatus_to_exitcode(status)
+        p.returncode = rc  # reaped here (wait4 gives its CPU time): Popen must not wait again
+        cpu = ru.ru_utime + ru.ru_stime
+        over = state["walled"] or rc in (-signal.SIGXCPU, -signal.SIGKILL) and cpu >= TIMEOUT
+        out.seek(0)
+        err.seek(0)
+        text = [f.read().decode("utf-8", "replace") for f in (out, err)]
+    if over:
+        what = "%d s of wall-clock time" % (WALL_FACTOR * TIMEOUT) if state["walled"] else "%d s of CPU time" % TIMEOUT
+        text[1] += "\nno answer within %s (%.1f s of CPU used)" % (what, cpu)
+    return rc, text[0], text[1], cpu, over
 
 
 # ---------------------------------------------------------------------------------------------
 # the .lpy files
 
 def classify(rc, err, timed_out):
+    """ok, refused, failed or crashed (see the module's comment)."""
     if timed_out or rc < 0 or rc > 128:
         return "crashed"
     if rc == 0:
@@ -69,12 +112,7 @@ def run_file(root, rel):
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [VERDANT, "grow", os.path.basename(path), "-o", os.path.join(tmp, "plant.json"),
                "--stats", "--no-progress", "--max-modules", "5000000"]
-        try:
-            p = subprocess.run(cmd, cwd=os.path.dirname(path), capture_output=True, text=True,
-                               errors="replace", timeout=TIMEOUT)
-            rc, out, err, to = p.returncode, p.stdout, p.stderr, False
-        except subprocess.TimeoutExpired:
-            rc, out, err, to = -1, "", "no answer within %d s" % TIMEOUT, True
+        rc, out, err, cpu, to = run_limited(cmd, os.path.dirname(path))
     engine = ""
     if rc == 0:
         try:
@@ -84,7 +122,7 @@ def run_file(root, rel):
     else:
         m = re.search(r"\(engine (\w+)\)", err)
         engine = m.group(1) if m else ""
-    return rel, classify(rc, err, to), engine, reason(err) if rc else ""
+    return rel, classify(rc, err, to), engine, reason(err) if rc else "", cpu
 
 
 def lpy_files(root):
@@ -230,10 +268,9 @@ class Lsystem:
                 if not callable(value) and re.search(r"^%s\s*=" % re.escape(name), self.code, re.M):
                     cmd += ["--set", "%s=%r" % (name, value)]
             cwd = os.path.dirname(self.filename) if self.filename else tmp
-            p = subprocess.run(cmd, capture_output=True, text=True, errors="replace",
-                               timeout=TIMEOUT, cwd=cwd)
-            if p.returncode:
-                raise LsystemError(reason(p.stderr))
+            rc, _, err, _, _ = run_limited(cmd, cwd)
+            if rc:
+                raise LsystemError(reason(err))
             with open(os.path.join(tmp, "lstring.json"), encoding="utf-8") as f:
                 mods = json.load(f)["modules"]
         return AxialTree(Module(m[0], m[1:]) for m in mods)
@@ -324,7 +361,9 @@ def main():
     ap.add_argument("lpy", help="an openalea/lpy checkout")
     ap.add_argument("--verdant", default=os.path.join(os.path.dirname(__file__), "..", "build", "verdant"))
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--timeout", type=int, default=60, help="seconds per file (default 60)")
+    ap.add_argument("--timeout", type=int, default=60,
+                    help="CPU seconds per run (default 60; a run that waits without computing is "
+                         "stopped after ten times that of wall-clock time)")
     ap.add_argument("--csv", help="write one line per file and unit test")
     ap.add_argument("--files-only", action="store_true")
     ap.add_argument("--tests-only", action="store_true")
@@ -336,17 +375,19 @@ def main():
         with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
             res = list(ex.map(lambda rel: run_file(a.lpy, rel), files))
         counts = {}
-        for rel, cls, engine, why in res:
+        for rel, cls, engine, why, cpu in res:
             counts[cls] = counts.get(cls, 0) + 1
-            rows.append(("file", rel, cls, engine, why))
+            rows.append(("file", rel, cls, engine, why, "%.2f" % cpu))
         by_engine = {}
-        for _, cls, engine, _ in res:
+        for _, cls, engine, _, _ in res:
             if cls == "ok":
                 by_engine[engine] = by_engine.get(engine, 0) + 1
         print("files: %d  ok %d (%s)  refused %d  failed %d  crashed %d" % (
             len(res), counts.get("ok", 0), ", ".join("%s %d" % kv for kv in sorted(by_engine.items())),
             counts.get("refused", 0), counts.get("failed", 0), counts.get("crashed", 0)))
-        for rel, cls, engine, why in res:
+        print("CPU time: %.1f s in all, the most %.1f s (%s)" % (
+            sum(r[4] for r in res), max(r[4] for r in res), max(res, key=lambda r: r[4])[0]))
+        for rel, cls, engine, why, _ in res:
             if cls != "ok":
                 print("  %-8s %s: %s" % (cls, rel, why))
     if not a.files_only:
@@ -354,13 +395,13 @@ def main():
         passed = sum(1 for t in tests if t[2] == "passed")
         print("unit tests: %d of %d passed" % (passed, len(tests)))
         for fname, name, cls, why in tests:
-            rows.append(("test", "%s::%s" % (fname, name), cls, "", why))
+            rows.append(("test", "%s::%s" % (fname, name), cls, "", why, ""))
             if cls != "passed":
                 print("  failed   %s::%s: %s" % (fname, name, why))
     if a.csv:
         with open(a.csv, "w", newline="", encoding="utf-8") as f:
             w = csv.writer(f)
-            w.writerow(["kind", "name", "result", "engine", "reason"])
+            w.writerow(["kind", "name", "result", "engine", "reason", "cpu_s"])
             w.writerows(rows)
 
 

@@ -18,20 +18,18 @@ SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fram
 # lsys's Python engine: CPython's headers and library, the shim compiled in (build-fuzz/gen); the
 # targets run the native engine only (fuzz input is never executed as Python)
 mkdir -p "$OUT/gen"
-if [ ! -f "$OUT/gen/lsys_shim.h" ] || [ src/lsys/lsys_shim.py -nt "$OUT/gen/lsys_shim.h" ]; then
-  cmake -DIN=src/lsys/lsys_shim.py -DOUT="$OUT/gen/lsys_shim.h" -DNAME=lsys_shim_py -P cmake/embed.cmake || exit 2
-fi
+cmake -DDIR=src/lsys/py/lpyshim -DOUT="$OUT/gen/lpyshim.h" -DNAME=lpyshim_files -P cmake/embed_package.cmake || exit 2
 PYINC=$(pkg-config --cflags-only-I python3-embed | sed 's/-I/-isystem /g')
 CFLAGS="-std=c11 -g -O1 -ffp-contract=off -Iinclude -Isrc -I$OUT/gen $PYINC $(pkg-config --cflags libcjson) $SAN"
 LIBS="$(pkg-config --libs libcjson) $(pkg-config --libs python3-embed) -lm"
 
 # library objects, rebuilt when the source or any header is newer (on every core at once)
 mkdir -p "$OUT/obj"
-newest_h=$(ls -t include/verdant/*.h src/*/*.h fuzz/*.h "$OUT/gen/lsys_shim.h" | head -1)
+newest_h=$(ls -t include/verdant/*.h src/*/*.h src/lsys/py/*.h fuzz/*.h "$OUT/gen/lpyshim.h" | head -1)
 objs=()
 jobs=$(nproc 2>/dev/null || echo 2)
 # (the robot module only for its scene parser: MuJoCo is not linked)
-for src in src/core/*.c src/plant/*.c src/lsys/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/phys/*.c src/sim/*.c src/mss/*.c src/robot/robot_scene.c; do
+for src in src/core/*.c src/plant/*.c src/lsys/*.c src/lsys/py/*.c src/geom/*.c src/collide/*.c src/cloud/*.c src/phys/*.c src/sim/*.c src/mss/*.c src/robot/robot_scene.c; do
   obj="$OUT/obj/$(basename "${src%.c}").o"
   objs+=("$obj")
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ "$newest_h" -nt "$obj" ]; then

@@ -9,10 +9,12 @@ set -eu
 # EGL and its software/DRI drivers (libegl-mesa0, libgl1-mesa-dri); dataset checksums (SHA-256):
 # nettle-dev; the Python package (python/): python3-dev, python3-numpy, python3-pytest for its
 # tests, python3-setuptools and python3-venv for `pip install ./python` (offline); the L-system
-# Python engine: embedded CPython (libpython3.11-dev), numpy for the models that import it
+# Python engine: embedded CPython (libpython3.11-dev), numpy, pandas and scipy for the models that
+# import them (L-Py models read tables with pandas and fit curves with scipy)
 need=(cmake make gcc pkg-config libcjson-dev libpng-dev libmujoco-dev libqhull-dev python3
   libegl-dev libgl-dev libegl1 libegl-mesa0 libgl1-mesa-dri nettle-dev
-  python3-dev python3-numpy python3-pytest python3-setuptools python3-venv libpython3.11-dev)
+  python3-dev python3-numpy python3-pytest python3-setuptools python3-venv libpython3.11-dev
+  python3-pandas python3-scipy)
 # --dev adds the tools of CI's hardening runs: clang with libFuzzer (make fuzz, fuzz-smoke),
 # clang-tidy and cppcheck (make lint); and the Python package's optional peers, so that CI runs
 # their tests: python3-torch (verdant.torch's DataLoader test) and python3-open3d (to_open3d, the

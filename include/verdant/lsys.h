@@ -108,7 +108,8 @@ extern "C" {
   X(VD_SYM_TEXTRANSFORM, "TextureTransformation")                                                  \
   X(VD_SYM_LEFTREFLECTION, "LeftReflection")                                                       \
   X(VD_SYM_UPREFLECTION, "UpReflection")                                                           \
-  X(VD_SYM_HEADINGREFLECTION, "HeadingReflection")
+  X(VD_SYM_HEADINGREFLECTION, "HeadingReflection")                                                \
+  X(VD_SYM_NEW, "new")
 
 typedef enum vd_sym {
 #define VD_SYM_ENUM(e, s) e,

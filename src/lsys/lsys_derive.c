@@ -60,7 +60,7 @@ static vd_lsystem* lsys_new(const char* name, vd_error* err) {
       {"SetScale", VD_SYM_SETSCALE}, {"PglShape", VD_SYM_PGLSHAPE},
       {"Elasticity", VD_SYM_ELASTICITY}, {"Tropism", VD_SYM_TROPISM},
       {"TextureVCoeff", VD_SYM_TEXVSCALE}, {"StartScreenProjection", VD_SYM_2D},
-      {"EndScreenProjection", VD_SYM_3D},
+      {"EndScreenProjection", VD_SYM_3D}, {"newmodule", VD_SYM_NEW},
   };
   for (size_t i = 0; i < sizeof aliases / sizeof aliases[0]; i++) {
     if (sym_alias(ls, aliases[i].name, aliases[i].sym) < 0) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Which engine runs a file: the native Python subset when the whole file stays inside it (the
-// fast path), else embedded CPython (lsys_py.c). Both share the parser's rule structure, the
+// fast path), else embedded CPython (py/lsys_py.c). Both share the parser's rule structure, the
 // derivation, the L-string layout and the turtle; only the Python parts differ.
 #include <string.h>
 

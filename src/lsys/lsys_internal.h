@@ -550,7 +550,7 @@ vd_status value_to_param(vd_lsystem* ls, value v, double* out, int line, int col
 value param_to_value(double d);
 
 // ---------------------------------------------------------------------------------------------
-// the Python engine (lsys_py.c: CPython bridge and run time; lsys_pysrc.c: the file's Python
+// the Python engine (py/lsys_py.c: CPython bridge and run time; py/lsys_pysrc.c: the file's Python
 // source). Only these two files include Python.h. Every function below is a no-op or an
 // error for the native engine (ls->py == NULL).
 

@@ -963,6 +963,11 @@ static tmpl* parse_tmpl(vd_lsystem* ls, scope* sc, const char* s, int len, int p
     }
     int sym = read_module_name(ls, s, len, &pos, lineno, col0);
     if (sym < 0) goto fail;
+    if (sym_canon(ls, sym) == VD_SYM_NEW && ls->engine == VD_LSYS_NATIVE) {
+      // newmodule('B', x) is the module B(x): its name is a value, made by the Python engine
+      perr(ls, VD_ERR_UNSUPPORTED, lineno, mcol, "unsupported: 'newmodule' module (a module named by a value)");
+      goto fail;
+    }
     if (t->n == cap) {
       int ncap = cap ? cap * 2 : 16;
       tmod* nm = aalloc(ls, sizeof(tmod) * (size_t)ncap);

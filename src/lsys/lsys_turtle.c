@@ -1766,6 +1766,7 @@ static vd_status step(turtle* T) {
   case VD_SYM_TEXBASECOLOR:
   case VD_SYM_INTERPTEXCOLORS:
   case VD_SYM_TEXTRANSFORM:
+  case VD_SYM_NEW:  // newmodule(...) becomes the module it names when produced
   case VD_SYM_PREDEFINED_COUNT:
     return VD_OK;
   }

@@ -21,17 +21,18 @@
 // vector, curve) as a NaN-boxed handle into the lsystem's object table. The table is swept
 // after each step (objects no module refers to are released) and emptied when a derivation
 // starts, so handles of an older derivation's string are stale (they read back as None).
-#include "lsys/lsys_py.h"  // Python.h first: it sets the feature macros
+#include "lsys/py/lsys_py.h"  // Python.h first: it sets the feature macros
 
 #include <limits.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#include "lsys_shim.h"  // generated from lsys_shim.py: lsys_shim_py[]
+#include "lpyshim.h"  // generated from the package lpyshim: lpyshim_files[]
 
 #ifndef VD_PYTHON_HOME
 #define VD_PYTHON_HOME "/usr"
@@ -128,37 +129,79 @@ static void start_watchdog(void) {
   pthread_attr_destroy(&a);
 }
 
-// read the shim (embedded Python source) into a private module and build the base namespace
-static int load_shim(void) {
-  PyObject* mod = vd_module_create();
-  if (!mod) return 0;
-  PyObject* ns = PyDict_New();
-  if (!ns) {
-    Py_DECREF(mod);
-    return 0;
+// The shim: the package lpyshim (embedded Python sources) as the private package
+// _verdant_lpyshim. __init__ runs first; its __all__ lists the modules in the order they run,
+// each registered in sys.modules so that their relative imports find each other; `_vd` (the C
+// module) is there before them. The last, engine, holds what the C side calls.
+#define SHIM_PKG "_verdant_lpyshim"
+
+static const char* shim_source(const char* module) {
+  for (int i = 0; i < lpyshim_files_count; i++)
+    if (!strcmp(lpyshim_files[i].module, module)) return lpyshim_files[i].source;
+  return NULL;
+}
+
+// run the shim's module `file` (a name of lpyshim_files) as the module `as`; a new reference
+static PyObject* shim_module(const char* as, const char* file) {
+  const char* src = shim_source(file);
+  if (!src) return PyErr_Format(PyExc_ImportError, "the shim has no module %s", file);
+  PyObject* m = PyModule_New(as);
+  PyObject* d = m ? PyModule_GetDict(m) : NULL;  // borrowed
+  PyObject* pkg = PyUnicode_FromString(SHIM_PKG);
+  char fname[96];
+  snprintf(fname, sizeof fname, "<verdant lpyshim/%s.py>", file);
+  int bad = !d || !pkg || PyDict_SetItemString(d, "__builtins__", PyEval_GetBuiltins()) ||
+            PyDict_SetItemString(d, "__package__", pkg) || PyDict_SetItemString(PyImport_GetModuleDict(), as, m);
+  Py_XDECREF(pkg);
+  if (bad) {
+    Py_XDECREF(m);
+    return NULL;
   }
-  PyDict_SetItemString(ns, "__builtins__", PyEval_GetBuiltins());
-  PyDict_SetItemString(ns, "__name__", PyUnicode_FromString("verdant_lsys_shim"));
-  PyDict_SetItemString(ns, "_vd", mod);
-  Py_DECREF(mod);
-  PyObject* code = Py_CompileString(lsys_shim_py, "<verdant lsys_shim.py>", Py_file_input);
-  PyObject* r = code ? PyEval_EvalCode(code, ns, ns) : NULL;
+  PyObject* code = Py_CompileString(src, fname, Py_file_input);
+  PyObject* r = code ? PyEval_EvalCode(code, d, d) : NULL;
   Py_XDECREF(code);
   if (!r) {
-    Py_DECREF(ns);
-    return 0;
+    Py_DECREF(m);
+    return NULL;
   }
   Py_DECREF(r);
-  PyObject* base = PyDict_GetItemString(ns, "BASE");  // borrowed
-  if (!base || !PyDict_Check(base)) {
-    PyErr_SetString(PyExc_RuntimeError, "the shim defines no BASE namespace");
-    Py_DECREF(ns);
-    return 0;
+  return m;
+}
+
+// load the shim's package and keep the engine module's namespace and its BASE namespace
+static int load_shim(void) {
+  PyObject* vd = vd_module_create();
+  PyObject* pkg = vd ? shim_module(SHIM_PKG, "__init__") : NULL;
+  PyObject* all = pkg ? PyObject_GetAttrString(pkg, "__all__") : NULL;
+  PyObject* path = PyList_New(0);
+  PyObject* eng = NULL;
+  int ok = all && PyList_Check(all) && path && !PyObject_SetAttrString(pkg, "__path__", path) &&
+           !PyDict_SetItemString(PyImport_GetModuleDict(), SHIM_PKG "._vd", vd) &&
+           !PyObject_SetAttrString(pkg, "_vd", vd);
+  Py_XDECREF(path);
+  for (Py_ssize_t i = 0; ok && i < PyList_GET_SIZE(all); i++) {
+    const char* name = PyUnicode_AsUTF8(PyList_GET_ITEM(all, i));
+    char as[64];
+    snprintf(as, sizeof as, SHIM_PKG ".%s", name ? name : "");
+    PyObject* m = name ? shim_module(as, name) : NULL;
+    ok = m && !PyObject_SetAttrString(pkg, name, m);
+    Py_XDECREF(eng);
+    eng = m;
   }
-  Py_INCREF(base);
-  g_base = base;
-  g_shim = ns;
-  return 1;
+  PyObject* ns = ok && eng ? PyModule_GetDict(eng) : NULL;  // borrowed: the last module's
+  PyObject* base = ns ? PyDict_GetItemString(ns, "BASE") : NULL;  // borrowed
+  if (ok && (!base || !PyDict_Check(base))) PyErr_SetString(PyExc_RuntimeError, "the shim defines no BASE namespace");
+  if (base && PyDict_Check(base)) {
+    Py_INCREF(base);
+    Py_INCREF(ns);
+    g_base = base;
+    g_shim = ns;
+  }
+  Py_XDECREF(eng);
+  Py_XDECREF(all);
+  Py_XDECREF(pkg);
+  Py_XDECREF(vd);
+  return g_shim != NULL;
 }
 
 static void shim_failed(void) {
@@ -288,7 +331,7 @@ void lsys_py_leave(vd_lsystem* ls) {
 static vd_status status_of(PyObject* type) {
   if (PyErr_GivenExceptionMatches(type, PyExc_SyntaxError)) return VD_ERR_SYNTAX;
   if (PyErr_GivenExceptionMatches(type, PyExc_NameError)) return VD_ERR_NAME;
-  // a PlantGL / L-Py name the shim does not have (lsys_shim.py _NotInShim): a refusal
+  // a PlantGL / L-Py name the shim does not have (lpyshim/engine.py _NotInShim): a refusal
   PyObject* nis = g_shim ? PyDict_GetItemString(g_shim, "_NotInShim") : NULL;  // borrowed
   if (nis && PyErr_GivenExceptionMatches(type, nis)) return VD_ERR_UNSUPPORTED;
   if (PyErr_GivenExceptionMatches(type, PyExc_AttributeError)) return VD_ERR_NAME;
@@ -300,6 +343,114 @@ static vd_status status_of(PyObject* type) {
   if (PyErr_GivenExceptionMatches(type, PyExc_NotImplementedError)) return VD_ERR_UNSUPPORTED;
   if (PyErr_GivenExceptionMatches(type, PyExc_OSError)) return VD_ERR_IO;
   return VD_ERR_VALUE;
+}
+
+// ---------------------------------------------------------------------------------------------
+// error places: the Python engine compiles rule bodies and successors as translated text
+// (`produce B(x)` becomes `return __vd_p(id, (x,))`), so a column in that text is found again in
+// the file's line: the failing expression's text, its k-th occurrence in the translated line
+// taken as its k-th occurrence in the file's line
+
+// line `line` (1-based) of text into buf (without its newline); 0 when absent
+static int text_line(const char* text, size_t len, int line, char* buf, size_t cap) {
+  size_t at = 0;
+  for (int l = 1; l < line && at < len; at++)
+    if (text[at] == '\n') l++;
+  if (at >= len && line > 1) return 0;
+  size_t e = at;
+  while (e < len && text[e] != '\n') e++;
+  size_t n = e - at < cap - 1 ? e - at : cap - 1;
+  memcpy(buf, text + at, n);
+  buf[n] = 0;
+  return 1;
+}
+
+// line `line` of the file `path` into buf; 0 when it cannot be read
+static int file_line(const char* path, int line, char* buf, size_t cap) {
+  FILE* f = path && *path ? fopen(path, "rb") : NULL;
+  if (!f) return 0;
+  int l = 1, ok = 0;
+  while (fgets(buf, (int)cap, f)) {
+    size_t n = strlen(buf);
+    int whole = n > 0 && buf[n - 1] == '\n';
+    if (l == line) {
+      while (n > 0 && (buf[n - 1] == '\n' || buf[n - 1] == '\r')) buf[--n] = 0;
+      ok = 1;
+      break;
+    }
+    if (whole) l++;
+  }
+  fclose(f);
+  return ok;
+}
+
+// the file column (1-based) of the expression at translated columns [c0, c1) of file line
+// `line`; 0 when it cannot be told
+static int file_col(const vd_lsystem* ls, int line, int c0, int c1) {
+  static char gen[1024], orig[1024];
+  const lsys_py* py = ls->py;
+  int found = 0;
+  for (int k = 0; py && k < py->nfn && !found; k++) {
+    const pychunk* ch = &py->fn[k];
+    if (ch->src && line >= ch->line) found = text_line(ch->src, ch->len, line - ch->line + 1, gen, sizeof gen);
+  }
+  if (!found || !file_line(ls->file, line, orig, sizeof orig)) return found ? 0 : c0 + 1;
+  int glen = (int)strlen(gen);
+  if (c0 < 0 || c1 <= c0 || c1 > glen) return 0;
+  // the k-th occurrence of the expression's text in the translated line
+  int tlen = c1 - c0, k = 0;
+  for (int i = 0; i < c0; i++)
+    if (!strncmp(gen + i, gen + c0, (size_t)tlen)) k++;
+  for (const char* p = orig; *p; p++)
+    if (!strncmp(p, gen + c0, (size_t)tlen) && k-- == 0) return (int)(p - orig) + 1;
+  return 0;
+}
+
+// Is path a module beside the .lpy file (under its folder, not the file itself)?
+static int beside_model(const vd_lsystem* ls, const char* path) {
+  char dir[4096];
+  if (!path || path[0] != '/' || !strcmp(path, ls->file) || !realpath(ls->file, dir)) return 0;
+  char* slash = strrchr(dir, '/');
+  if (!slash) return 0;
+  slash[1] = 0;
+  size_t n = strlen(dir);
+  return !strncmp(path, dir, n) && !strstr(path + n, "/site-packages/") && !strstr(path + n, "/dist-packages/");
+}
+
+// path shown as the user named the model's folder (dir/helper.py for dir/model.lpy)
+static void shown_path(const vd_lsystem* ls, const char* path, char* out, size_t cap) {
+  char dir[4096];
+  const char* slash = realpath(ls->file, dir) ? strrchr(dir, '/') : NULL;
+  const char* given = strrchr(ls->file, '/');
+  size_t n = slash ? (size_t)(slash - dir) + 1 : 0;
+  if (slash && !strncmp(path, dir, n))
+    snprintf(out, cap, "%.*s%s", given ? (int)(given - ls->file) + 1 : 0, ls->file, path + n);
+  else
+    snprintf(out, cap, "%s", path);
+}
+
+// one traceback frame: its file, line and (1-based, exact) column; 0 when not known
+static const char* frame_place(PyObject* t, PyObject** fname, int* line, int* c0, int* c1) {
+  PyObject* frame = PyObject_GetAttrString(t, "tb_frame");
+  PyObject* lineno = PyObject_GetAttrString(t, "tb_lineno");
+  PyObject* lasti = PyObject_GetAttrString(t, "tb_lasti");
+  PyObject* code = frame ? PyObject_GetAttrString(frame, "f_code") : NULL;
+  *fname = code ? PyObject_GetAttrString(code, "co_filename") : NULL;
+  const char* fs = *fname && PyUnicode_Check(*fname) ? PyUnicode_AsUTF8(*fname) : NULL;
+  *line = lineno && PyLong_Check(lineno) ? (int)PyLong_AsLong(lineno) : 0;
+  *c0 = *c1 = -1;
+  int l0, l1, a, b;
+  if (lasti && PyLong_Check(lasti) && code && PyCode_Check(code) &&
+      PyCode_Addr2Location((PyCodeObject*)code, (int)PyLong_AsLong(lasti), &l0, &a, &l1, &b) && l0 == *line && a >= 0) {
+    *c0 = a;
+    *c1 = l1 == l0 ? b : -1;
+  }
+  Py_XDECREF(frame);
+  Py_XDECREF(lineno);
+  Py_XDECREF(lasti);
+  Py_XDECREF(code);
+  PyErr_Clear();
+  return fs;
 }
 
 // Turn the pending exception into ls->err: the innermost traceback frame in the .lpy file gives
@@ -331,30 +482,25 @@ static vd_status py_error(vd_lsystem* ls) {
     Py_XDECREF(f);
     PyErr_Clear();
   }
-  // the innermost frame of the traceback in the .lpy file
+  // the innermost frame of the traceback in the .lpy file, and the innermost one after it in a
+  // module beside the file (a helper the file imports), where the error is then reported
+  char helper[512] = "";
+  int hline = 0, hcol = 0;
   for (PyObject* t = tb; t && t != Py_None;) {
-    PyObject* frame = PyObject_GetAttrString(t, "tb_frame");
-    PyObject* lineno = PyObject_GetAttrString(t, "tb_lineno");
-    PyObject* code = frame ? PyObject_GetAttrString(frame, "f_code") : NULL;
-    PyObject* fname = code ? PyObject_GetAttrString(code, "co_filename") : NULL;
-    const char* fs = fname && PyUnicode_Check(fname) ? PyUnicode_AsUTF8(fname) : NULL;
-    if (fs && !strcmp(fs, ls->file) && lineno && PyLong_Check(lineno)) {
-      line = (int)PyLong_AsLong(lineno);
-      col = 0;
-      PyObject* lasti = PyObject_GetAttrString(t, "tb_lasti");
-      if (lasti && PyLong_Check(lasti) && code && PyCode_Check(code)) {
-        int l0, c0, l1, c1;
-        if (PyCode_Addr2Location((PyCodeObject*)code, (int)PyLong_AsLong(lasti), &l0, &c0, &l1, &c1) && l0 == line &&
-            c0 >= 0)
-          col = c0 + 1;
-      }
-      Py_XDECREF(lasti);
+    PyObject* fname = NULL;
+    int fl, c0, c1;
+    const char* fs = frame_place(t, &fname, &fl, &c0, &c1);
+    if (fs && !strcmp(fs, ls->file) && fl > 0) {
+      line = fl;
+      col = c0 >= 0 ? file_col(ls, fl, c0, c1) : 0;
+      helper[0] = 0;
+    } else if (fs && line && beside_model(ls, fs)) {
+      shown_path(ls, fs, helper, sizeof helper);
+      hline = fl;
+      hcol = c0 >= 0 ? c0 + 1 : 0;
     }
-    PyObject* next = PyObject_GetAttrString(t, "tb_next");
-    Py_XDECREF(frame);
-    Py_XDECREF(lineno);
-    Py_XDECREF(code);
     Py_XDECREF(fname);
+    PyObject* next = PyObject_GetAttrString(t, "tb_next");
     if (t != tb) Py_DECREF(t);
     t = next;
     PyErr_Clear();
@@ -364,17 +510,23 @@ static vd_status py_error(vd_lsystem* ls) {
   const char* msg = s ? PyUnicode_AsUTF8(s) : NULL;
   if (!msg) PyErr_Clear();
   // a limit or an unsupported feature keeps verdant's wording
+  char text[512];
   if (st == VD_ERR_LIMIT && atomic_load(&g_fired))
-    vm_error(ls, st, line, col,
+    snprintf(text, sizeof text,
              "the Python code made no progress for %.0f s (a loop that never ends?); --max-ops %lld allows "
              "max_ops / 10^7 seconds",
              (double)atomic_load(&g_limit_ms) / 1000.0, (long long)ls->max_ops);
   else if (st == VD_ERR_UNSUPPORTED)
-    vm_error(ls, st, line, col, "unsupported: %s: %s", tn, msg ? msg : "");
+    snprintf(text, sizeof text, "unsupported: %s: %s", tn, msg ? msg : "");
   else if (!msg || !*msg)
-    vm_error(ls, st, line, col, "%s", PyErr_GivenExceptionMatches(type, PyExc_AssertionError) ? "assertion failed" : tn);
+    snprintf(text, sizeof text, "%s", PyErr_GivenExceptionMatches(type, PyExc_AssertionError) ? "assertion failed" : tn);
   else
-    vm_error(ls, st, line, col, "%s: %s", tn, msg);
+    snprintf(text, sizeof text, "%s: %s", tn, msg);
+  // failed in a module beside the file: its place, and the file's line that called it
+  if (helper[0] && ls->err && ls->err->status == VD_OK)
+    vd_error_set(ls->err, st, helper, hline, hcol, "%s (called from %s:%d:%d)", text, ls->file, line, col);
+  else
+    vm_error(ls, st, line, col, "%s", text);
   Py_XDECREF(s);
   Py_XDECREF(type);
   Py_XDECREF(val);
@@ -598,6 +750,26 @@ static PyObject* vd_abort(void) {
 static int64_t lstr_nval(const vd_lstring* s) { return s->par ? s->par[s->n] : 0; }
 
 // append the template tid with parameter tuples args[0..nargs) to out
+// newmodule('B', ...) (L-Py's `new`): the module named by the first parameter, which must be a
+// string; *sym gets its symbol. Returns 1 (the parameters left start at 1), 0 with an exception.
+static Py_ssize_t new_module(vd_lsystem* ls, PyObject* tup, int* sym) {
+  PyObject* name = tup && PyTuple_GET_SIZE(tup) ? PyTuple_GET_ITEM(tup, 0) : NULL;
+  Py_ssize_t len = 0;
+  const char* s = name && PyUnicode_Check(name) ? PyUnicode_AsUTF8AndSize(name, &len) : NULL;
+  if (!s || !len || len > INT_MAX) {
+    if (!PyErr_Occurred())
+      PyErr_SetString(PyExc_TypeError, "newmodule(name, ...): the first parameter is the new module's name (a string)");
+    return 0;
+  }
+  int id = sym_intern(ls, s, (int)len, 0);
+  if (id < 0) {
+    PyErr_NoMemory();
+    return 0;
+  }
+  *sym = id;
+  return 1;
+}
+
 static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_ssize_t nargs) {
   lsys_py* py = ls->py;
   if (tid < 0 || tid >= py->ntp) {
@@ -634,12 +806,14 @@ static int emit(vd_lsystem* ls, vm_out* out, int tid, PyObject* const* args, Py_
     s->sym[n] = t->mod[m].sym;
     if (s->src) s->src[n] = out->src;
     if (s->line) s->line[n] = t->mod[m].line;
-    if (t->mod[m].nparam) {
-      PyObject* tup = args[a++];
+    PyObject* tup = t->mod[m].nparam ? args[a++] : NULL;
+    Py_ssize_t k0 = 0;
+    if (sym_canon(ls, t->mod[m].sym) == VD_SYM_NEW && !(k0 = new_module(ls, tup, &s->sym[n]))) return 0;
+    if (tup) {
       Py_ssize_t np = PyTuple_GET_SIZE(tup);
-      for (Py_ssize_t k = 0; k < np; k++)
-        if (!object_param(ls, PyTuple_GET_ITEM(tup, k), &s->val[v + k])) return 0;
-      v += np;
+      for (Py_ssize_t k = k0; k < np; k++)
+        if (!object_param(ls, PyTuple_GET_ITEM(tup, k), &s->val[v + k - k0])) return 0;
+      v += np - k0;
     }
     s->par[n + 1] = v;
     s->n = n + 1;
@@ -1045,6 +1219,18 @@ static PyObject* vd_isa(PyObject* self, PyObject* args) {
 }
 
 // frameDisplay(enabled): whether the step's frame is drawn
+// the short name of a predefined module named `name` (its own name or one of L-Py's long names),
+// or None: openalea.lpy's predefined module classes
+static PyObject* vd_predefined(PyObject* self, PyObject* arg) {
+  (void)self;
+  vd_lsystem* ls = current();
+  const char* name = PyUnicode_Check(arg) ? PyUnicode_AsUTF8(arg) : NULL;
+  if (!ls || !name) return name ? py_none() : NULL;
+  int sym = vd_lsys_symbol_find(ls, name);
+  if (sym < 0 || sym >= VD_SYM_PREDEFINED_COUNT) return py_none();
+  return PyUnicode_FromString(vd_lsys_symbol_name(ls, sym));
+}
+
 static PyObject* vd_set_frame_displayed(PyObject* self, PyObject* arg) {
   (void)self;
   vd_lsystem* ls = current();
@@ -1155,6 +1341,7 @@ static PyMethodDef vd_methods[] = {
     {"set_frame_displayed", vd_set_frame_displayed, METH_O, "frameDisplay"},
     {"animating", vd_animating, METH_NOARGS, "isAnimationEnabled"},
     {"isa", vd_isa, METH_VARARGS, "ModuleClass.issubclass"},
+    {"predefined", vd_predefined, METH_O, "a predefined module's short name, or None"},
     {"nested", vd_nested, METH_VARARGS, "an Lsystem inside a file"},
     {"module_matching", vd_module_matching, METH_NOARGS, "the 'Module matching' option"},
     {"set_option", vd_set_option, METH_VARARGS, "context().options.setSelection"},

@@ -8,7 +8,7 @@
 // values, so `*args` unpacks as in Python. Top-level code keeps its file lines; each function
 // is compiled on its own with its first line at the file line it came from, so tracebacks and
 // errors name the lines of the .lpy file.
-#include "lsys/lsys_py.h"  // Python.h first: it sets the feature macros
+#include "lsys/py/lsys_py.h"  // Python.h first: it sets the feature macros
 
 #include <ctype.h>
 #include <stdarg.h>

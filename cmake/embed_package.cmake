@@ -1,0 +1,35 @@
+# SPDX-License-Identifier: MIT
+# Embed the .py files of a Python package as C strings:
+#   cmake -DDIR=package_folder -DOUT=header.h -DNAME=symbol -P embed_package.cmake
+# The header defines NAME[] = {{"module", "source"}, ...} (module names without .py, sorted) and
+# NAME_count; the program that includes it runs the modules as it sees fit.
+get_filename_component(shown ${DIR} NAME)
+get_filename_component(DIR ${DIR} ABSOLUTE)
+file(GLOB files RELATIVE ${DIR} ${DIR}/*.py)
+list(SORT files)
+set(body "// generated from ${DIR} by cmake/embed_package.cmake: do not edit\n")
+set(table "")
+set(k 0)
+foreach(f ${files})
+  file(READ ${DIR}/${f} hex HEX)
+  string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," bytes "${hex}")
+  string(REGEX REPLACE "\\.py$" "" mod ${f})
+  string(APPEND body "static const char ${NAME}_${k}[] = {${bytes}0x00};\n")
+  string(APPEND table "    {\"${mod}\", ${NAME}_${k}},\n")
+  math(EXPR k "${k} + 1")
+endforeach()
+string(APPEND body "static const struct {\n  const char* module;  // name without .py\n  const char* source;\n} ${NAME}[] = {\n${table}};\n")
+string(APPEND body "static const int ${NAME}_count = ${k};\n")
+file(WRITE ${OUT}.tmp "${body}")
+# rewrite only on change, so an unchanged package does not rebuild its includer
+file(READ ${OUT}.tmp new)
+if(EXISTS ${OUT})
+  file(READ ${OUT} old)
+else()
+  set(old "")
+endif()
+if(NOT new STREQUAL old)
+  file(RENAME ${OUT}.tmp ${OUT})
+else()
+  file(REMOVE ${OUT}.tmp)
+endif()
