@@ -390,6 +390,23 @@ int sym_find(const vd_lsystem* ls, const char* name, int len);
 int sym_alias(vd_lsystem* ls, const char* alias, int canon);
 // The symbol a name id stands for (aliases resolve to their short name).
 static inline int sym_canon(const vd_lsystem* ls, int id) { return ls->syms.canon[id]; }
+
+// Python quotes while scanning source one character c at a time (*q: the open quote, 0 outside a
+// string): 0 when c is code, 1 when c opens, closes or is inside a string, 2 when c is a
+// backslash inside one (the next character is escaped: skip it). Use:
+//   int k = lsys_quote_step(c, &q); if (k) { i += k - 1; continue; }
+static inline int lsys_quote_step(char c, char* q) {
+  if (*q) {
+    if (c == '\\') return 2;
+    if (c == *q) *q = 0;
+    return 1;
+  }
+  if (c == '\'' || c == '"') {
+    *q = c;
+    return 1;
+  }
+  return 0;
+}
 #define LSYS_MAX_STR_BYTES (64 << 20)  // all strings of an lsystem together (bytes)
 // Id of a string, added when new; -1 out of memory, -2 over LSYS_MAX_STR_BYTES.
 int str_intern(vd_lsystem* ls, const char* s, int len);

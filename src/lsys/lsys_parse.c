@@ -1071,12 +1071,12 @@ static int close_paren(const char* s, int p, int b) {
   char q = 0;
   for (int i = p; i < b; i++) {
     char c = s[i];
-    if (q) {
-      if (c == '\\') i++;
-      else if (c == q) q = 0;
-    } else if (c == '\'' || c == '"') {
-      q = c;
-    } else if (c == '(') {
+    int k = lsys_quote_step(c, &q);
+    if (k) {
+      i += k - 1;
+      continue;
+    }
+    if (c == '(') {
       depth++;
     } else if (c == ')' && --depth == 0) {
       return i;
@@ -1091,12 +1091,12 @@ static int next_comma(const char* s, int p, int b) {
   char q = 0;
   for (int i = p; i < b; i++) {
     char c = s[i];
-    if (q) {
-      if (c == '\\') i++;
-      else if (c == q) q = 0;
-    } else if (c == '\'' || c == '"') {
-      q = c;
-    } else if (c == '(') {
+    int k = lsys_quote_step(c, &q);
+    if (k) {
+      i += k - 1;
+      continue;
+    }
+    if (c == '(') {
       depth++;
     } else if (c == ')') {
       depth--;
@@ -2123,13 +2123,9 @@ static int find_top(const char* s, int a, int b, const char* what) {
   char q = 0;
   for (int i = a; i + n <= b; i++) {
     char c = s[i];
-    if (q) {
-      if (c == '\\') i++;
-      else if (c == q) q = 0;
-      continue;
-    }
-    if (c == '\'' || c == '"') {
-      q = c;
+    int k = lsys_quote_step(c, &q);
+    if (k) {
+      i += k - 1;
       continue;
     }
     if (c == '#') return -1;
@@ -2151,12 +2147,12 @@ static vd_status parse_rule(parser* P, int* li, int section, int group) {
     int depth = 0;
     for (int i = 0; i < len; i++) {
       char c = s[i];
-      if (q) {
-        if (c == '\\') i++;
-        else if (c == q) q = 0;
-      } else if (c == '\'' || c == '"') {
-        q = c;
-      } else if (c == '(') {
+      int k = lsys_quote_step(c, &q);
+      if (k) {
+        i += k - 1;
+        continue;
+      }
+      if (c == '(') {
         depth++;
       } else if (c == ')') {
         depth--;
@@ -2203,13 +2199,12 @@ static vd_status parse_rule(parser* P, int* li, int section, int group) {
     char q = 0;
     for (int i = 0; i < hend; i++) {
       char c = s[i];
-      if (q) {
-        if (c == '\\') i++;
-        else if (c == q) q = 0;
+      int k = lsys_quote_step(c, &q);
+      if (k) {
+        i += k - 1;
         continue;
       }
-      if (c == '\'' || c == '"') q = c;
-      else if (c == '(') depth++;
+      if (c == '(') depth++;
       else if (c == ')') depth--;
       else if (depth == 0 && c == '<') {
         int two = i + 1 < hend && s[i + 1] == '<';

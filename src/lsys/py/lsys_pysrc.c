@@ -136,13 +136,9 @@ int lsys_py_params(vd_lsystem* ls, const char* s, int len, int* pos, int lineno,
   char q = 0;
   for (; i < len; i++) {
     char c = s[i];
-    if (q) {
-      if (c == '\\') i++;
-      else if (c == q) q = 0;
-      continue;
-    }
-    if (c == '\'' || c == '"') {
-      q = c;
+    int k = lsys_quote_step(c, &q);
+    if (k) {
+      i += k - 1;
       continue;
     }
     if (c == '(' || c == '[' || c == '{') {
@@ -198,12 +194,12 @@ expr* lsys_py_expr(vd_lsystem* ls, const char* s, int len, int lineno, int col) 
   char q = 0;
   int b = len;
   for (int i = 0; i < len; i++) {
-    if (q) {
-      if (s[i] == '\\') i++;
-      else if (s[i] == q) q = 0;
-    } else if (s[i] == '\'' || s[i] == '"') {
-      q = s[i];
-    } else if (s[i] == '#') {
+    int k = lsys_quote_step(s[i], &q);
+    if (k) {
+      i += k - 1;
+      continue;
+    }
+    if (s[i] == '#') {
       b = i;
       break;
     }
@@ -281,13 +277,12 @@ static size_t lstring_end(const char* t, size_t n, size_t a, int paren) {
   size_t i = a;
   for (; i < n; i++) {
     char c = t[i];
-    if (q) {
-      if (c == '\\') i++;
-      else if (c == q) q = 0;
+    int k = lsys_quote_step(c, &q);
+    if (k) {
+      i += (size_t)k - 1;
       continue;
     }
-    if (c == '\'' || c == '"') q = c;
-    else if (c == '(') depth++;
+    if (c == '(') depth++;
     else if (c == ')') {
       depth--;
       if (paren && depth == 0) return i;
@@ -317,12 +312,12 @@ static vd_status translate_incontext(vd_lsystem* ls, const char* t, size_t n, si
   char q = 0;
   for (; e < n; e++) {
     char c = t[e];
-    if (q) {
-      if (c == '\\') e++;
-      else if (c == q) q = 0;
-    } else if (c == '\'' || c == '"') {
-      q = c;
-    } else if (c == '(' || c == '[' || c == '{') {
+    int k = lsys_quote_step(c, &q);
+    if (k) {
+      e += (size_t)k - 1;
+      continue;
+    }
+    if (c == '(' || c == '[' || c == '{') {
       depth++;
     } else if (c == ']' || c == '}') {
       depth--;
