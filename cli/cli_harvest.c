@@ -219,6 +219,28 @@ static vd_status write_events(const vd_harvest* h, const char* dir, vd_error* er
   return st;
 }
 
+// RUN/forces.csv: the target's joint loads at every plant step over the last 0.5 s before it
+// came off (docs/formats.md)
+static vd_status write_forces(const vd_harvest* h, const char* dir, vd_error* err) {
+  char path[4200];
+  snprintf(path, sizeof path, "%s/forces.csv", dir);
+  int n = vd_harvest_forces(h, NULL, 0);
+  vd_harvest_force* x = vd_malloc(sizeof *x * (size_t)(n ? n : 1));
+  if (!x) return vd_error_set(err, VD_ERR_NOMEM, path, 0, 0, "out of memory");
+  vd_harvest_forces(h, x, n);
+  vd_outfile f;
+  vd_status st = vd_outfile_open(&f, path, err);
+  if (!st) {
+    fputs("time_s,calyx_force_N,calyx_moment_Nm,abscission_force_N,abscission_moment_Nm,pull_force_N,broke\n", f.fp);
+    for (int k = 0; k < n; k++)
+      fprintf(f.fp, "%.6f,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n", x[k].time, x[k].calyx_force, x[k].calyx_moment,
+              x[k].abscission_force, x[k].abscission_moment, x[k].pull_force, x[k].broke);
+    st = vd_outfile_commit(&f, err);
+  }
+  vd_free(x, sizeof *x * (size_t)(n ? n : 1));
+  return st;
+}
+
 // what an episode run writes as it goes
 typedef struct episode_out {
   const harvest_opts* o;
@@ -384,6 +406,7 @@ static int run_one(const harvest_opts* o, vd_scene* s) {
     vd_status s2 = cli_frames_end(&eo.frames, &err);
     st = st ? st : s2;
     if (!st) st = write_events(h, o->out, &err);
+    if (!st) st = write_forces(h, o->out, &err);
     char path[4200];
     snprintf(path, sizeof path, "%s/summary.json", o->out);
     if (!st) st = write_json(path, summary_json(h, o->profile ? wall : -1), &err);
@@ -801,12 +824,15 @@ int cli_harvest(int argc, char** argv) {
   override(&o, &s);
   // the files: the scene and what it names read; the run folder written (a single run replaces
   // an earlier one's files; a batch keeps its complete episodes and resumes)
-  static const char* const run_files[] = {"summary.json", "events.csv", "trajectory.csv"};
+  static const char* const run_files[] = {"summary.json", "events.csv", "trajectory.csv", "forces.csv"};
   static const char* const batch_files[] = {"summary.json", "episodes.csv", "episodes/*.json"};
   const char* members[32];
   int nm = 0;
-  for (int k = 0; !o.episodes && k < cli_run_nmember && nm < 29; k++) members[nm++] = cli_run_members[k];
-  for (int k = 0; k < 3; k++) members[nm++] = o.episodes ? batch_files[k] : run_files[k];
+  for (int k = 0; !o.episodes && k < cli_run_nmember && nm < 28; k++) members[nm++] = cli_run_members[k];
+  if (o.episodes)
+    for (int k = 0; k < 3; k++) members[nm++] = batch_files[k];
+  else
+    for (int k = 0; k < 4; k++) members[nm++] = run_files[k];
   cli_out_input("SCENE", o.scene);
   cli_out_input("the scene's plant", s.plant_path);
   cli_out_input("the scene's robot", s.robot_path);

@@ -41,6 +41,28 @@ for f in summary.json events.csv trajectory.csv; do
   [ -s "$T/pull/$f" ] && ok "pull wrote $f" || bad "pull wrote $f"
 done
 grep -q ',detach,' "$T/pull/events.csv" && ok "events: detach" || bad "events: detach"
+# forces.csv: every plant step of the last 0.5 s before the break, ending with the fracture's load
+python3 - "$T" <<'PY' && ok "forces.csv: plant steps up to the break" || bad "forces.csv: plant steps up to the break"
+import csv, json, sys
+t = sys.argv[1]
+s = json.load(open(f"{t}/pull/summary.json"))
+rows = list(csv.DictReader(open(f"{t}/pull/forces.csv")))
+times = [float(r["time_s"]) for r in rows]
+steps = [b - a for a, b in zip(times, times[1:])]
+last = rows[-1]
+col = "calyx_force_N" if s["site"] == "calyx" else "abscission_force_N"
+bad = []
+if not rows or last["broke"] != "1" or sum(r["broke"] == "1" for r in rows) != 1:
+    bad.append("the last row, and only it, is the break")
+if steps and not (max(steps) < 1.5 * min(steps) and max(steps) <= 0.002):
+    bad.append(f"rows every plant step ({min(steps)}-{max(steps)} s)")
+if not times[-1] - times[0] <= 0.5 + 1e-9:
+    bad.append(f"span {times[-1] - times[0]} s over 0.5 s")
+if abs(float(last[col]) - s["pedicel_force"]) > 1e-4 * max(1.0, s["pedicel_force"]):
+    bad.append(f"break row {last[col]} N against the summary's {s['pedicel_force']} N")
+print("\n".join(bad) or f"{len(rows)} rows over {times[-1] - times[0]:.3f} s, {col} {last[col]} N at the break")
+sys.exit(1 if bad else 0)
+PY
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -395,6 +395,21 @@ void vd_harvest_end(vd_harvest* h, const char* reason);
 // approach direction and the pedicel axis (calyx to centre). 0 when there is no target.
 int vd_harvest_grasp_pose(vd_harvest* h, vd_vec3* pos, vd_quat* rot, vd_vec3* approach,
                           vd_vec3* pedicel);
+// The target fruit's joint loads at one plant step (RUN/forces.csv).
+typedef struct vd_harvest_force {
+  double time;                                 // s
+  double calyx_force, calyx_moment;            // its stalk's joint (N, N m)
+  double abscission_force, abscission_moment;  // its pedicel's abscission joint (N, N m); 0: none
+  double pull_force;                           // the gripper's force sensor (N); 0 when not held
+  int broke;                                   // 1 at the step a watched joint broke (its load:
+                                               // the fracture's)
+} vd_harvest_force;
+#define VD_HARVEST_FORCE_WINDOW 0.5  // seconds of plant steps kept before the detachment
+// The target's joint loads at every plant step over the last VD_HARVEST_FORCE_WINDOW s up to
+// the step its calyx or abscission joint broke (or up to now, when none broke), oldest first:
+// how many there are; the first cap of them into out (Nullable).
+int vd_harvest_forces(const vd_harvest* h, vd_harvest_force* out, int cap);
+
 // The plant's fruits now: how many there are; the first cap of them into out (Nullable).
 int vd_harvest_fruits(const vd_harvest* h, vd_harvest_fruit* out, int cap);
 // The fruit with organ instance id; VD_ERR_ARG when the plant has none.

@@ -464,6 +464,10 @@ vd_status vd_sim_to_spec(const vd_sim_model* m, const vd_sim_data* d, vd_plant_s
 // M = C_b / (compliance l-bar) (N m), in the parent's material frame: bending about d1 and d2,
 // twisting about d3 (nseg x 3); 0 for broken joints and segments without a parent.
 void vd_sim_joint_moment(const vd_sim_model* m, const vd_sim_data* d, double* out);
+// The constraint force (N) and moment (N m) that the joint of segment seg with its parent
+// carried in the last step, as the fracture test measures them (the multipliers' generalised
+// forces J^T lambda / h^2); 0 for a broken joint, a segment without a parent and before a step.
+void vd_sim_joint_load(const vd_sim_model* m, const vd_sim_data* d, int seg, double* force, double* moment);
 // Largest bending stress of each rod segment (Pa): 4 |M_bend| / (pi r^3) of the joints at its
 // two ends, with its parent and with its children (nseg).
 void vd_sim_seg_stress(const vd_sim_model* m, const vd_sim_data* d, double* out);

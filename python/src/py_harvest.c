@@ -371,16 +371,45 @@ static PyObject* harvest_close(vdpy_harvest* o, PyObject* unused) {
 }
 
 // run(): the scene's scripted controller to the end of the episode (as `verdant harvest`)
-static PyObject* harvest_run(vdpy_harvest* o, PyObject* unused) {
+// run(until=): stop when the scripted controller enters a phase (its on_step hook)
+typedef struct run_until {
+  int phase;    // the phase to stop at; VD_PHASE_COUNT: none
+  int reached;  // 1 when it was entered
+} run_until;
+
+static vd_status stop_at_phase(void* user, const vd_harvest* h) {
+  run_until* u = user;
+  vd_harvest_obs b;
+  vd_harvest_observe((vd_harvest*)h, &b);
+  if ((int)b.phase != u->phase) return VD_OK;
+  u->reached = 1;
+  return VD_ERR_LIMIT;  // stops vd_harvest_run (u->reached tells it from an error)
+}
+
+static PyObject* harvest_run(vdpy_harvest* o, PyObject* args, PyObject* kw) {
+  static char* names[] = {"until", NULL};
+  const char* until = NULL;
+  if (!PyArg_ParseTupleAndKeywords(args, kw, "|z:run", names, &until)) return NULL;
+  run_until u = {VD_PHASE_COUNT, 0};
+  if (until) {
+    for (int p = VD_PHASE_APPROACH; p < VD_PHASE_COUNT; p++)
+      if (!strcmp(until, vd_harvest_phase_name((vd_harvest_phase)p))) u.phase = p;
+    if (u.phase == VD_PHASE_COUNT)
+      return vdpy_arg_error("until: a phase (approach, reach, close, detach, hold, done), not '%s'", until);
+  }
   if (!have_episode(o) || !busy_check(o)) return NULL;
   if (o->s.stepped) return vdpy_arg_error("run() drives an episode from its start: reset() first");
   o->busy = 1;
   vd_error err = {0};
   vd_status st = VD_OK;
   Py_BEGIN_ALLOW_THREADS
-  if (!vd_harvest_done(o->s.h)) st = vd_harvest_run(o->s.h, NULL, NULL, &err);
+  if (!vd_harvest_done(o->s.h)) st = vd_harvest_run(o->s.h, until ? stop_at_phase : NULL, &u, &err);
   Py_END_ALLOW_THREADS
   o->busy = 0;
+  if (u.reached) {
+    o->s.stepped = 1;  // the episode goes on from here under step() or act()
+    Py_RETURN_TRUE;
+  }
   if (st == VD_ERR_VALUE && vd_harvest_done(o->s.h)) Py_RETURN_FALSE;
   if (st) return vdpy_raise(st, &err);
   Py_RETURN_TRUE;
@@ -439,6 +468,34 @@ static PyObject* events_list(const vd_harvest* h, int since) {
     Py_XDECREF(d);
   }
   return list;
+}
+
+// the target's joint loads at every plant step of the last 0.5 s before its detachment
+static PyObject* harvest_forces(vdpy_harvest* o, PyObject* unused) {
+  if (!have_episode(o) || !busy_check(o)) return NULL;
+  int n = vd_harvest_forces(o->s.h, NULL, 0);
+  vd_harvest_force* x = PyMem_Malloc(sizeof *x * (size_t)(n ? n : 1));
+  double* col = PyMem_Malloc(sizeof(double) * 7 * (size_t)(n ? n : 1));
+  if (!x || !col) {
+    PyMem_Free(x), PyMem_Free(col);
+    return PyErr_NoMemory();
+  }
+  vd_harvest_forces(o->s.h, x, n);
+  for (int k = 0; k < n; k++) {
+    double v[7] = {x[k].time, x[k].calyx_force, x[k].calyx_moment, x[k].abscission_force,
+                   x[k].abscission_moment, x[k].pull_force, x[k].broke};
+    for (int c = 0; c < 7; c++) col[(size_t)c * (size_t)n + (size_t)k] = v[c];
+  }
+  static const char* keys[7] = {"time", "calyx_force", "calyx_moment", "abscission_force", "abscission_moment",
+                                "pull_force", "broke"};
+  PyObject* d = PyDict_New();
+  for (int c = 0; d && c < 7; c++) {
+    PyObject* a = vec(col + (size_t)c * (size_t)n, n);
+    if (!a || PyDict_SetItemString(d, keys[c], a) < 0) Py_CLEAR(d);
+    Py_XDECREF(a);
+  }
+  PyMem_Free(x), PyMem_Free(col);
+  return d;
 }
 
 static PyObject* harvest_summary(vdpy_harvest* o, PyObject* unused) {
@@ -551,11 +608,13 @@ static PyMethodDef harvest_methods[] = {
      "before a successful reset and after the episode ended."},
     {"close", (PyCFunction)harvest_close, METH_NOARGS,
      "close($self, /)\n--\n\nFree the episode and its plant now; later calls that need them raise."},
-    {"run", (PyCFunction)harvest_run, METH_NOARGS,
-     "run($self, /)\n--\n\n"
-     "run() -> bool: the scene's scripted controller (approach, grasp, then pull, bend or twist)\n"
-     "to the end of the episode, without the GIL, as `verdant harvest` runs it; False when MuJoCo\n"
-     "or the plant failed. Only before the first step() of an episode."},
+    {"run", (PyCFunction)(void (*)(void))harvest_run, METH_VARARGS | METH_KEYWORDS,
+     "run($self, /, until=None)\n--\n\n"
+     "run(until=None) -> bool: the scene's scripted controller (approach, grasp, then pull, bend or\n"
+     "twist) to the end of the episode, without the GIL, as `verdant harvest` runs it; False when\n"
+     "MuJoCo or the plant failed. until: a phase name (e.g. \"reach\": the arm at its pre-grasp\n"
+     "pose); the run stops as the controller enters it (True) and the episode goes on under\n"
+     "step() or act(). Only before the first step() of an episode."},
     {"observe", (PyCFunction)harvest_observe, METH_NOARGS,
      "observe($self, /)\n--\n\n"
      "observe() -> dict: time, phase, joint state q and qd, end-effector pose, target fruit, grasp\n"
@@ -564,6 +623,12 @@ static PyMethodDef harvest_methods[] = {
      "events($self, /, since=0)\n--\n\n"
      "events(since=0) -> list of dicts: phase, touch, grasp, slip, release, fracture, detach, hit,\n"
      "drop and ik events from index since on."},
+    {"forces", (PyCFunction)harvest_forces, METH_NOARGS,
+     "forces($self, /)\n--\n\n"
+     "forces() -> dict of arrays: the target fruit's joint loads at every plant step over the last\n"
+     "0.5 s before its calyx or abscission joint broke (or before now): time (s), calyx_force (N),\n"
+     "calyx_moment (N m), abscission_force, abscission_moment, pull_force (the gripper's sensor,\n"
+     "N), broke (1 at the fracture's step, which carries the fracture's load); RUN/forces.csv."},
     {"summary", (PyCFunction)harvest_summary, METH_NOARGS,
      "summary($self, /)\n--\n\n"
      "summary() -> dict: the outcome so far (summary.json)."},

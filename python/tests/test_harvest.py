@@ -96,6 +96,30 @@ def test_scripted_run_equals_cli(cli):
         h.run()                                          # not from the start any more
 
 
+def test_wrist_camera_sees_the_target_at_pregrasp():
+    # issue 20 item 7: where the scripted reach begins (the arm at its pre-grasp pose) the wrist
+    # camera shows the target fruit (>= 5 % of the picture) and little of the robot (<= 30 %)
+    scene = os.path.join(HERE, "tomato_pull.json")
+    for seed in (0, 1):
+        env = verdant.HarvestEnv(scene, image=True, masks=True)
+        env.reset(seed=seed)
+        assert env._h.run(until="reach")
+        raw = env._h.observe()
+        assert raw["phase"] == "reach"
+        obs = env._observation(raw)
+        target = np.mean(obs["instance"] == raw["target_instance"])
+        robot = np.mean(obs["label"] == 65535)
+        assert target >= 0.05 and robot <= 0.30, (seed, target, robot)
+        obs, *_ = env.step(np.zeros(7, np.float32))          # the episode goes on under step()
+        with pytest.raises(verdant.ArgumentError):
+            env._h.run()
+        env.close()
+    with pytest.raises(verdant.ArgumentError):
+        verdant.HarvestEnv(MINI)._h.run(until="lunch")
+    with pytest.raises(verdant.ArgumentError):
+        verdant.HarvestEnv(MINI, camera_fov=0)
+
+
 def test_wrist_camera_observations():
     env = verdant.HarvestEnv(MINI, image=True, masks=True, cloud=True, image_size=(64, 48),
                              cloud_points=500, render_mode="rgb_array")

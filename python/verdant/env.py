@@ -31,6 +31,13 @@ except ImportError:
     _gym = None
 
 # the default reward: what each term weighs (docs/python.md); the order is the C layer's
+# Where the wrist camera sits in the end-effector's frame (m): behind the tool point along the
+# approach axis, aside along the axis normal to the fingers' opening, and the point ahead of the
+# tool point it is aimed at (the default pre-grasp distance). Measured at the reach's start on
+# tomato_pull (docs/python.md): the target 5-13 % of the picture where leaves leave it in view,
+# the robot under 1 %.
+WRIST_CAMERA = {"back": 0.0, "side": 0.05, "aim": 0.06}
+
 REWARD_WEIGHTS = {
     "detach": 10.0,     # once, when the target fruit comes off the plant
     "grasp": 1.0,       # once, when the gripper first holds the target fruit
@@ -230,8 +237,9 @@ _NOT_RUNNING = {
 
 class HarvestEnv(_EnvBase):
     """HarvestEnv(scene, *, image=False, masks=False, cloud=False, image_size=(96, 72),
-    cloud_points=1024, max_lin_vel=0.1, max_ang_vel=1.0, reward_weights=None,
-    max_episode_steps=None, randomize=True, terminate_on_detach=True, render_mode=None)
+    camera_fov=40.0, cloud_points=1024, max_lin_vel=0.1, max_ang_vel=1.0,
+    reward_weights=None, max_episode_steps=None, randomize=True, terminate_on_detach=True,
+    render_mode=None)
 
     scene: a scene file (docs/formats.md) or its JSON text: plant, robot MJCF, target fruit,
     method (its grip force and friction), episodes (what reset randomises: plant seed, target,
@@ -245,8 +253,11 @@ class HarvestEnv(_EnvBase):
     (float32, m), label and instance masks and target_visible (the target fruit's visible
     fraction); with cloud=True a labelled point cloud of what the wrist camera's position sees
     (cloud_xyz float32 (N, 3), cloud_label and cloud_instance int32 (N)). The wrist
-    camera looks along the end-effector's approach axis; pictures show the plant and the robot's
-    collision shapes (label 65535), clouds the plant.
+    camera (WRIST_CAMERA) sits on the wrist beside the gripper, level with the tool point and
+    5 cm off it across the fingers' plane, aimed at the point 6 cm ahead of the tool point (the
+    default pre-grasp distance: where the target is when the reach begins), with a vertical
+    field of view of camera_fov degrees; pictures show the plant and the robot's collision
+    shapes (label 65535), clouds the plant.
 
     Action: float32 (7,): end-effector velocity (3, m/s, within max_lin_vel), angular velocity
     (3, rad/s, within max_ang_vel), gripper command in [0, 1]; values outside are clipped.
@@ -273,9 +284,9 @@ class HarvestEnv(_EnvBase):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
     def __init__(self, scene, *, image=False, masks=False, cloud=False, image_size=(96, 72),
-                 cloud_points=1024, max_lin_vel=0.1, max_ang_vel=1.0, reward_weights=None,
-                 max_episode_steps=None, randomize=True, terminate_on_detach=True,
-                 render_mode=None):
+                 camera_fov=40.0, cloud_points=1024, max_lin_vel=0.1, max_ang_vel=1.0,
+                 reward_weights=None, max_episode_steps=None, randomize=True,
+                 terminate_on_detach=True, render_mode=None):
         unknown = set(reward_weights or {}) - set(REWARD_WEIGHTS)
         if unknown:
             raise _verdant.ArgumentError(f"reward_weights: unknown terms {sorted(unknown)}")
@@ -285,6 +296,9 @@ class HarvestEnv(_EnvBase):
         self.scene = scene
         self.image, self.masks, self.cloud = bool(image or masks), bool(masks), bool(cloud)
         self.image_size = tuple(int(v) for v in image_size)
+        self.camera_fov = float(camera_fov)
+        if not 1.0 <= self.camera_fov <= 170.0:
+            raise _verdant.ArgumentError(f"camera_fov: degrees in [1, 170], not {camera_fov}")
         self.cloud_points = int(cloud_points)
         self.weights = {**REWARD_WEIGHTS, **(reward_weights or {})}
         self._weights = tuple(float(self.weights[k]) for k in REWARD_WEIGHTS)
@@ -322,7 +336,8 @@ class HarvestEnv(_EnvBase):
         self.observation_space = Dict(spaces)
         self._kwargs = dict(
             scene=scene, image=image, masks=masks, cloud=cloud, image_size=image_size,
-            cloud_points=cloud_points, max_lin_vel=max_lin_vel, max_ang_vel=max_ang_vel,
+            camera_fov=camera_fov, cloud_points=cloud_points, max_lin_vel=max_lin_vel,
+            max_ang_vel=max_ang_vel,
             reward_weights=reward_weights, max_episode_steps=max_episode_steps,
             randomize=randomize, terminate_on_detach=terminate_on_detach, render_mode=render_mode)
         if _gym is None:
@@ -486,14 +501,15 @@ class HarvestEnv(_EnvBase):
         return self._renderer.draw(self._h, **kw)
 
     def _wrist(self, raw):
-        # the wrist camera: just behind the tool point, looking along its approach axis (+z),
-        # image up along the fingers' opening axis' normal (+x)
+        # the wrist camera (WRIST_CAMERA): "back" behind the tool point along the approach axis
+        # (+z) and "side" along +x (normal to the fingers' opening axis, so the fingers stay out
+        # of the picture), aimed at the point "aim" ahead of the tool point; image up +x
         w, x, y, z = raw["ee_quat"]
         R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                       [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                       [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-        eye = raw["ee_pos"] - 0.06 * R[:, 2]
-        return eye, eye + 0.5 * R[:, 2], R[:, 0]
+        eye = raw["ee_pos"] - WRIST_CAMERA["back"] * R[:, 2] + WRIST_CAMERA["side"] * R[:, 0]
+        return eye, raw["ee_pos"] + WRIST_CAMERA["aim"] * R[:, 2], R[:, 0]
 
     def _observation(self, raw):
         obs = {
@@ -506,7 +522,7 @@ class HarvestEnv(_EnvBase):
         if self.image or self.cloud:
             eye, lookat, up = self._wrist(raw)
         if self.image:
-            f = self._draw(self.image_size, eye=eye, lookat=lookat, up=up, fov=70,
+            f = self._draw(self.image_size, eye=eye, lookat=lookat, up=up, fov=self.camera_fov,
                            depth=self.masks, masks=self.masks)
             obs["rgb"] = f["rgb"]
             obs["camera_K"], obs["camera_pose"] = f["K"], f["pose"]

@@ -99,6 +99,7 @@ void harvest_release(vd_harvest* h) {
 static void harvest_free_parts(vd_harvest* h) {
   robot_free(h);
   if (h->sm) vd_free(h->on, (size_t)h->sm->nseg + 1);
+  vd_free(h->fwin, (size_t)h->fwin_cap * sizeof *h->fwin);
   vd_sim_data_destroy(h->sd);
   vd_sim_model_destroy(h->sm);
   vd_free(h->ev, (size_t)h->cap_ev * sizeof *h->ev);
@@ -194,7 +195,10 @@ vd_status vd_harvest_create_with(const vd_scene* scene, const vd_robot* robot, c
     h->sm->opt = h->scene.sim_opt;
     h->sd = vd_sim_data_create(h->sm);
     h->on = vd_malloc((size_t)h->sm->nseg + 1);
-    if (!h->sd || !h->on) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory (plant state)");
+    double steps = VD_HARVEST_FORCE_WINDOW / h->sm->opt.dt;
+    h->fwin_cap = steps < 1e6 ? (int)ceil(steps) + 1 : 1000001;
+    h->fwin = vd_malloc((size_t)h->fwin_cap * sizeof *h->fwin);
+    if (!h->sd || !h->on || !h->fwin) st = vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory (plant state)");
   }
   if (!st) st = robot_attach(h, err);
   if (!st && isfinite(h->scene.ground)) {
@@ -454,6 +458,8 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   h->max_pull = h->max_disp = h->grasp_ik_err = h->grasp_track_err = h->pull_at_break = 0;
   h->done = 0, h->reason[0] = 0;
   h->nevent_seen = 0, h->nev = 0, h->ev_dropped = 0, h->step = 0;
+  h->watch_seg[0] = -2, h->watch_seg[1] = -1;
+  h->fwin_n = h->fwin_head = h->fwin_frozen = 0;
   for (int f = 0; f < h->nfruit; f++) h->fruit[f].hit = h->fruit[f].dropped = 0;
   h->phase = VD_PHASE_EXTERNAL;
   // without a target the episode can still be driven from outside; target_reason says why
@@ -570,6 +576,52 @@ static void grasp_check(vd_harvest* h) {
   harvest_event(h, VD_EV_GRASP, 0.5 * (h->finger_force[0] + h->finger_force[1]), -1, f->instance);
 }
 
+// the target's stalk and abscission joints (the abscission within 8 segments of the fruit)
+static void watch_target(vd_harvest* h) {
+  h->watch_seg[0] = h->watch_seg[1] = -1;
+  if (h->target < 0) return;
+  const vd_sim_model* sm = h->sm;
+  int s0 = h->fruit[h->target].seg;
+  h->watch_seg[0] = s0;
+  for (int s = s0, n = 0; s >= 0 && n < 8; s = sm->seg_parent[s], n++)
+    if (sm->seg_flags[s] & VD_SIM_ABSCISSION) {
+      h->watch_seg[1] = s;
+      break;
+    }
+}
+
+// one plant step's sample of the target's joint loads into the window; events from nev0 on are
+// this step's fractures (a watched joint that broke carries the fracture's load, and the window
+// stops there)
+static void record_forces(vd_harvest* h, int nev0, double pull) {
+  if (h->fwin_frozen) return;
+  if (h->watch_seg[0] == -2) watch_target(h);
+  if (h->watch_seg[0] < 0) return;
+  const vd_sim_data* sd = h->sd;
+  vd_harvest_force* x = &h->fwin[h->fwin_head];
+  memset(x, 0, sizeof *x);
+  x->time = sd->time;
+  x->pull_force = pull;
+  double* f[2] = {&x->calyx_force, &x->abscission_force};
+  double* mo[2] = {&x->calyx_moment, &x->abscission_moment};
+  for (int k = 0; k < 2; k++) {
+    int s = h->watch_seg[k];
+    if (s < 0) continue;
+    vd_sim_joint_load(h->sm, sd, s, f[k], mo[k]);
+    for (int e = nev0; e < sd->nevent; e++)
+      if (sd->event[e].seg == s) *f[k] = sd->event[e].force, *mo[k] = sd->event[e].moment, x->broke = 1;
+  }
+  h->fwin_head = (h->fwin_head + 1) % h->fwin_cap;
+  if (h->fwin_n < h->fwin_cap) h->fwin_n++;
+  if (x->broke) h->fwin_frozen = 1;
+}
+
+int vd_harvest_forces(const vd_harvest* h, vd_harvest_force* out, int cap) {
+  int first = (h->fwin_head - h->fwin_n + h->fwin_cap) % h->fwin_cap;
+  for (int k = 0; out && k < h->fwin_n && k < cap; k++) out[k] = h->fwin[(first + k) % h->fwin_cap];
+  return h->fwin_n;
+}
+
 static vd_status robot_step(vd_harvest* h, vd_error* err) {
   mjModel* m = h->m;
   mjData* d = h->d;
@@ -618,12 +670,13 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
       force[k] = vd_add(force[k], sd->collider_force[h->col[k].sim]);
       torque[k] = vd_add(torque[k], sd->collider_torque[h->col[k].sim]);
     }
+    double fsensor = 0;
     if (h->held) {
       vd_vec3 fg;
       grasp_slip(h, e, &fg);
       pull = vd_add(pull, fg);
       // the force sensor: its largest value up to and with the break, and its value at the break
-      double fn = vd_norm(fg);
+      double fn = fsensor = vd_norm(fg);
       if (!h->detached && !broke && fn > h->max_pull) h->max_pull = fn;
       if (sd->nevent > nev) h->pull_at_break = fn, broke = 1;
       twist = vd_sub(twist, tau);
@@ -632,6 +685,7 @@ static vd_status robot_step(vd_harvest* h, vd_error* err) {
         tie_remove(h);
       }
     }
+    record_forces(h, nev, fsensor);
   }
   double inv = 1.0 / h->nsub;
   h->robot_force = vd_v3(0, 0, 0);

@@ -139,6 +139,12 @@ struct vd_harvest {
   int ev_dropped;             // events not logged (out of memory): none is logged after one
   int64_t step;
   signed char* on;            // scratch: segment still on the plant (nseg + 1)
+  // the target's joint loads at every plant step, the last VD_HARVEST_FORCE_WINDOW s (a ring)
+  int watch_seg[2];           // the target's stalk (calyx) and abscission joints, -1 none; [0] -2:
+                              // not looked up yet
+  vd_harvest_force* fwin;     // the ring (fwin_cap samples)
+  int fwin_cap, fwin_n, fwin_head;  // capacity, samples held, next to write
+  int fwin_frozen;            // a watched joint broke: the window before it is kept
   double qbuf[VD_ROBOT_MAX_JOINTS], qdbuf[VD_ROBOT_MAX_JOINTS];  // observation copies
 };
 

@@ -323,6 +323,22 @@ vd_status vd_robot_validate(const vd_validate_def* def, vd_validate_result** out
               "5-8 N in tension (facts 5.2)");
     vd_scene_free(&s);
   }
+  // a quasi-static pull (1 cm/s): the force the gripper's sensor reads at the break is the calyx
+  // joint's threshold (the fruit's weight and inertia are small beside it); the forces logged at
+  // every plant step (vd_harvest_forces) end at the joint's fracture load
+  if (!st && wanted(&rs, "harvest_pull_quasistatic")) {
+    truss_scene(&s, robot);
+    s.method.method = VD_HARVEST_PULL, s.method.speed = 0.01, s.method.distance = 0.1;
+    s.duration = 12;
+    double thr = s.sim_def.material[VD_SIM_FRUIT].break_force;
+    outcome o = harvest(&s, err);
+    if (o.st) st = o.st;
+    double f = o.sum.site == VD_SITE_CALYX ? o.sum.pull_force : NAN;
+    add(&rs, "harvest_pull_quasistatic", "gripper force at the break / calyx threshold (-)", f / thr, 1,
+        fabs(f / thr - 1), 0.05, isfinite(f) && fabs(f / thr - 1) <= 0.05,
+        "pull at 0.01 m/s, site calyx: within 5 % of the joint's break force (issue 20 item 2)");
+    vd_scene_free(&s);
+  }
   // bend: detaches with less force than pull (tomato peduncle tests, Trans. CSAE 2008)
   if (!st && (!def->filter || strstr("harvest_bend_vs_pull", def->filter))) {
     truss_scene(&s, robot);

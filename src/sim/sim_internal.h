@@ -184,6 +184,7 @@ typedef struct sim_work {
   vd_vec3 col_imp[VD_SIM_MAX_COLLIDERS];  // impulse of this step's contacts on each collider (N s)
   vd_vec3 col_ang[VD_SIM_MAX_COLLIDERS];  // its moment about the collider's pos (N m s)
   double strain;        // largest stretch strain at the end of the last step (-)
+  double h_last;        // size of the last dynamic step kept (s; the multipliers' step), 0 before
 } sim_work;
 
 // Allocate the work block for a model; NULL when out of memory. *bytes gets its size.

@@ -206,6 +206,18 @@ static int cannot_break(const vd_sim_model* m, const vd_sim_data* d, int t, doub
   return !isfinite(thr[3]) || 4 / lbar * slack <= thr[3];
 }
 
+// the constraint force and moment of joint t in a step of h (h2 = h^2): the generalised forces
+// J^T lambda / h^2 of its stretch-shear and bend-twist multipliers; j gets the joint's values
+static void joint_load(const vd_sim_model* m, const vd_sim_data* d, int t, double h2, sim_joint* j, double* force,
+                       double* moment) {
+  const double* lam = d->seg_lambda + 6 * t;
+  sim_joint_eval(m, d, t, j);
+  vd_vec3 ms = vd_v3(lam[0] / h2, lam[1] / h2, lam[2] / h2);
+  vd_vec3 mb = vd_v3(lam[3] / h2, lam[4] / h2, lam[5] / h2);
+  *force = vd_norm(m3_tmul_v(j->a, ms));
+  *moment = j->bend ? vd_norm(m3_tmul_v(j->g, mb)) : 0.0;
+}
+
 // joints whose force, moment or strain passed their threshold break (each once)
 static void check_fracture(const vd_sim_model* m, vd_sim_data* d, double h) {
   double h2 = h * h;
@@ -213,19 +225,22 @@ static void check_fracture(const vd_sim_model* m, vd_sim_data* d, double h) {
     if (m->seg_spare[t] < 0 || d->seg_broken[t] || (m->seg_flags[t] & VD_SIM_FIXED)) continue;
     if (cannot_break(m, d, t, h2)) continue;
     const double* thr = m->seg_break + 4 * t;
-    const double* lam = d->seg_lambda + 6 * t;
     sim_joint j;
-    sim_joint_eval(m, d, t, &j);
-    // constraint force and moment: the generalised forces J^T lambda / h^2
-    vd_vec3 ms = vd_v3(lam[0] / h2, lam[1] / h2, lam[2] / h2);
-    vd_vec3 mb = vd_v3(lam[3] / h2, lam[4] / h2, lam[5] / h2);
-    double force = vd_norm(m3_tmul_v(j.a, ms));
-    double moment = j.bend ? vd_norm(m3_tmul_v(j.g, mb)) : 0.0;
+    double force, moment;
+    joint_load(m, d, t, h2, &j, &force, &moment);
     double cs = sqrt(j.c[0] * j.c[0] + j.c[1] * j.c[1] + j.c[2] * j.c[2]);
     double cb = sqrt(j.c[3] * j.c[3] + j.c[4] * j.c[4] + j.c[5] * j.c[5]);
     int cause = force > thr[0] ? 0 : moment > thr[1] ? 1 : cs > thr[2] ? 2 : cb > thr[3] ? 3 : -1;
     if (cause >= 0) break_joint(m, d, t, force, moment, cs, cb, cause);
   }
+}
+
+void vd_sim_joint_load(const vd_sim_model* m, const vd_sim_data* d, int seg, double* force, double* moment) {
+  const sim_work* w = (const sim_work*)d->work;
+  *force = *moment = 0;
+  if (seg < 0 || seg >= m->nseg || d->seg_broken[seg] || m->seg_parent[seg] < 0 || !(w->h_last > 0)) return;
+  sim_joint j;
+  joint_load(m, d, seg, w->h_last * w->h_last, &j, force, moment);
 }
 
 // potential energy of the current state under the loads in w (J): elastic energy of every
@@ -351,6 +366,7 @@ static int step_core(const vd_sim_model* m, vd_sim_data* d, const sim_step_ctx* 
   lc.damp = 1.0 / (1.0 + (m->opt.mass_damping + c.extra_damping) * h);
   sim_parallel(nt, na > ns ? na : ns, velocity_range, &lc);
   sim_stage(d, VD_SIM_STAGE_VELOCITY, &tp);
+  if (!c.statics) w->h_last = h;
   if (m->opt.fracture && !c.statics) check_fracture(m, d, h);
   // the step's reactions on the colliders (impulses; vd_sim_step makes them forces)
   for (int k = 0; k < d->ncollider; k++) {
