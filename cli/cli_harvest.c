@@ -162,6 +162,12 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
   cJSON_AddNumberToObject(o, "detach_time", r.detached ? r.time : 0);
   cJSON_AddNumberToObject(o, "pedicel_force", r.detach_force);
   cJSON_AddNumberToObject(o, "pedicel_moment", r.detach_moment);
+  // the target's break forces this episode (drawn per plant, or fixed); null: unbreakable, none
+  cJSON_AddItemToObject(o, "calyx_threshold", isfinite(r.calyx_threshold) ? cJSON_CreateNumber(r.calyx_threshold)
+                                                                           : cJSON_CreateNull());
+  cJSON_AddItemToObject(o, "abscission_threshold", isfinite(r.abscission_threshold)
+                                                       ? cJSON_CreateNumber(r.abscission_threshold)
+                                                       : cJSON_CreateNull());
   cJSON_AddNumberToObject(o, "pull_force", r.pull_force);
   cJSON_AddNumberToObject(o, "max_pull_force", r.max_pull_force);
   cJSON_AddNumberToObject(o, "max_plant_displacement", r.max_displacement);
@@ -611,8 +617,8 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
   if (!st && !force) st = vd_error_set(&err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
   if (!st) {
     fputs("episode,plant_seed,target_instance,method,speed,distance,angle_deg,grip_force,grasped,detached,site,"
-          "detach_time,pull_force,pedicel_force,pedicel_moment,max_plant_displacement,fruits_hit,"
-          "fruits_dropped,reason\n",
+          "detach_time,pull_force,pedicel_force,pedicel_moment,calyx_threshold,abscission_threshold,"
+          "max_plant_displacement,fruits_hit,fruits_dropped,reason\n",
           f.fp);
     for (int k = 0; k < n && !st; k++) {
       int mm = 0;
@@ -638,12 +644,20 @@ static int batch_summary(const batch* b, int n, double wall, int made, int skipp
       for (int i = 0; i < VD_SITE_COUNT; i++)
         if (!strcmp(site, vd_harvest_site_name((vd_harvest_site)i))) nsite[i]++;
       if (det && gr) force[nf] = num_of(r, "pull_force"), pforce[nf] = num_of(r, "pedicel_force"), nf++;
-      fprintf(f.fp, "%d,%.0f,%.0f,%s,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%.6f,%.6g,%.6g,%.6g,%.6g,%.0f,%.0f,%s\n", k,
+      // thresholds: empty where unbreakable or none (null in the record)
+      char thr[2][32];
+      const char* tk[2] = {"calyx_threshold", "abscission_threshold"};
+      for (int i = 0; i < 2; i++) {
+        const cJSON* x = cJSON_GetObjectItemCaseSensitive(r, tk[i]);
+        if (cJSON_IsNumber(x)) snprintf(thr[i], sizeof thr[i], "%.6g", x->valuedouble);
+        else thr[i][0] = 0;
+      }
+      fprintf(f.fp, "%d,%.0f,%.0f,%s,%.6g,%.6g,%.6g,%.6g,%d,%d,%s,%.6f,%.6g,%.6g,%.6g,%s,%s,%.6g,%.0f,%.0f,%s\n", k,
               num_of(r, "plant_seed"), num_of(r, "target_instance"), method, num_of(r, "speed"),
               num_of(r, "distance"), num_of(r, "angle_deg"), num_of(r, "grip_force"), gr, det, site,
               num_of(r, "detach_time"), num_of(r, "pull_force"), num_of(r, "pedicel_force"),
-              num_of(r, "pedicel_moment"), num_of(r, "max_plant_displacement"), num_of(r, "fruits_hit"),
-              num_of(r, "fruits_dropped"), str_of(r, "reason"));
+              num_of(r, "pedicel_moment"), thr[0], thr[1], num_of(r, "max_plant_displacement"),
+              num_of(r, "fruits_hit"), num_of(r, "fruits_dropped"), str_of(r, "reason"));
       cJSON_Delete(r);
     }
     if (st) vd_outfile_abort(&f);

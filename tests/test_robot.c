@@ -18,8 +18,11 @@ static vd_status truss_scene(const char* method, const char* extra, vd_scene* s,
            " \"robot\": {\"mjcf\": \"%s\", \"base\": {\"pos\": [0.45, 0, 0.22], \"yaw_deg\": 180},"
            "            \"q0\": [0, 0, 1.57, 0, 1.57, 0]},"
            " \"method\": {%s},"
-           " \"sim\": {\"segment_length\": 0.02}, \"duration\": 8 %s}",
-           vdt_path("data/robots/lite6.xml"), method, extra ? extra : "");
+           " \"sim\": {\"segment_length\": 0.02}, \"duration\": 8 %s %s}",
+           vdt_path("data/robots/lite6.xml"), method,
+           // the materials' thresholds unless the test draws its own
+           extra && strstr(extra, "\"thresholds\"") ? "" : ", \"thresholds\": {\"calyx\": null, \"abscission\": null}",
+           extra ? extra : "");
   return vd_scene_parse(text, strlen(text), NULL, s, e);
 }
 
@@ -363,6 +366,55 @@ TEST(robot, description_shared_by_episodes) {
   vd_robot_destroy(rb);
   vd_model_destroy(pm);
   vd_scene_free(&s);
+}
+
+TEST(robot, thresholds_drawn_per_plant) {
+  // each fruit's calyx and abscission break forces are drawn in the scene's ranges from the
+  // plant seed: the same seed, the same thresholds; another seed, others; the summary shows them;
+  // null fixes the materials' value
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", ", \"thresholds\": {\"calyx\": [1, 2], \"abscission\": [5, 8]}", &s,
+                           &e),
+               VD_OK, e);
+  vd_model* pm = robot_truss(0.012);
+  REQUIRE(pm);
+  double thr[3][2];
+  const uint64_t seeds[3] = {1, 1, 2};
+  for (int k = 0; k < 3; k++) {
+    s.plant_seed = seeds[k];
+    vd_harvest* h = NULL;
+    CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
+    REQUIRE(h);
+    vd_harvest_summary r;
+    vd_harvest_summarize(h, &r);
+    thr[k][0] = r.calyx_threshold, thr[k][1] = r.abscission_threshold;
+    if (getenv("VDT_VERBOSE")) printf("  seed %d: calyx %.6f N, abscission %.6f N, target %d\n", (int)seeds[k], thr[k][0], thr[k][1], r.target_instance);
+    CHECK(thr[k][0] >= 1 && thr[k][0] <= 2);
+    CHECK(thr[k][1] >= 5 && thr[k][1] <= 8);
+    vd_harvest_destroy(h);
+  }
+  CHECK(thr[0][0] == thr[1][0] && thr[0][1] == thr[1][1]);
+  CHECK(thr[0][0] != thr[2][0] && thr[0][1] != thr[2][1]);
+  vd_scene_free(&s);
+  // fixed: the materials' values
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  vd_harvest* h = NULL;
+  CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
+  REQUIRE(h);
+  vd_harvest_summary r;
+  vd_harvest_summarize(h, &r);
+  CHECK_NEAR(r.calyx_threshold, s.sim_def.material[VD_SIM_FRUIT].break_force, 1e-12);
+  CHECK_NEAR(r.abscission_threshold, s.sim_def.material[VD_SIM_PEDICEL].break_force, 1e-12);
+  vd_harvest_destroy(h);
+  vd_scene_free(&s);
+  // a range that is not one
+  const char* bad = "{\"format\": \"verdant-scene\", \"version\": 1, \"plant\": {\"file\": \"x.lpy\"},"
+                    " \"robot\": {\"mjcf\": \"r.xml\"}, \"thresholds\": {\"calyx\": [3, 1]}}";
+  CHECK_STATUS(vd_scene_parse(bad, strlen(bad), "bad.json", &s, &e), VD_ERR_FORMAT, e);
+  CHECK(strstr(e.msg, "thresholds") != NULL);
+  vd_scene_free(&s);
+  vd_model_destroy(pm);
 }
 
 TEST(robot, grip_sweep_friction_boundary) {

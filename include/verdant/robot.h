@@ -168,6 +168,12 @@ typedef struct vd_scene {
   vd_episode_def episodes;         // what --episodes randomises
   // physics
   vd_sim_def sim_def;              // rod model: materials and fracture thresholds, sag-free ...
+  // each fruit's break forces, drawn uniformly in [lo, hi] from the plant seed and the fruit's
+  // instance (the same plant, the same thresholds); lo > hi (NaN): the materials' fixed value.
+  // Defaults: calyx 0.58-2.46 N (Xie et al. 2021, cherry-tomato pulling), abscission 5-8 N
+  // (cherry-tomato cluster abscission zone in tension); "thresholds" in the scene file; a scene
+  // that sets materials.fruit.break_force (pedicel) fixes the calyx (abscission) threshold.
+  double draw_calyx[2], draw_abscission[2];
   vd_sim_opt sim_opt;              // plant run settings (dt, friction, ...)
   double ground;                   // height of the plant's ground plane (m); NAN: none
   int two_way;                     // 1: the plant pushes the robot back
@@ -331,6 +337,9 @@ typedef struct vd_harvest_summary {
   double time;                 // time of detachment (s), else the episode's end
   double detach_force;         // force of the broken joint at detachment (N)
   double detach_moment;        // its moment (N m)
+  double calyx_threshold;      // the target's calyx break force this episode (N; drawn or fixed,
+                               // INFINITY: unbreakable; NAN: no target)
+  double abscission_threshold; // ... its abscission joint's (INFINITY also: none)
   double pull_force;           // gripper pull force at detachment (N), the force sensor's view
   double max_pull_force;       // largest gripper pull force before detachment (N)
   double max_displacement;     // largest displacement of a node still on the plant (m)

@@ -502,10 +502,11 @@ static PyObject* harvest_summary(vdpy_harvest* o, PyObject* unused) {
   if (!have_episode(o) || !busy_check(o)) return NULL;
   vd_harvest_summary s;
   vd_harvest_summarize(o->s.h, &s);
-  return Py_BuildValue("{s:O,s:O,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:i,s:i,s:d,s:d,s:d,s:d,s:L,s:L,s:i,s:s,s:K}",
+  return Py_BuildValue("{s:O,s:O,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:d,s:i,s:i,s:d,s:d,s:d,s:d,s:L,s:L,s:i,s:s,s:K}",
                        "detached", s.detached ? Py_True : Py_False, "grasped", s.grasped ? Py_True : Py_False,
                        "site", vd_harvest_site_name(s.site), "time", s.time, "detach_force", s.detach_force,
-                       "detach_moment", s.detach_moment, "pull_force", s.pull_force, "max_pull_force",
+                       "detach_moment", s.detach_moment, "calyx_threshold", s.calyx_threshold,
+                       "abscission_threshold", s.abscission_threshold, "pull_force", s.pull_force, "max_pull_force",
                        s.max_pull_force, "max_displacement", s.max_displacement, "fruits_hit", s.fruits_hit,
                        "fruits_dropped", s.fruits_dropped, "ik_error", s.ik_error, "track_error", s.track_error,
                        "slip", s.slip, "duration", s.duration, "steps", (long long)s.steps, "plant_warnings",

@@ -6,7 +6,7 @@
 
 #include "verdant/core.h"
 
-vd_scalar vd_scalar_ply(const char* s) {
+vd_scalar vd_scalar_ply(const char* name) {
   static const struct {
     const char* name;
     vd_scalar t;
@@ -17,7 +17,7 @@ vd_scalar vd_scalar_ply(const char* s) {
              {"float", VD_SCALAR_F32},    {"float32", VD_SCALAR_F32},   {"double", VD_SCALAR_F64},
              {"float64", VD_SCALAR_F64}};
   for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++)
-    if (!strcmp(s, tab[i].name)) return tab[i].t;
+    if (!strcmp(name, tab[i].name)) return tab[i].t;
   return VD_SCALAR_BAD;
 }
 

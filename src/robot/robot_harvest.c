@@ -410,6 +410,33 @@ static vd_status choose_target(vd_harvest* h, uint64_t seed, vd_error* err) {
   return VD_OK;
 }
 
+// each fruit's calyx and abscission break forces for this plant: drawn in the scene's ranges
+// from the plant seed and the fruit's instance (the same plant, the same thresholds), or the
+// materials' fixed values; written into the rod model's thresholds
+static void draw_thresholds(vd_harvest* h) {
+  vd_sim_model* sm = h->sm;
+  const double* range[2] = {h->scene.draw_calyx, h->scene.draw_abscission};
+  for (int f = 0; f < h->nfruit; f++) {
+    robot_fruit* fr = &h->fruit[f];
+    int seg[2] = {fr->seg, -1};
+    for (int s = fr->seg, n = 0; s >= 0 && n < 8; s = sm->seg_parent[s], n++)
+      if (sm->seg_flags[s] & VD_SIM_ABSCISSION) {
+        seg[1] = s;
+        break;
+      }
+    fr->absc = seg[1];
+    vd_rng rng;
+    vd_rng_stream(&rng, h->scene.plant_seed, (uint64_t)(uint32_t)fr->instance);
+    for (int k = 0; k < 2; k++) {
+      double u = vd_rng_random(&rng);  // drawn either way: one stream per fruit whatever is fixed
+      fr->thr[k] = seg[k] >= 0 ? sm->seg_break[4 * seg[k]] : INFINITY;
+      if (seg[k] < 0 || !(range[k][0] <= range[k][1])) continue;
+      fr->thr[k] = range[k][0] + (range[k][1] - range[k][0]) * u;
+      sm->seg_break[4 * seg[k]] = fr->thr[k];
+    }
+  }
+}
+
 vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   mjModel* m = h->m;
   mjData* d = h->d;
@@ -462,6 +489,7 @@ vd_status vd_harvest_reset(vd_harvest* h, uint64_t seed, vd_error* err) {
   h->fwin_n = h->fwin_head = h->fwin_frozen = 0;
   for (int f = 0; f < h->nfruit; f++) h->fruit[f].hit = h->fruit[f].dropped = 0;
   h->phase = VD_PHASE_EXTERNAL;
+  draw_thresholds(h);
   // without a target the episode can still be driven from outside; target_reason says why
   return choose_target(h, seed, err);
 }
@@ -968,6 +996,8 @@ void vd_harvest_summarize(const vd_harvest* h, vd_harvest_summary* o) {
   o->time = h->detached ? h->detach_time : h->sd->time;
   o->detach_force = h->detach_force;
   o->detach_moment = h->detach_moment;
+  o->calyx_threshold = h->target >= 0 ? h->fruit[h->target].thr[0] : NAN;
+  o->abscission_threshold = h->target >= 0 ? h->fruit[h->target].thr[1] : NAN;
   o->pull_force = h->detach_pull;
   o->max_pull_force = h->max_pull;
   o->max_displacement = h->max_disp;

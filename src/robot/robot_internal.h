@@ -70,6 +70,8 @@ typedef struct robot_fruit {
   int seg;        // its stalk segment (VD_SIM_FRUITSEG, class fruit)
   int instance;   // organ instance
   double radius;  // sphere radius (m)
+  int absc;       // its pedicel's abscission joint within 8 segments, -1 none
+  double thr[2];  // its calyx and abscission break forces this episode (N; INFINITY: none)
   int hit;        // the robot has touched it
   int dropped;    // it came off the plant
 } robot_fruit;

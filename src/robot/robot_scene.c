@@ -44,6 +44,8 @@ void vd_scene_default(vd_scene* s) {
   s->method = vd_method_def_default();
   s->sim_def = vd_sim_def_default();
   s->sim_def.sag_free = 1;
+  s->draw_calyx[0] = 0.58, s->draw_calyx[1] = 2.46;
+  s->draw_abscission[0] = 5.0, s->draw_abscission[1] = 8.0;
   s->sim_opt = vd_sim_opt_default();
   s->ground = 0.0;
   s->two_way = 0;
@@ -382,6 +384,9 @@ static vd_status read_materials(rd* r, const cJSON* o, vd_scene* s) {
       if (!x) continue;
       double* v = (double*)((char*)&s->sim_def.material[k] + off[i]);
       int brk = i >= 3 && i <= 6;
+      // a fixed break force (or none): no draw for that joint
+      if (i == 3 && k == VD_SIM_FRUIT) s->draw_calyx[0] = s->draw_calyx[1] = NAN;
+      if (i == 3 && k == VD_SIM_PEDICEL) s->draw_abscission[0] = s->draw_abscission[1] = NAN;
       if (brk && cJSON_IsNull(x)) {
         *v = INFINITY;
         continue;
@@ -396,6 +401,30 @@ static vd_status read_materials(rd* r, const cJSON* o, vd_scene* s) {
     }
   }
   return VD_OK;
+}
+
+// "thresholds": {"calyx": [lo, hi] or null, "abscission": [lo, hi] or null} (N): each fruit's
+// break forces drawn in [lo, hi]; null: the materials' fixed value
+static vd_status read_thresholds(rd* r, const cJSON* o, vd_scene* s) {
+  if (!o) return VD_OK;
+  static const char* keys[] = {"calyx", "abscission", NULL};
+  vd_status st = known_keys(r, o, "thresholds", keys);
+  double* dst[2] = {s->draw_calyx, s->draw_abscission};
+  for (int k = 0; !st && k < 2; k++) {
+    const cJSON* x = cJSON_GetObjectItemCaseSensitive(o, keys[k]);
+    if (!x) continue;
+    if (cJSON_IsNull(x)) {
+      dst[k][0] = dst[k][1] = NAN;
+      continue;
+    }
+    const cJSON* a = cJSON_IsArray(x) && cJSON_GetArraySize(x) == 2 ? x->child : NULL;
+    const cJSON* b = a ? a->next : NULL;
+    if (!a || !cJSON_IsNumber(a) || !cJSON_IsNumber(b) || !isfinite(a->valuedouble) || !isfinite(b->valuedouble) ||
+        !(a->valuedouble > 0) || !(b->valuedouble >= a->valuedouble) || b->valuedouble > 1e6)
+      return bad(r, "thresholds", keys[k], "[lo, hi] break forces with 0 < lo <= hi <= 1e6 (N), or null");
+    dst[k][0] = a->valuedouble, dst[k][1] = b->valuedouble;
+  }
+  return st;
 }
 
 static vd_status read_sim(rd* r, const cJSON* o, vd_scene* s) {
@@ -462,9 +491,9 @@ static size_t skip_ws(const char* t, size_t len, size_t i) {
 }
 
 static vd_status read_root(rd* r, const cJSON* root, vd_scene* s) {
-  static const char* keys[] = {"format",   "version", "plant",     "robot", "target",
-                               "method",   "episodes", "materials", "sim",   "two_way",
-                               "duration", "control_dt", "outputs", NULL};
+  static const char* keys[] = {"format",   "version",    "plant",   "robot",      "target",
+                               "method",   "episodes",   "materials", "sim",      "two_way",
+                               "duration", "control_dt", "outputs", "thresholds", NULL};
   if (!cJSON_IsObject(root)) return bad(r, "", "scene", "a JSON object");
   vd_status st = known_keys(r, root, "", keys);
   if (st) return st;
@@ -474,9 +503,9 @@ static vd_status read_root(rd* r, const cJSON* root, vd_scene* s) {
   const cJSON* ver = cJSON_GetObjectItemCaseSensitive(root, "version");
   if (!cJSON_IsNumber(ver) || ver->valuedouble != VD_SCENE_VERSION)
     return bad(r, "", "version", "1 (this verdant reads scene version 1)");
-  const cJSON* sec[9];
-  static const char* names[9] = {"plant", "robot", "target", "method", "episodes", "materials",
-                                 "sim",   "outputs", NULL};
+  const cJSON* sec[10];
+  static const char* names[10] = {"plant", "robot",   "target",     "method", "episodes",
+                                  "materials", "sim", "outputs", "thresholds", NULL};
   for (int k = 0; names[k]; k++)
     if ((st = obj(r, root, "", names[k], &sec[k]))) return st;
   if (!st) st = read_plant(r, sec[0], s);
@@ -487,6 +516,7 @@ static vd_status read_root(rd* r, const cJSON* root, vd_scene* s) {
   if (!st) st = read_materials(r, sec[5], s);
   if (!st) st = read_sim(r, sec[6], s);
   if (!st) st = read_outputs(r, sec[7], s);
+  if (!st) st = read_thresholds(r, sec[8], s);
   if (!st) st = flag(r, root, "", "two_way", &s->two_way);
   if (!st) st = num_pos(r, root, "", "duration", 3600, "a time in (0, 3600] (s)", &s->duration);
   if (!st)

@@ -205,6 +205,8 @@ static void truss_scene(vd_scene* s, const char* robot) {
   s->base_pos = vd_v3(0.45, 0, 0.46);
   s->duration = 8;
   s->sim_def.segment_length = 0.02;
+  // the materials' thresholds, fixed: each case states its own
+  s->draw_calyx[0] = s->draw_calyx[1] = s->draw_abscission[0] = s->draw_abscission[1] = NAN;
 }
 
 typedef struct outcome {
