@@ -476,6 +476,40 @@ TEST(robot, start_inside_plant_refused) {
   vd_scene_free(&s);
 }
 
+TEST(robot, base_auto_slides_to_the_fruit) {
+  // robot.base.auto: a base 0.4 m along the row and 0.3 m too high reaches no fruit; with auto it
+  // slides along the row (the base's y) and lifts (z) to the fruit, keeps its distance from the
+  // row and its yaw, and the pull harvests it
+  vd_error e = {0};
+  vd_scene s;
+  CHECK_STATUS(truss_scene("\"name\": \"pull\"", NULL, &s, &e), VD_OK, e);
+  vd_vec3 b0 = s.base_pos;
+  s.base_pos = vd_v3(b0.x, b0.y + 0.4, b0.z + 0.3);
+  vd_model* pm = robot_truss(0.012);
+  for (int k = 0; k < 2; k++) {
+    s.base_auto = k;
+    vd_harvest* h = NULL;
+    CHECK_STATUS(vd_harvest_create(&s, pm, &h, &e), VD_OK, e);
+    REQUIRE(h);
+    vd_harvest_obs o;
+    vd_harvest_observe(h, &o);
+    if (!k) {
+      CHECK_INT(o.target_instance, 0);  // out of reach where the scene put it
+    } else {
+      CHECK(o.target_instance > 0);
+      CHECK_NEAR(o.base_pos.x, b0.x, 1e-9);  // the same distance from the row
+      CHECK(fabs(o.base_pos.y - (b0.y + 0.4)) > 0.1 && fabs(o.base_pos.z - (b0.z + 0.3)) > 0.1);
+      CHECK_STATUS(vd_harvest_run(h, NULL, NULL, &e), VD_OK, e);
+      vd_harvest_summary r;
+      vd_harvest_summarize(h, &r);
+      CHECK_STR(r.reason, "detached");
+    }
+    vd_harvest_destroy(h);
+  }
+  vd_model_destroy(pm);
+  vd_scene_free(&s);
+}
+
 TEST(robot, unreachable_target) {
   // the fruit far out of reach: a clean "unreachable" outcome, not a failure of the call's caller
   vd_harvest_summary r;

@@ -177,6 +177,8 @@ typedef struct vd_scene {
   vd_sim_opt sim_opt;              // plant run settings (dt, friction, ...)
   double ground;                   // height of the plant's ground plane (m); NAN: none
   int two_way;                     // 1: the plant pushes the robot back
+  int base_auto;                   // 1: the base slides along its row (its y) and lifts (z) to a
+                                   // fruit before the episode, as a rail trolley with a lift
   double duration;                 // longest episode (s)
   double control_dt;               // control step (s): a multiple of the MJCF's timestep
   // outputs

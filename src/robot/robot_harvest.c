@@ -168,6 +168,76 @@ vd_status vd_harvest_create(const vd_scene* scene, const vd_model* plant, vd_har
   return VD_OK;
 }
 
+static int reachable(vd_harvest* h, int f, double* ik_err);
+
+// move the robot's root body by d and bring the data and the collider shapes along
+static vd_status move_base(vd_harvest* h, vd_vec3 d, vd_error* err) {
+  int r = h->rb->root_body;
+  double* bp = h->m->body_pos + 3 * r;
+  bp[0] += d.x, bp[1] += d.y, bp[2] += d.z;
+  h->scene.base_pos = vd_v3(bp[0], bp[1], bp[2]);
+  vd_mj_trap trap;
+  if (!VD_MJ_TRY(&trap)) return vd_mj_trap_status(&trap, err);
+  mj_forward(h->m, h->d);
+  vd_mj_trap_end(&trap);
+  for (int k = 0; k < h->ncol; k++)
+    h->col[k].cur = h->col[k].prev = h->col[k].shape.pose = robot_geom_pose(h->m, h->d, h->col[k].geom);
+  return VD_OK;
+}
+
+// robot.base.auto: the base slides along its row (the base frame's y axis) and lifts (z) so that
+// the end effector at q0 is level with a fruit and in line with it along the row; its distance
+// from the row (along the base's x) and its yaw stay the scene's, as a greenhouse pipe-rail
+// trolley with a lift. The fruit: the scene's target; else the first, in order of their
+// distance across the row from the end effector (the plant's side the robot faces), that the
+// arm reaches from there without starting inside the plant. None such: the first (reset then
+// says why no fruit is reachable).
+static vd_status place_base(vd_harvest* h, vd_error* err) {
+  if (!h->nfruit) return VD_OK;
+  // the robot at q0, gripper open, as an episode starts
+  for (int k = 0; k < h->rb->narm; k++) h->d->qpos[h->rb->arm_qpos[k]] = h->q0[k];
+  for (int k = 0; k < 2; k++) h->d->qpos[h->rb->grip_qpos[k]] = h->scene.gripper_open;
+  vd_status st = move_base(h, vd_v3(0, 0, 0), err);
+  if (st) return st;
+  vd_vec3 ee;
+  robot_site_pose(h, h->d, &ee, NULL);
+  double yaw = h->scene.base_yaw;
+  vd_vec3 across = vd_v3(cos(yaw), sin(yaw), 0), row = vd_v3(-sin(yaw), cos(yaw), 0);
+  int* order = vd_malloc((size_t)h->nfruit * sizeof(int));
+  double* key = vd_malloc((size_t)h->nfruit * sizeof(double));
+  if (!order || !key) {
+    vd_free(order, (size_t)h->nfruit * sizeof(int));
+    vd_free(key, (size_t)h->nfruit * sizeof(double));
+    return vd_error_set(err, VD_ERR_NOMEM, "", 0, 0, "out of memory");
+  }
+  int n = 0;
+  for (int f = 0; f < h->nfruit; f++) {
+    if (h->scene.target_instance > 0 && h->fruit[f].instance != h->scene.target_instance) continue;
+    vd_vec3 p = h->sd->node_pos[h->fruit[f].node];
+    key[f] = fabs(vd_dot(vd_sub(p, ee), across)) + 1e-6 * p.z;
+    int i = n++;
+    for (; i > 0 && key[order[i - 1]] > key[f]; i--) order[i] = order[i - 1];
+    order[i] = f;
+  }
+  vd_vec3 moved = vd_v3(0, 0, 0), first = moved;
+  int placed = 0;
+  for (int i = 0; !st && i < n && !placed; i++) {
+    vd_vec3 p = h->sd->node_pos[h->fruit[order[i]].node];
+    // ee: the end effector at the scene's base; want: the base's move that lines it up
+    vd_vec3 want = vd_madd(vd_v3(0, 0, p.z - ee.z), row, vd_dot(vd_sub(p, ee), row));
+    if (i == 0) first = want;
+    st = move_base(h, vd_sub(want, moved), err);
+    moved = want;
+    double e;
+    vd_error quiet = {0};
+    placed = !st && reachable(h, order[i], &e) && start_pose_check(h, &quiet) == VD_OK;
+  }
+  if (!st && !placed && n) st = move_base(h, vd_sub(first, moved), err);
+  vd_free(order, (size_t)h->nfruit * sizeof(int));
+  vd_free(key, (size_t)h->nfruit * sizeof(double));
+  return st;
+}
+
 vd_status vd_harvest_create_with(const vd_scene* scene, const vd_robot* robot, const vd_model* plant,
                                  vd_harvest** out, vd_error* err) {
   *out = NULL;
@@ -220,6 +290,8 @@ vd_status vd_harvest_create_with(const vd_scene* scene, const vd_robot* robot, c
     }
   }
   if (!st) st = robot_colliders(h, err);
+  // (the colliders follow the moved base at the reset below)
+  if (!st && h->scene.base_auto) st = place_base(h, err);
   if (st) {
     vd_harvest_destroy(h);
     return st;

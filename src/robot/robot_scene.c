@@ -237,7 +237,7 @@ static vd_status read_plant(rd* r, const cJSON* o, vd_scene* s) {
 static vd_status read_robot(rd* r, const cJSON* o, vd_scene* s) {
   static const char* keys[] = {"mjcf",    "base",         "q0",           "ee_site",
                                "gripper", "gripper_open", "gripper_closed", NULL};
-  static const char* bkeys[] = {"pos", "yaw_deg", NULL};
+  static const char* bkeys[] = {"pos", "yaw_deg", "auto", NULL};
   const char* w = "robot";
   if (!o) return bad(r, "", "robot", "an object with \"mjcf\"");
   vd_status st = known_keys(r, o, w, keys);
@@ -249,6 +249,7 @@ static vd_status read_robot(rd* r, const cJSON* o, vd_scene* s) {
   if (!st && base) st = vec(r, base, "robot.base", "pos", 3, 1e4, "[x, y, z] (m)", pos);
   if (!st && base)
     st = num(r, base, "robot.base", "yaw_deg", -360, 360, "an angle in -360..360 (deg)", &yaw);
+  if (!st && base) st = flag(r, base, "robot.base", "auto", &s->base_auto);
   if (st) return st;
   s->base_pos = vd_v3(pos[0], pos[1], pos[2]);
   s->base_yaw = yaw * M_PI / 180;
