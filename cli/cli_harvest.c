@@ -142,11 +142,8 @@ static vd_status scene_plant(const vd_scene* s, vd_plant_spec** spec, vd_model**
   return st;
 }
 
-// the summary of an episode as JSON (NULL when out of memory)
-static cJSON* summary_json(const vd_harvest* h, double wall) {
-  const vd_scene* s = vd_harvest_scene(h);
-  vd_harvest_summary r;
-  vd_harvest_summarize(h, &r);
+// the keys every episode record begins with (NULL when out of memory)
+static cJSON* record_begin(const vd_scene* s) {
   cJSON* o = cJSON_CreateObject();
   if (!o) return NULL;
   cJSON_AddStringToObject(o, "format", "verdant-harvest");
@@ -155,6 +152,16 @@ static cJSON* summary_json(const vd_harvest* h, double wall) {
   cJSON_AddStringToObject(o, "method", vd_harvest_method_name(s->method.method));
   cJSON_AddBoolToObject(o, "two_way", s->two_way);
   cJSON_AddNumberToObject(o, "plant_seed", (double)s->plant_seed);
+  return o;
+}
+
+// the summary of an episode as JSON (NULL when out of memory)
+static cJSON* summary_json(const vd_harvest* h, double wall) {
+  const vd_scene* s = vd_harvest_scene(h);
+  vd_harvest_summary r;
+  vd_harvest_summarize(h, &r);
+  cJSON* o = record_begin(s);
+  if (!o) return NULL;
   cJSON_AddNumberToObject(o, "target_instance", r.target_instance);
   cJSON_AddBoolToObject(o, "grasped", r.grasped);
   cJSON_AddBoolToObject(o, "detached", r.detached);
@@ -497,13 +504,8 @@ static cJSON* complete_record(const batch* b, int k, int* mismatch) {
 // outcome with reason "failed" and the error, so that the batch goes on
 static cJSON* failure_json(const vd_scene* s, const vd_error* e, vd_status st) {
   char buf[1024];
-  cJSON* o = cJSON_CreateObject();
+  cJSON* o = record_begin(s);
   if (!o) return NULL;
-  cJSON_AddStringToObject(o, "format", "verdant-harvest");
-  cJSON_AddNumberToObject(o, "version", VD_HARVEST_FORMAT_VERSION);
-  cJSON_AddStringToObject(o, "scene", s->path);
-  cJSON_AddStringToObject(o, "method", vd_harvest_method_name(s->method.method));
-  cJSON_AddNumberToObject(o, "plant_seed", (double)s->plant_seed);
   cJSON_AddNumberToObject(o, "target_instance", 0);
   cJSON_AddBoolToObject(o, "grasped", 0);
   cJSON_AddBoolToObject(o, "detached", 0);
