@@ -498,6 +498,16 @@ static void mjcf_mesh(FILE* fp, const char* name, const tmesh* s, vd_vec3 o) {
   fprintf(fp, "\"/>\n");
 }
 
+// one MJCF material per label (its colour), named prefix + the label's name
+static void mjcf_materials(FILE* fp, const vd_model* m, const char* pre) {
+  for (int i = 0; i < m->nlabel; i++) {
+    char lname[VD_LABEL_NAME_MAX + 16];
+    geom_obj_name(m->labels, m->nlabel, m->labels[i].id, lname, sizeof lname);
+    fprintf(fp, "    <material name=\"%s%s\" rgba=\"%.4g %.4g %.4g 1\"/>\n", pre, lname,
+            m->labels[i].rgb[0], m->labels[i].rgb[1], m->labels[i].rgb[2]);
+  }
+}
+
 static vd_status write_mjcf(out* w, const plan* p, prim_ref* pr, int cap, vd_error* err) {
   FILE* fp = w->fp;
   const vd_model* m = p->m;
@@ -507,12 +517,7 @@ static vd_status write_mjcf(out* w, const plan* p, prim_ref* pr, int cap, vd_err
               "(%slabel_instance), units m; include it beside a robot: <include file=\"...\"/> -->\n",
           VD_EXPORT_FORMAT_VERSION, pre);
   fprintf(fp, "<mujoco model=\"%s\">\n  <asset>\n", d->name);
-  for (int i = 0; i < m->nlabel; i++) {
-    char lname[VD_LABEL_NAME_MAX + 16];
-    geom_obj_name(m->labels, m->nlabel, m->labels[i].id, lname, sizeof lname);
-    fprintf(fp, "    <material name=\"%s%s\" rgba=\"%.4g %.4g %.4g 1\"/>\n", pre, lname,
-            m->labels[i].rgb[0], m->labels[i].rgb[1], m->labels[i].rgb[2]);
-  }
+  mjcf_materials(fp, m, pre);
   // the meshes, inline, in the plant's frame
   vd_status st = VD_OK;
   for (int o = 0; !st && o < p->norg; o++) {
@@ -951,12 +956,7 @@ static vd_status write_mjcf_flex(out* w, const plan* p, const flex* f, vd_error*
           VD_EXPORT_FORMAT_VERSION, d->links_per_organ >= 0 ? "flexible" : "rigid",
           d->links_per_organ >= 0 ? "link" : "organ", pre);
   fprintf(fp, "<mujoco model=\"%s\">\n  <asset>\n", d->name);
-  for (int i = 0; i < m->nlabel; i++) {
-    char lname[VD_LABEL_NAME_MAX + 16];
-    geom_obj_name(m->labels, m->nlabel, m->labels[i].id, lname, sizeof lname);
-    fprintf(fp, "    <material name=\"%s%s\" rgba=\"%.4g %.4g %.4g 1\"/>\n", pre, lname,
-            m->labels[i].rgb[0], m->labels[i].rgb[1], m->labels[i].rgb[2]);
-  }
+  mjcf_materials(fp, m, pre);
   // the meshes in the frame of the body they ride on
   for (int i = 0; !st && i < m->nmesh; i++) {
     tmesh s;
